@@ -1,0 +1,61 @@
+#include "algo/core/status.h"
+
+#include <cstdio>
+#include <cstring>
+
+namespace lb {
+
+const char* CodeName(Code code) {
+  switch (code) {
+    case Code::kOk:
+      return "ok";
+    case Code::kInvalidArgument:
+      return "invalid argument";
+    case Code::kOutOfMemory:
+      return "out of memory";
+    case Code::kCorruptData:
+      return "corrupt data";
+    case Code::kIoError:
+      return "I/O error";
+    case Code::kNotFound:
+      return "not found";
+    case Code::kUnsupported:
+      return "unsupported";
+    case Code::kTimeout:
+      return "timeout";
+    case Code::kBusy:
+      return "busy";
+    case Code::kDegenerate:
+      return "degenerate input";
+    case Code::kInternal:
+      return "internal error";
+  }
+  return "unknown";
+}
+
+Status::Status(Code code, const char* format, ...) : code_(code) {
+  va_list args;
+  va_start(args, format);
+  vsnprintf(message_, sizeof(message_), format, args);
+  va_end(args);
+}
+
+Status& Status::Prefix(const char* format, ...) {
+  char prefix[kMaxMessage];
+  va_list args;
+  va_start(args, format);
+  int n = vsnprintf(prefix, sizeof(prefix), format, args);
+  va_end(args);
+  if (n <= 0) return *this;
+  // Shift the old message right to make room, then put the prefix in front (truncating the end).
+  const size_t plen =
+      static_cast<size_t>(n) < kMaxMessage - 1 ? static_cast<size_t>(n) : kMaxMessage - 1;
+  const size_t mlen = strnlen(message_, kMaxMessage - 1);
+  const size_t keep = mlen < kMaxMessage - 1 - plen ? mlen : kMaxMessage - 1 - plen;
+  memmove(message_ + plen, message_, keep);
+  memcpy(message_, prefix, plen);
+  message_[plen + keep] = '\0';
+  return *this;
+}
+
+}  // namespace lb

@@ -1,0 +1,246 @@
+#include "algo/pipeline/pipeline.h"
+
+#include <cstring>
+
+#include "algo/core/color.h"
+
+namespace lb {
+
+Pipeline::Layout Pipeline::Plan(const PipelineConfig& c) {
+  int32_t s = 1;
+  while (c.width / s > c.max_working_width || c.height / s > c.max_working_height) ++s;
+  return {s, c.width / s, c.height / s};
+}
+
+static DepthConfig MakeDepthConfig(const PipelineConfig& c, int32_t w, int32_t h) {
+  DepthConfig d;
+  d.width = w;
+  d.height = h;
+  d.views = c.frames;
+  d.reference = c.reference;
+  d.labels = c.labels;
+  d.disp_min_q8 = c.disp_min_q8;
+  d.disp_max_q8 = c.disp_max_q8;
+  return d;
+}
+
+static RenderConfig MakeRenderConfig(const PipelineConfig& c, int32_t s, int32_t w, int32_t h) {
+  RenderConfig r;
+  r.width = c.width;
+  r.height = c.height;
+  r.working_scale = s;
+  r.working_width = w;
+  r.working_height = h;
+  r.max_radius = c.max_blur_radius;
+  return r;
+}
+
+Status Pipeline::RequiredBytes(const PipelineConfig& c, size_t* bytes) {
+  *bytes = 0;
+  if (c.width < 16 || c.height < 16 || c.width > PipelineConfig::kMaxWidth ||
+      c.height > PipelineConfig::kMaxHeight) {
+    return Status(Code::kInvalidArgument, "frame size %dx%d outside 16x16 .. %dx%d", c.width,
+                  c.height, PipelineConfig::kMaxWidth, PipelineConfig::kMaxHeight);
+  }
+  if (c.frames < 2 || c.frames > PipelineConfig::kMaxFrames) {
+    return Status(Code::kInvalidArgument,
+                  "a burst of %d frame%s: depth needs at least 2 views (at most %d)", c.frames,
+                  c.frames == 1 ? "" : "s", PipelineConfig::kMaxFrames);
+  }
+  if (c.max_working_width < 8 || c.max_working_height < 8) {
+    return Status(Code::kInvalidArgument, "working size bound %dx%d is below 8x8",
+                  c.max_working_width, c.max_working_height);
+  }
+  const Layout l = Plan(c);
+  LB_RETURN_IF_ERROR(DepthStage::Validate(MakeDepthConfig(c, l.work_w, l.work_h)));
+  LB_RETURN_IF_ERROR(RenderStage::Validate(MakeRenderConfig(c, l.scale, l.work_w, l.work_h)));
+  Pipeline planner;
+  planner.config_ = c;
+  planner.scale_ = l.scale;
+  planner.work_w_ = l.work_w;
+  planner.work_h_ = l.work_h;
+  Arena plan;
+  LB_RETURN_IF_ERROR(planner.Carve(plan));
+  *bytes = plan.used();
+  return Status::Ok();
+}
+
+Status Pipeline::Carve(Arena& arena) {
+  const PipelineConfig& c = config_;
+  ref_.count = 3;
+  ref_.planes[0] = arena.AllocateImage<uint8_t>(c.width, c.height);
+  ref_.planes[1] = arena.AllocateImage<uint8_t>((c.width + 1) / 2, (c.height + 1) / 2);
+  ref_.planes[2] = arena.AllocateImage<uint8_t>((c.width + 1) / 2, (c.height + 1) / 2);
+  for (int32_t i = 0; i < c.frames; ++i)
+    working_[i] = arena.AllocateImage<uint8_t>(work_w_, work_h_, 3);
+  disp_q8_ = arena.AllocateImage<uint16_t>(work_w_, work_h_);
+  rgb_rows_[0] = arena.Allocate<uint8_t>(static_cast<size_t>(c.width) * 3);
+  rgb_rows_[1] = arena.Allocate<uint8_t>(static_cast<size_t>(c.width) * 3);
+  acc_ = arena.Allocate<uint32_t>(static_cast<size_t>(work_w_) * 3);
+  if (arena.planning()) {
+    (void)arena.AllocateBytes(DepthStage::RequiredBytes(MakeDepthConfig(c, work_w_, work_h_)));
+    (void)arena.AllocateBytes(
+        RenderStage::RequiredBytes(MakeRenderConfig(c, scale_, work_w_, work_h_)));
+    return Status::Ok();
+  }
+  LB_RETURN_IF_ERROR(depth_.Configure(MakeDepthConfig(c, work_w_, work_h_), arena));
+  LB_RETURN_IF_ERROR(render_.Configure(MakeRenderConfig(c, scale_, work_w_, work_h_), arena));
+  if (arena.overflowed()) {
+    return Status(Code::kOutOfMemory, "pipeline arena of %zu bytes is too small (needs %zu)",
+                  arena.size(), arena.used());
+  }
+  return Status::Ok();
+}
+
+Status Pipeline::Configure(const PipelineConfig& config, void* arena, size_t bytes) {
+  size_t needed = 0;
+  LB_RETURN_IF_ERROR(RequiredBytes(config, &needed));
+  if (bytes < needed) {
+    return Status(Code::kOutOfMemory, "pipeline needs %zu arena bytes, got %zu", needed, bytes);
+  }
+  if (reinterpret_cast<uintptr_t>(arena) % Arena::kAlign != 0) {
+    return Status(Code::kInvalidArgument, "pipeline arena is not %zu-byte aligned", Arena::kAlign);
+  }
+  config_ = config;
+  const Layout l = Plan(config);
+  scale_ = l.scale;
+  work_w_ = l.work_w;
+  work_h_ = l.work_h;
+  Arena a(arena, bytes);
+  LB_RETURN_IF_ERROR(Carve(a));
+  ResetBurst();
+  return Status::Ok();
+}
+
+void Pipeline::ResetBurst() {
+  received_mask_ = 0;
+  in_frame_ = false;
+  depth_ready_ = false;
+  render_started_ = false;
+}
+
+Status Pipeline::BeginFrame(const FrameInfo& info) {
+  if (in_frame_)
+    return Status(Code::kInvalidArgument, "frame %d began before frame %d ended", info.index,
+                  frame_.index);
+  if (info.index < 0 || info.index >= config_.frames) {
+    return Status(Code::kInvalidArgument, "frame index %d outside the burst of %d", info.index,
+                  config_.frames);
+  }
+  if (received_mask_ & (1u << info.index)) {
+    return Status(Code::kInvalidArgument, "frame %d delivered twice", info.index);
+  }
+  if (info.width != config_.width || info.height != config_.height) {
+    return Status(Code::kInvalidArgument, "frame %d is %dx%d, the burst is %dx%d", info.index,
+                  info.width, info.height, config_.width, config_.height);
+  }
+  if (BytesPerPixel(info.format) == 0) {
+    return Status(Code::kUnsupported, "frame %d: pixel format %s", info.index,
+                  PixelFormatName(info.format));
+  }
+  frame_ = info;
+  in_frame_ = true;
+  next_row_ = 0;
+  depth_ready_ = false;
+  memset(acc_, 0, static_cast<size_t>(work_w_) * 3 * sizeof(uint32_t));
+  return Status::Ok();
+}
+
+Status Pipeline::Rows(const FrameRows& rows) {
+  if (!in_frame_) return Status(Code::kInvalidArgument, "rows delivered outside a frame");
+  if (rows.y0 != next_row_ || rows.height < 0 || rows.y0 + rows.height > frame_.height) {
+    return Status(Code::kInvalidArgument, "frame %d: rows %d..%d out of order (expected row %d)",
+                  frame_.index, rows.y0, rows.y0 + rows.height - 1, next_row_);
+  }
+  for (int32_t i = 0; i < rows.height; ++i) {
+    const uint8_t* src = rows.planes[0] + rows.strides[0] * i;
+    const uint8_t* uv = nullptr;
+    if (frame_.format == PixelFormat::kNv12) {
+      uv = rows.planes[1] + rows.strides[1] * ((rows.y0 + i) / 2 - rows.y0 / 2);
+    }
+    IngestRow(src, uv, rows.y0 + i);
+  }
+  next_row_ += rows.height;
+  return Status::Ok();
+}
+
+void Pipeline::IngestRow(const uint8_t* src, const uint8_t* uv, int32_t y) {
+  uint8_t* rgb = rgb_rows_[y & 1];
+  RowToRgb8(frame_.format, src, uv, config_.width, rgb);
+  if (frame_.index == config_.reference) {
+    RowRgb8ToY(rgb, config_.width, ref_.planes[0].Row(y));
+    if ((y & 1) || y == config_.height - 1) FlushChroma(y);
+  }
+  // Integer box downscale: accumulate `scale_` rows, then write their mean (rounded).
+  const int32_t s = scale_;
+  if (y >= work_h_ * s) return;
+  for (int32_t wx = 0; wx < work_w_; ++wx) {
+    const uint8_t* p = rgb + 3 * wx * s;
+    uint32_t r = 0, g = 0, b = 0;
+    for (int32_t k = 0; k < s; ++k) {
+      r += p[3 * k];
+      g += p[3 * k + 1];
+      b += p[3 * k + 2];
+    }
+    acc_[3 * wx] += r;
+    acc_[3 * wx + 1] += g;
+    acc_[3 * wx + 2] += b;
+  }
+  if ((y + 1) % s == 0) {
+    const uint32_t n = static_cast<uint32_t>(s * s);
+    uint8_t* out = working_[frame_.index].Row(y / s);
+    for (int32_t i = 0; i < work_w_ * 3; ++i) {
+      out[i] = static_cast<uint8_t>((acc_[i] + n / 2) / n);
+      acc_[i] = 0;
+    }
+  }
+}
+
+void Pipeline::FlushChroma(int32_t y) {
+  const uint8_t* row0 = rgb_rows_[(y & 1) ? 0 : 1];
+  const uint8_t* row1 = rgb_rows_[y & 1];
+  if (!(y & 1)) row0 = row1;  // a lone last row
+  RowsRgb8ToCbCr420(row0, row1, config_.width, ref_.planes[1].Row(y / 2),
+                    ref_.planes[2].Row(y / 2));
+}
+
+Status Pipeline::EndFrame() {
+  if (!in_frame_) return Status(Code::kInvalidArgument, "EndFrame without BeginFrame");
+  in_frame_ = false;
+  if (next_row_ != frame_.height) {
+    return Status(Code::kCorruptData, "frame %d ended after %d of %d rows", frame_.index, next_row_,
+                  frame_.height);
+  }
+  received_mask_ |= 1u << frame_.index;
+  return Status::Ok();
+}
+
+Status Pipeline::ComputeDepth() {
+  const uint32_t all = (config_.frames >= 32) ? ~0u : ((1u << config_.frames) - 1);
+  if ((received_mask_ & all) != all) {
+    for (int32_t i = 0; i < config_.frames; ++i) {
+      if (!(received_mask_ & (1u << i))) {
+        return Status(Code::kNotFound, "frame %d of the burst of %d is missing", i, config_.frames);
+      }
+    }
+  }
+  ConstImageU8 views[PipelineConfig::kMaxFrames];
+  for (int32_t i = 0; i < config_.frames; ++i) views[i] = working_[i].AsConst();
+  LB_RETURN_IF_ERROR(depth_.Compute(views, disp_q8_));
+  depth_ready_ = true;
+  return Status::Ok();
+}
+
+Status Pipeline::BeginRender(const RenderParams& params) {
+  if (!depth_ready_) return Status(Code::kInvalidArgument, "render before depth was computed");
+  LB_RETURN_IF_ERROR(render_.Begin(ref_.AsConst(), disp_q8_.AsConst(), params));
+  render_started_ = true;
+  return Status::Ok();
+}
+
+Status Pipeline::NextStrip(ConstPlanarU8* strip, int32_t* y0, int32_t* rows) {
+  if (!render_started_) return Status(Code::kInvalidArgument, "NextStrip before BeginRender");
+  return render_.NextStrip(strip, y0, rows);
+}
+
+}  // namespace lb

@@ -1,0 +1,104 @@
+// The lens-blur pipeline: configure once, ingest a burst frame by frame, compute depth, render
+// strip by strip. All memory is one arena sized by RequiredBytes() from the configuration; after
+// Configure nothing is allocated.
+//
+//   size_t bytes = 0;
+//   Status s = Pipeline::RequiredBytes(config, &bytes);   // validates too
+//   Pipeline p;  s = p.Configure(config, block, bytes);  // block: 64-byte aligned
+//   sensor.CaptureBurst(p)  // p is a FrameSink: BeginFrame / Rows... / EndFrame per frame
+//   s = p.ComputeDepth();
+//   s = p.BeginRender(params);  while (p.NextStrip(&strip, &y0, &rows), rows > 0) encode(strip);
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "algo/core/arena.h"
+#include "algo/core/frame.h"
+#include "algo/core/image.h"
+#include "algo/core/status.h"
+#include "algo/depth/depth_stage.h"
+#include "algo/render/render_stage.h"
+
+namespace lb {
+
+struct PipelineConfig {
+  static constexpr int32_t kMaxFrames = DepthConfig::kMaxViews;
+  static constexpr int32_t kMaxWidth = 8192;
+  static constexpr int32_t kMaxHeight = 8192;
+
+  int32_t width = 0;  // sensor frames, full resolution
+  int32_t height = 0;
+  int32_t frames = 5;     // burst length
+  int32_t reference = 2;  // the view the output is rendered from
+  // The depth stage runs at the full resolution divided by the smallest integer factor that
+  // brings it within these bounds.
+  int32_t max_working_width = 640;
+  int32_t max_working_height = 480;
+  int32_t labels = 64;
+  // Disparity range of the labels, in working-resolution px per view step, Q8.8.
+  int32_t disp_min_q8 = 0;
+  int32_t disp_max_q8 = 16 << 8;
+  int32_t max_blur_radius = 32;  // full-resolution px
+};
+
+class Pipeline : public FrameSink {
+ public:
+  // Validates `config` and reports the arena bytes it needs.
+  static Status RequiredBytes(const PipelineConfig& config, size_t* bytes);
+
+  // Carves `arena` (at least RequiredBytes, 64-byte aligned). Resets any previous burst.
+  Status Configure(const PipelineConfig& config, void* arena, size_t bytes);
+
+  // FrameSink: frames 0..frames-1 in any order, each exactly once, each covering every row.
+  Status BeginFrame(const FrameInfo& info) override;
+  Status Rows(const FrameRows& rows) override;
+  Status EndFrame() override;
+
+  // Forgets the frames ingested so far; the configuration stays.
+  void ResetBurst();
+
+  Status ComputeDepth();
+  Status BeginRender(const RenderParams& params);
+  Status NextStrip(ConstPlanarU8* strip, int32_t* y0, int32_t* rows);
+
+  const PipelineConfig& config() const { return config_; }
+  int32_t working_scale() const { return scale_; }
+  int32_t working_width() const { return work_w_; }
+  int32_t working_height() const { return work_h_; }
+  ConstPlanarU8 reference() const { return ref_.AsConst(); }
+  ConstImageU8 working_view(int32_t i) const { return working_[i].AsConst(); }
+  ConstImageU16 disparity_q8() const { return disp_q8_.AsConst(); }
+  const DepthStage& depth() const { return depth_; }
+  RenderStage& render() { return render_; }
+
+ private:
+  struct Layout {
+    int32_t scale, work_w, work_h;
+  };
+  static Layout Plan(const PipelineConfig& config);
+  Status Carve(Arena& arena);
+  void IngestRow(const uint8_t* src, const uint8_t* uv, int32_t y);
+  void FlushChroma(int32_t y);
+
+  PipelineConfig config_;
+  int32_t scale_ = 1, work_w_ = 0, work_h_ = 0;
+
+  PlanarU8 ref_;                                 // full-resolution reference, YCbCr 4:2:0
+  ImageU8 working_[PipelineConfig::kMaxFrames];  // working-resolution views, RGB8
+  ImageU16 disp_q8_;                             // working-resolution disparity, Q8.8
+  uint8_t* rgb_rows_[2] = {nullptr, nullptr};    // full-width RGB8 rows (even, odd)
+  uint32_t* acc_ = nullptr;                      // box-downscale accumulator, working row x 3
+  DepthStage depth_;
+  RenderStage render_;
+
+  // Burst state.
+  uint32_t received_mask_ = 0;
+  bool in_frame_ = false;
+  FrameInfo frame_;
+  int32_t next_row_ = 0;
+  bool depth_ready_ = false;
+  bool render_started_ = false;
+};
+
+}  // namespace lb
