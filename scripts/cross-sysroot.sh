@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Unpacks the target-architecture libraries the firmware links (libjpeg, libpng, zlib, libexif,
+# libmd, Eigen) into build/sysroot/<arch>. `apt-get download` + `dpkg -x` instead of multiarch
+# installs: multiarch requires the host's and the target's versions of every shared package to
+# match exactly, which breaks whenever the mirror's security updates differ between architectures.
+set -euo pipefail
+arch=${1:?usage: cross-sysroot.sh arm64|armhf}
+top=$(cd "$(dirname "$0")/.." && pwd)
+root="$top/build/sysroot/$arch"
+pkgs=(libjpeg62-turbo libjpeg62-turbo-dev libpng16-16 libpng-dev zlib1g zlib1g-dev
+      libexif12 libexif-dev libmd0 libmd-dev)
+stamp="$root/.complete"
+[ -f "$stamp" ] && [ "$(cat "$stamp")" = "${pkgs[*]}" ] && exit 0
+
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO="sudo"
+if ! dpkg --print-foreign-architectures | grep -qx "$arch"; then
+  $SUDO dpkg --add-architecture "$arch"
+fi
+if ! apt-cache show "libjpeg62-turbo:$arch" >/dev/null 2>&1; then
+  $SUDO apt-get -o DPkg::Lock::Timeout=600 update -q >/dev/null 2>&1 || true
+fi
+rm -rf "$root" && mkdir -p "$root/debs"
+# Eigen is headers only (Architecture: all); its CMake package must sit in the sysroot too.
+(cd "$root/debs" && apt-get download -q libeigen3-dev "${pkgs[@]/%/:$arch}" >/dev/null)
+for deb in "$root"/debs/*.deb; do dpkg -x "$deb" "$root"; done
+# The -dev symlinks are absolute-free, but pkg-config files name /usr: rewrite to the sysroot.
+find "$root/usr/lib" -name '*.pc' -exec sed -i "s|^prefix=/usr|prefix=$root/usr|" {} +
+rm -rf "$root/debs"
+echo "${pkgs[*]}" > "$stamp"
+echo "cross-sysroot: $arch libraries in $root"
