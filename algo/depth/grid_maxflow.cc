@@ -1,0 +1,268 @@
+// Boykov-Kolmogorov max-flow ("An experimental comparison of min-cut/max-flow algorithms", PAMI
+// 2004) written for an implicit grid: two search trees grow from the terminals, an s-t path is
+// augmented as soon as they touch, and the nodes cut off by saturated arcs look for a new parent
+// in their own tree before they are freed. Time stamps and distances keep the trees shallow.
+#include "algo/depth/grid_maxflow.h"
+
+#include <cstring>
+
+namespace lb {
+
+void GridMaxflow::Carve(Arena& arena, int32_t max_nodes) {
+  max_nodes_ = max_nodes;
+  nodes_ = arena.Allocate<Node>(static_cast<size_t>(max_nodes));
+  orphans_ = arena.Allocate<int32_t>(static_cast<size_t>(max_nodes));
+}
+
+void GridMaxflow::Reset(int32_t width, int32_t height) {
+  width_ = width;
+  height_ = height;
+  count_ = width * height;
+  memset(static_cast<void*>(nodes_), 0, sizeof(Node) * static_cast<size_t>(count_));
+  flow_ = 0;
+}
+
+bool GridMaxflow::HasNeighbour(int32_t p, int dir) const {
+  switch (dir) {
+    case kRight:
+      return (p % width_) != width_ - 1;
+    case kLeft:
+      return (p % width_) != 0;
+    case kDown:
+      return p + width_ < count_;
+    default:
+      return p >= width_;
+  }
+}
+
+void GridMaxflow::Activate(int32_t p) {
+  Node& n = nodes_[p];
+  if (n.next != kNotActive) return;
+  n.next = p;  // the tail links to itself
+  if (queue_tail_ == kNotActive) {
+    queue_head_ = p;
+  } else {
+    nodes_[queue_tail_].next = p;
+  }
+  queue_tail_ = p;
+}
+
+int32_t GridMaxflow::NextActive() {
+  while (queue_head_ != kNotActive) {
+    const int32_t p = queue_head_;
+    Node& n = nodes_[p];
+    queue_head_ = (n.next == p) ? kNotActive : n.next;
+    if (queue_head_ == kNotActive) queue_tail_ = kNotActive;
+    n.next = kNotActive;
+    if (n.tree != kFree) return p;
+  }
+  return kNotActive;
+}
+
+void GridMaxflow::PushOrphan(int32_t p) {
+  nodes_[p].parent = kOrphan;
+  int32_t slot = orphan_head_ + orphan_count_;
+  if (slot >= max_nodes_) slot -= max_nodes_;
+  orphans_[slot] = p;
+  ++orphan_count_;
+}
+
+// s_node is in the source tree, its neighbour in direction `dir` in the sink tree.
+void GridMaxflow::Augment(int32_t s_node, int dir) {
+  const int32_t t_node = Neighbour(s_node, dir);
+  int32_t bottleneck = nodes_[s_node].cap[dir];
+  // Source side: arcs parent -> child, up to the root's source capacity.
+  for (int32_t p = s_node;;) {
+    const Node& n = nodes_[p];
+    if (n.parent == kTerminal) {
+      if (n.tcap < bottleneck) bottleneck = n.tcap;
+      break;
+    }
+    const int32_t parent = Neighbour(p, n.parent);
+    const int32_t c = nodes_[parent].cap[n.parent ^ 1];
+    if (c < bottleneck) bottleneck = c;
+    p = parent;
+  }
+  // Sink side: arcs child -> parent, down to the root's sink capacity.
+  for (int32_t p = t_node;;) {
+    const Node& n = nodes_[p];
+    if (n.parent == kTerminal) {
+      if (-n.tcap < bottleneck) bottleneck = -n.tcap;
+      break;
+    }
+    if (n.cap[n.parent] < bottleneck) bottleneck = n.cap[n.parent];
+    p = Neighbour(p, n.parent);
+  }
+
+  nodes_[s_node].cap[dir] -= bottleneck;
+  nodes_[t_node].cap[dir ^ 1] += bottleneck;
+  for (int32_t p = s_node;;) {
+    Node& n = nodes_[p];
+    if (n.parent == kTerminal) {
+      n.tcap -= bottleneck;
+      if (n.tcap == 0) PushOrphan(p);
+      break;
+    }
+    const int32_t parent = Neighbour(p, n.parent);
+    const int d = n.parent;
+    n.cap[d] += bottleneck;
+    nodes_[parent].cap[d ^ 1] -= bottleneck;
+    if (nodes_[parent].cap[d ^ 1] == 0) PushOrphan(p);
+    p = parent;
+  }
+  for (int32_t p = t_node;;) {
+    Node& n = nodes_[p];
+    if (n.parent == kTerminal) {
+      n.tcap += bottleneck;
+      if (n.tcap == 0) PushOrphan(p);
+      break;
+    }
+    const int32_t parent = Neighbour(p, n.parent);
+    const int d = n.parent;
+    n.cap[d] -= bottleneck;
+    nodes_[parent].cap[d ^ 1] += bottleneck;
+    if (n.cap[d] == 0) PushOrphan(p);
+    p = parent;
+  }
+  flow_ += bottleneck;
+}
+
+// Finds a new parent for orphan p in its own tree, or frees it and orphans its children.
+void GridMaxflow::Adopt(int32_t p) {
+  Node& n = nodes_[p];
+  const bool source = n.tree == kSourceTree;
+  int best_dir = -1;
+  uint32_t best_dist = UINT32_MAX;
+  for (int dir = 0; dir < 4; ++dir) {
+    if (!HasNeighbour(p, dir)) continue;
+    const int32_t q = Neighbour(p, dir);
+    if (nodes_[q].tree != n.tree) continue;
+    // The arc that would carry flow from the new parent: q->p in the source tree, p->q in the sink.
+    const int32_t c = source ? nodes_[q].cap[dir ^ 1] : n.cap[dir];
+    if (c <= 0) continue;
+    // Walk up from q: does it reach the terminal without passing through an orphan?
+    uint32_t d = 0;
+    bool valid = false;
+    for (int32_t j = q;;) {
+      Node& m = nodes_[j];
+      if (m.ts == time_) {
+        d += m.dist;
+        valid = true;
+        break;
+      }
+      ++d;
+      if (m.parent == kTerminal) {
+        m.ts = time_;
+        m.dist = 1;
+        valid = true;
+        break;
+      }
+      if (m.parent == kOrphan) break;
+      j = Neighbour(j, m.parent);
+    }
+    if (!valid) continue;
+    if (d < best_dist) {
+      best_dist = d;
+      best_dir = dir;
+    }
+    // Record the verified distances along the path so later walks stop early.
+    for (int32_t j = q; nodes_[j].ts != time_;) {
+      Node& m = nodes_[j];
+      m.ts = time_;
+      m.dist = static_cast<uint16_t>(d > 0xffff ? 0xffff : d);
+      --d;
+      j = Neighbour(j, m.parent);
+    }
+  }
+  if (best_dir >= 0) {
+    n.parent = static_cast<uint8_t>(best_dir);
+    n.ts = time_;
+    n.dist = static_cast<uint16_t>(best_dist + 1 > 0xffff ? 0xffff : best_dist + 1);
+    return;
+  }
+  // No parent: p leaves its tree. Neighbours that could feed it become active again, and its
+  // children become orphans.
+  for (int dir = 0; dir < 4; ++dir) {
+    if (!HasNeighbour(p, dir)) continue;
+    const int32_t q = Neighbour(p, dir);
+    Node& m = nodes_[q];
+    if (m.tree != n.tree) continue;
+    const int32_t c = source ? m.cap[dir ^ 1] : n.cap[dir];
+    if (c > 0) Activate(q);
+    if (m.parent == (dir ^ 1)) PushOrphan(q);
+  }
+  n.tree = kFree;
+}
+
+int64_t GridMaxflow::Solve() {
+  queue_head_ = queue_tail_ = kNotActive;
+  orphan_head_ = orphan_count_ = 0;
+  time_ = 0;
+  for (int32_t p = 0; p < count_; ++p) {
+    Node& n = nodes_[p];
+    n.next = kNotActive;
+    n.ts = 0;
+    n.dist = 1;
+    if (n.tcap > 0) {
+      n.tree = kSourceTree;
+      n.parent = kTerminal;
+      Activate(p);
+    } else if (n.tcap < 0) {
+      n.tree = kSinkTree;
+      n.parent = kTerminal;
+      Activate(p);
+    } else {
+      n.tree = kFree;
+      n.parent = kOrphan;
+    }
+  }
+
+  int32_t current = kNotActive;
+  for (;;) {
+    if (current == kNotActive || nodes_[current].tree == kFree) current = NextActive();
+    if (current == kNotActive) break;
+    const int32_t p = current;
+    Node& n = nodes_[p];
+    const bool source = n.tree == kSourceTree;
+    int32_t touch_s = -1;
+    int touch_dir = 0;
+    for (int dir = 0; dir < 4 && touch_s < 0; ++dir) {
+      if (!HasNeighbour(p, dir)) continue;
+      const int32_t q = Neighbour(p, dir);
+      const int32_t c = source ? n.cap[dir] : nodes_[q].cap[dir ^ 1];
+      if (c <= 0) continue;
+      Node& m = nodes_[q];
+      if (m.tree == kFree) {
+        m.tree = n.tree;
+        m.parent = static_cast<uint8_t>(dir ^ 1);
+        m.ts = n.ts;
+        m.dist = static_cast<uint16_t>(n.dist == 0xffff ? 0xffff : n.dist + 1);
+        Activate(q);
+      } else if (m.tree != n.tree) {
+        touch_s = source ? p : q;
+        touch_dir = source ? dir : (dir ^ 1);
+      } else if (m.ts <= n.ts && m.dist > n.dist) {
+        // p is a closer parent for q than the one it has.
+        m.parent = static_cast<uint8_t>(dir ^ 1);
+        m.ts = n.ts;
+        m.dist = static_cast<uint16_t>(n.dist + 1);
+      }
+    }
+    if (touch_s < 0) {
+      current = kNotActive;
+      continue;
+    }
+    ++time_;
+    Augment(touch_s, touch_dir);
+    while (orphan_count_ > 0) {
+      const int32_t o = orphans_[orphan_head_];
+      orphan_head_ = orphan_head_ + 1 == max_nodes_ ? 0 : orphan_head_ + 1;
+      --orphan_count_;
+      Adopt(o);
+    }
+    // Keep growing from p while it is still in a tree: it may touch the other tree again.
+  }
+  return flow_;
+}
+
+}  // namespace lb

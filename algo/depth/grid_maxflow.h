@@ -1,0 +1,99 @@
+// Boykov-Kolmogorov max-flow on an implicit 4-connected grid: node p = y * width + x, arcs to the
+// right, left, down and up neighbours found by arithmetic, so there are no adjacency lists. All
+// node storage is carved once for the largest grid and reused by every expansion move (Reset).
+//
+// Capacities are int32 and must stay within kMaxCapacity so that the residual of an arc (its own
+// capacity plus its sister's) and a node's terminal balance cannot overflow; flow totals are int64.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "algo/core/arena.h"
+
+namespace lb {
+
+class GridMaxflow {
+ public:
+  static constexpr int32_t kMaxCapacity = 1 << 28;
+  // Arc directions; the sister of arc (p, d) is (neighbour(p, d), d ^ 1).
+  enum Dir : uint8_t { kRight = 0, kLeft = 1, kDown = 2, kUp = 3 };
+
+  // Carves node storage for grids of up to `max_nodes` nodes.
+  void Carve(Arena& arena, int32_t max_nodes);
+
+  // Starts a new graph of width x height nodes (width * height <= max_nodes), all capacities 0.
+  void Reset(int32_t width, int32_t height);
+
+  // Adds terminal capacities source->p and p->sink (both >= 0).
+  void AddTerminal(int32_t p, int32_t cap_source, int32_t cap_sink) {
+    const int32_t m = cap_source < cap_sink ? cap_source : cap_sink;
+    flow_ += m;
+    nodes_[p].tcap += cap_source - cap_sink;
+  }
+  // Adds a signed terminal balance: positive goes to source->p, negative to p->sink.
+  void AddTerminalBalance(int32_t p, int32_t balance) { nodes_[p].tcap += balance; }
+
+  // Adds capacity to the arc p->q and its sister q->p, q = neighbour of p in direction `dir`.
+  void AddEdge(int32_t p, Dir dir, int32_t cap_pq, int32_t cap_qp) {
+    nodes_[p].cap[dir] += cap_pq;
+    nodes_[Neighbour(p, dir)].cap[dir ^ 1] += cap_qp;
+  }
+
+  // Computes the maximum flow (including what AddTerminal routed directly).
+  int64_t Solve();
+
+  // After Solve: true when p is on the source side of the minimum cut.
+  bool InSource(int32_t p) const { return nodes_[p].tree == kSourceTree; }
+
+  int32_t width() const { return width_; }
+  int32_t height() const { return height_; }
+
+ private:
+  static constexpr uint8_t kFree = 0, kSourceTree = 1, kSinkTree = 2;
+  static constexpr uint8_t kTerminal = 4, kOrphan = 5;  // parent values besides a Dir
+  static constexpr int32_t kNotActive = -1;
+
+  struct Node {
+    int32_t cap[4];  // residual capacity of the arc to each neighbour
+    int32_t tcap;    // residual terminal capacity: > 0 from the source, < 0 to the sink
+    int32_t next;    // active queue link (kNotActive when not queued, self at the tail)
+    int32_t ts;      // time stamp of the last verified distance to a terminal
+    uint16_t dist;   // distance to the terminal (saturating; only a heuristic)
+    uint8_t parent;  // a Dir, kTerminal or kOrphan
+    uint8_t tree;    // kFree, kSourceTree or kSinkTree
+  };
+  static_assert(sizeof(Node) == 32);
+
+  int32_t Neighbour(int32_t p, int dir) const {
+    switch (dir) {
+      case kRight:
+        return p + 1;
+      case kLeft:
+        return p - 1;
+      case kDown:
+        return p + width_;
+      default:
+        return p - width_;
+    }
+  }
+  // The set of directions whose neighbour exists, for node p at (x, y).
+  bool HasNeighbour(int32_t p, int dir) const;
+
+  void Activate(int32_t p);
+  int32_t NextActive();
+  void Augment(int32_t s_node, int dir);
+  void Adopt(int32_t p);
+  void PushOrphan(int32_t p);
+
+  Node* nodes_ = nullptr;
+  int32_t* orphans_ = nullptr;  // ring buffer of max_nodes_ entries
+  int32_t max_nodes_ = 0;
+  int32_t width_ = 0, height_ = 0, count_ = 0;
+  int32_t queue_head_ = kNotActive, queue_tail_ = kNotActive;
+  int32_t orphan_head_ = 0, orphan_count_ = 0;
+  int32_t time_ = 0;
+  int64_t flow_ = 0;
+};
+
+}  // namespace lb
