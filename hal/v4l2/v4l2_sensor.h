@@ -1,0 +1,76 @@
+// V4L2 sensor: a single-planar capture node streamed through mmap'ed driver buffers. Configure
+// opens the node, negotiates the format and maps the buffers (the slow part, so a half press can
+// run it early); CaptureBurst streams, hands each frame to the sink as one strip straight from
+// its driver buffer, and stops streaming again. Dropped frames (a gap in the buffer sequence
+// numbers or a buffer the driver flags bad) fail the burst: the depth stage assumes evenly spaced
+// views, so the caller retries with a fresh burst.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "hal/sensor.h"
+#include "hal/v4l2/frame_sequence.h"
+#include "hal/v4l2/v4l2_format.h"
+#include "hal/v4l2/v4l2_io.h"
+
+namespace lb {
+
+struct V4l2Options {
+  static constexpr int32_t kMaxBuffers = 8;
+  const char* device = "/dev/video0";  // copied by the constructor
+  uint32_t fourcc = 0;                 // 0: the first of kV4l2Preferred the device offers
+  // Driver buffers to request, 2..kMaxBuffers; 0: one per burst frame, so a slow consumer never
+  // leaves the driver without a buffer (which it reports as a dropped frame).
+  int32_t buffers = 0;
+};
+
+class V4l2Sensor : public Sensor {
+ public:
+  static constexpr int32_t kMaxFrames = 64;
+
+  // `io` is borrowed (tests pass a scripted device); nullptr means the real system calls.
+  explicit V4l2Sensor(const V4l2Options& options, V4l2Io* io = nullptr);
+  ~V4l2Sensor() override;
+  V4l2Sensor(const V4l2Sensor&) = delete;
+  V4l2Sensor& operator=(const V4l2Sensor&) = delete;
+
+  const char* name() const override { return "v4l2"; }
+  Status Configure(const SensorConfig& config, SensorMode* mode) override;
+  Status CaptureBurst(FrameSink& sink) override;
+  void Stop() override;
+
+  const V4l2Layout& layout() const { return layout_; }
+  uint32_t fourcc() const { return fourcc_; }
+  int32_t buffer_count() const { return buffer_count_; }
+
+ private:
+  struct Buffer {
+    void* addr = nullptr;
+    size_t length = 0;
+  };
+
+  Status IoctlError(const char* what, int err) const;
+  Status OpenAndNegotiate(const SensorConfig& config);
+  Status MapBuffers();
+  Status QueueBuffer(uint32_t index);
+  Status WaitFrame();
+  Status Stream(FrameSink& sink);
+  Status Deliver(FrameSink& sink, const v4l2_buffer& buf, int32_t index);
+
+  V4l2Io* io_;
+  char device_[128] = {};
+  uint32_t wanted_fourcc_ = 0;
+  int32_t wanted_buffers_ = 0;
+
+  int fd_ = -1;
+  SensorConfig config_;
+  uint32_t fourcc_ = 0;
+  V4l2Layout layout_;
+  Buffer buffers_[V4l2Options::kMaxBuffers];
+  int32_t buffer_count_ = 0;
+  bool streaming_ = false;
+  FrameSequence sequence_;
+};
+
+}  // namespace lb
