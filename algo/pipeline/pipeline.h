@@ -47,6 +47,9 @@ class Pipeline : public FrameSink {
   // Validates `config` and reports the arena bytes it needs.
   static Status RequiredBytes(const PipelineConfig& config, size_t* bytes);
 
+  // The integer factor between the full and the working resolution for this configuration.
+  static int32_t WorkingScale(const PipelineConfig& config) { return Plan(config).scale; }
+
   // Carves `arena` (at least RequiredBytes, 64-byte aligned). Resets any previous burst.
   Status Configure(const PipelineConfig& config, void* arena, size_t bytes);
 

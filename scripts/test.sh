@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# Every check CI runs: set-up, format, host tests under ASan+UBSan, the Middlebury accuracy tests
+# in Release, short fuzz runs, clang-tidy on algo/, and the ARM builds with their unit tests under
+# qemu-user. Ends with one line "tests: N passed, M failed".
+set -uo pipefail
+cd "$(dirname "$0")/.."
+top=$(pwd)
+jobs=${JOBS:-$(nproc)}
+passed=0
+failed=0
+log=$(mktemp -d)
+
+step() { printf '\n=== %s\n' "$*"; }
+die() { echo "test: $*" >&2; echo "tests: $passed passed, $((failed + 1)) failed"; exit 1; }
+# Runs ctest and adds its counts to the totals.
+run_ctest() {
+  local name=$1; shift
+  ctest "$@" --output-on-failure -j "$jobs" 2>&1 | tee "$log/$name.log" | grep -vE '^\s+(Start|[0-9]+/[0-9]+ Test)' || true
+  local line
+  line=$(grep -E 'tests passed, [0-9]+ tests failed out of [0-9]+' "$log/$name.log" | tail -1)
+  if [ -z "$line" ]; then
+    grep -q 'No tests were found' "$log/$name.log" && return 0
+    failed=$((failed + 1)); echo "test: $name: ctest gave no summary"; return 0
+  fi
+  local total fails
+  total=$(sed -E 's/.*out of ([0-9]+).*/\1/' <<<"$line")
+  fails=$(sed -E 's/.*passed, ([0-9]+) tests failed.*/\1/' <<<"$line")
+  passed=$((passed + total - fails)); failed=$((failed + fails))
+}
+
+step "set-up"
+bash scripts/setup.sh || die "set-up failed"
+bash scripts/cross-sysroot.sh arm64 || die "arm64 sysroot failed"
+bash scripts/cross-sysroot.sh armhf || die "armhf sysroot failed"
+
+step "format (clang-format)"
+mapfile -t sources < <(git ls-files '*.h' '*.cc')
+if ! clang-format --dry-run --Werror "${sources[@]}" 2>"$log/format.txt"; then
+  head -20 "$log/format.txt"; die "files are not clang-formatted (run: clang-format -i FILE)"
+fi
+
+step "host-asan: build and all tests but data and vm (AddressSanitizer + UBSan)"
+cmake --preset host-asan >/dev/null || die "configure host-asan"
+cmake --build --preset host-asan -j "$jobs" || die "build host-asan"
+run_ctest host-asan --preset host-asan -LE 'data|vm'
+
+step "host (Release): Middlebury accuracy tests and the command line"
+cmake --preset host >/dev/null || die "configure host"
+cmake --build --preset host -j "$jobs" || die "build host"
+run_ctest host-data --preset host -L data
+
+if [ -d tests/vm ]; then
+  step "kernel drivers in a VM (vivid, uinput, vimc)"
+  run_ctest host-vm --preset host -L vm
+fi
+
+step "fuzz: short runs of every file-reader fuzzer (clang-14, ASan + UBSan)"
+cmake --preset fuzz >/dev/null || die "configure fuzz"
+cmake --build --preset fuzz -j "$jobs" || die "build fuzz"
+if [ -x tests/fuzz/run_fuzzers.sh ]; then
+  if bash tests/fuzz/run_fuzzers.sh "${FUZZ_SECONDS:-20}" build/fuzz; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1)); echo "test: a fuzzer found a crash"
+  fi
+fi
+
+step "clang-tidy on algo/"
+if ! clang-tidy -p build/host-asan --quiet $(git ls-files 'algo/*.cc') >"$log/tidy.txt" 2>&1; then
+  grep -E 'warning:|error:' "$log/tidy.txt" | head -30; die "clang-tidy found problems in algo/"
+fi
+
+for arch in aarch64 armhf; do
+  step "$arch: cross build (-Werror) and unit tests under qemu-user"
+  cmake --preset "$arch" >/dev/null || die "configure $arch"
+  cmake --build --preset "$arch" -j "$jobs" || die "build $arch"
+  run_ctest "$arch" --preset "$arch"
+done
+
+echo
+echo "tests: $passed passed, $failed failed"
+[ "$failed" -eq 0 ]
