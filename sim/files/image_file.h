@@ -3,6 +3,7 @@
 // message names the file and the problem, never a crash.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -10,6 +11,10 @@
 #include "algo/core/status.h"
 
 namespace lb {
+
+// How to decode bytes: by their magic bytes (kAuto) or as one format whatever they start with
+// (the fuzz targets force a format so every mutation reaches that decoder).
+enum class ImageFileType : uint8_t { kAuto, kPnm, kPng, kJpeg };
 
 struct ImageFileInfo {
   PixelFormat format = PixelFormat::kRgb8;  // kGray8, kRgb8, kGray16 or kRgb16
@@ -29,8 +34,15 @@ Status StreamImageFile(const char* path, int32_t index, FrameSink& sink);
 Status ReadImageFile(const char* path, ImageFileInfo* info, std::vector<uint8_t>* pixels);
 
 // The same readers over bytes in memory (the fuzz targets and the JPEG/XMP reader use them).
-// `name` is used in error messages.
+// `name` is used in error messages. On error `pixels` is left empty.
 Status ReadImageMemory(const uint8_t* data, size_t size, const char* name, ImageFileInfo* info,
-                       std::vector<uint8_t>* pixels);
+                       std::vector<uint8_t>* pixels, ImageFileType type = ImageFileType::kAuto);
+Status ProbeImageMemory(const uint8_t* data, size_t size, const char* name, ImageFileInfo* info,
+                        ImageFileType type = ImageFileType::kAuto);
+
+// Frames are capped at this size in each direction (a corrupt header cannot ask for gigabytes).
+inline constexpr int32_t kMaxImageSide = 16384;
+// Streaming readers deliver strips of at most this many rows.
+inline constexpr int32_t kImageStripRows = 16;
 
 }  // namespace lb

@@ -1,0 +1,156 @@
+// PNG through libpng. libpng reports errors by longjmp: everything that must survive one (the
+// png structs, the row buffers) lives in PngReader, so nothing with a destructor is skipped.
+#include <png.h>
+
+#include <cinttypes>
+#include <csetjmp>
+#include <cstring>
+
+#include "sim/files/decoder.h"
+
+namespace lb::files {
+namespace {
+
+class PngReader {
+ public:
+  PngReader(ByteSource& src, const DecodeRequest& request) : src_(src), request_(request) {}
+  ~PngReader() {
+    if (png_ != nullptr) png_destroy_read_struct(&png_, &info_, nullptr);
+  }
+
+  Status Run();
+
+ private:
+  static void OnError(png_structp png, png_const_charp message) {
+    auto* self = static_cast<PngReader*>(png_get_error_ptr(png));
+    snprintf(self->message_, sizeof(self->message_), "%s", message);
+    png_longjmp(png, 1);
+  }
+  static void OnWarning(png_structp, png_const_charp) {}  // benign: unknown chunks, sRGB quirks
+  static void OnRead(png_structp png, png_bytep data, size_t size) {
+    auto* self = static_cast<PngReader*>(png_get_io_ptr(png));
+    if (self->src_.Read(data, size) != size) {
+      self->ended_ = true;
+      png_error(png, "truncated");
+    }
+  }
+
+  Status Decode();
+  Status Deliver(const uint8_t* rows, int32_t y0, int32_t count);
+
+  ByteSource& src_;
+  const DecodeRequest& request_;
+  png_structp png_ = nullptr;
+  png_infop info_ = nullptr;
+  Buffer rows_;
+  size_t row_bytes_ = 0;
+  bool ended_ = false;
+  char message_[160] = {};
+};
+
+Status PngReader::Run() {
+  const char* name = request_.name;
+  png_ = png_create_read_struct(PNG_LIBPNG_VER_STRING, this, OnError, OnWarning);
+  if (png_ == nullptr) return Status(Code::kOutOfMemory, "%s: cannot create a PNG reader", name);
+  info_ = png_create_info_struct(png_);
+  if (info_ == nullptr) return Status(Code::kOutOfMemory, "%s: cannot create a PNG reader", name);
+  png_set_read_fn(png_, this, OnRead);
+  // By default libpng only warns about a bad CRC in an ancillary chunk; corruption is corruption.
+  png_set_crc_action(png_, PNG_CRC_ERROR_QUIT, PNG_CRC_ERROR_QUIT);
+
+  if (setjmp(png_jmpbuf(png_)) != 0) {
+    if (ended_ && src_.error() != 0) {
+      return Status(Code::kIoError, "%s: read error: %s", name, strerror(src_.error()));
+    }
+    if (ended_) {
+      return Status(Code::kCorruptData, "%s: truncated: PNG data ends after %" PRIu64 " bytes",
+                    name, src_.consumed());
+    }
+    return Status(Code::kCorruptData, "%s: PNG %s", name, message_);
+  }
+  // Decode() may longjmp back here: it keeps only trivially destructible locals.
+  return Decode();
+}
+
+Status PngReader::Decode() {
+  const char* name = request_.name;
+  png_read_info(png_, info_);
+  png_uint_32 width = 0, height = 0;
+  int depth = 0, color = 0, interlace = 0;
+  png_get_IHDR(png_, info_, &width, &height, &depth, &color, &interlace, nullptr, nullptr);
+  LB_RETURN_IF_ERROR(CheckImageSize(name, width, height));
+  const bool gray = (color & PNG_COLOR_MASK_COLOR) == 0;
+  const bool wide = depth == 16;
+  const PixelFormat format = gray ? (wide ? PixelFormat::kGray16 : PixelFormat::kGray8)
+                                  : (wide ? PixelFormat::kRgb16 : PixelFormat::kRgb8);
+  request_.info->format = format;
+  request_.info->width = static_cast<int32_t>(width);
+  request_.info->height = static_cast<int32_t>(height);
+  if (request_.sink == nullptr) return Status::Ok();
+
+  if (color == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png_);
+  if (gray && depth < 8) png_set_expand_gray_1_2_4_to_8(png_);
+  if ((color & PNG_COLOR_MASK_ALPHA) != 0) png_set_strip_alpha(png_);
+  if (wide && HostIsLittleEndian()) png_set_swap(png_);
+  const int passes = png_set_interlace_handling(png_);
+  png_read_update_info(png_, info_);
+
+  row_bytes_ = png_get_rowbytes(png_, info_);
+  const size_t expect = static_cast<size_t>(width) * static_cast<size_t>(BytesPerPixel(format));
+  if (row_bytes_ != expect || png_get_channels(png_, info_) != (gray ? 1 : 3)) {
+    return Status(Code::kInternal, "%s: PNG rows are %zu bytes, expected %zu", name, row_bytes_,
+                  expect);
+  }
+  // Interlaced images need every pass before any row is final: hold the whole image then.
+  const int32_t buffer_rows = passes > 1 ? static_cast<int32_t>(height) : kImageStripRows;
+  if (!rows_.Allocate(static_cast<uint64_t>(row_bytes_) * static_cast<uint64_t>(buffer_rows))) {
+    return Status(Code::kOutOfMemory, "%s: no memory for %ux%d PNG rows", name, width, buffer_rows);
+  }
+
+  FrameInfo frame;
+  frame.index = request_.index;
+  frame.format = format;
+  frame.width = static_cast<int32_t>(width);
+  frame.height = static_cast<int32_t>(height);
+  LB_RETURN_IF_ERROR(request_.sink->BeginFrame(frame));
+  if (passes > 1) {
+    for (int pass = 0; pass < passes; ++pass) {
+      for (int32_t y = 0; y < frame.height; ++y) {
+        png_read_row(png_, rows_.data() + row_bytes_ * static_cast<size_t>(y), nullptr);
+      }
+    }
+    for (int32_t y0 = 0; y0 < frame.height; y0 += kImageStripRows) {
+      const int32_t n = frame.height - y0 < kImageStripRows ? frame.height - y0 : kImageStripRows;
+      LB_RETURN_IF_ERROR(Deliver(rows_.data() + row_bytes_ * static_cast<size_t>(y0), y0, n));
+    }
+  } else {
+    for (int32_t y0 = 0; y0 < frame.height; y0 += kImageStripRows) {
+      const int32_t n = frame.height - y0 < kImageStripRows ? frame.height - y0 : kImageStripRows;
+      for (int32_t y = 0; y < n; ++y) {
+        png_read_row(png_, rows_.data() + row_bytes_ * static_cast<size_t>(y), nullptr);
+      }
+      LB_RETURN_IF_ERROR(Deliver(rows_.data(), y0, n));
+    }
+  }
+  // Reads up to IEND, so a broken CRC after the image data is still an error.
+  png_read_end(png_, nullptr);
+  return request_.sink->EndFrame();
+}
+
+Status PngReader::Deliver(const uint8_t* rows, int32_t y0, int32_t count) {
+  FrameRows strip;
+  strip.y0 = y0;
+  strip.height = count;
+  strip.planes[0] = rows;
+  strip.strides[0] = static_cast<ptrdiff_t>(row_bytes_);
+  return request_.sink->Rows(strip);
+}
+
+}  // namespace
+
+Status DecodePng(ByteSource& src, const DecodeRequest& request) {
+  PngReader reader(src, request);
+  return reader.Run();
+}
+
+}  // namespace lb::files
