@@ -24,7 +24,8 @@ int64_t MonotonicMs() {
 V4l2Sensor::V4l2Sensor(const V4l2Options& options, V4l2Io* io)
     : io_(io ? io : &SystemV4l2Io()),
       wanted_fourcc_(options.fourcc),
-      wanted_buffers_(options.buffers) {
+      wanted_buffers_(options.buffers),
+      wanted_fps_(options.fps) {
   snprintf(device_, sizeof(device_), "%s", options.device ? options.device : "");
 }
 
@@ -46,12 +47,17 @@ Status V4l2Sensor::Configure(const SensorConfig& config, SensorMode* mode) {
                   device_, config.frames, config.timeout_ms, config.width, config.height,
                   kMaxFrames);
   }
+  if (wanted_fps_ < 0 || wanted_fps_ > 1000) {
+    return Status(Code::kInvalidArgument, "%s: %d fps requested, 0..1000 allowed", device_,
+                  wanted_fps_);
+  }
   if (wanted_buffers_ != 0 && (wanted_buffers_ < 2 || wanted_buffers_ > V4l2Options::kMaxBuffers)) {
     return Status(Code::kInvalidArgument, "%s: %d buffers requested, 2..%d allowed", device_,
                   wanted_buffers_, V4l2Options::kMaxBuffers);
   }
   config_ = config;
   Status status = OpenAndNegotiate(config);
+  if (status.ok()) status = SetFrameRate();
   if (status.ok()) status = MapBuffers();
   if (!status.ok()) {
     Stop();
@@ -111,6 +117,22 @@ Status V4l2Sensor::OpenAndNegotiate(const SensorConfig& config) {
   fmt.fmt.pix.sizeimage = 0;
   if (int r = io_->Ioctl(fd_, VIDIOC_S_FMT, &fmt); r < 0) return IoctlError("VIDIOC_S_FMT", -r);
   return LayoutFromFormat(device_, fmt.fmt.pix, fourcc_, &layout_);
+}
+
+Status V4l2Sensor::SetFrameRate() {
+  if (wanted_fps_ == 0) return Status::Ok();
+  v4l2_streamparm parm;
+  memset(&parm, 0, sizeof(parm));
+  parm.type = kCapture;
+  if (int r = io_->Ioctl(fd_, VIDIOC_G_PARM, &parm); r < 0) return IoctlError("VIDIOC_G_PARM", -r);
+  if (!(parm.parm.capture.capability & V4L2_CAP_TIMEPERFRAME)) {
+    return Status(Code::kUnsupported, "%s: the driver has no settable frame rate (%d fps asked)",
+                  device_, wanted_fps_);
+  }
+  parm.parm.capture.timeperframe.numerator = 1;
+  parm.parm.capture.timeperframe.denominator = static_cast<uint32_t>(wanted_fps_);
+  if (int r = io_->Ioctl(fd_, VIDIOC_S_PARM, &parm); r < 0) return IoctlError("VIDIOC_S_PARM", -r);
+  return Status::Ok();
 }
 
 Status V4l2Sensor::MapBuffers() {

@@ -23,6 +23,9 @@ struct V4l2Options {
   // Driver buffers to request, 2..kMaxBuffers; 0: one per burst frame, so a slow consumer never
   // leaves the driver without a buffer (which it reports as a dropped frame).
   int32_t buffers = 0;
+  // Frames per second to ask for (VIDIOC_S_PARM), 0 = the driver's choice. A rate the device
+  // cannot keep shows up as dropped frames, so a slow sensor wants a modest rate here.
+  int32_t fps = 0;
 };
 
 class V4l2Sensor : public Sensor {
@@ -52,6 +55,7 @@ class V4l2Sensor : public Sensor {
 
   Status IoctlError(const char* what, int err) const;
   Status OpenAndNegotiate(const SensorConfig& config);
+  Status SetFrameRate();
   Status MapBuffers();
   Status QueueBuffer(uint32_t index);
   Status WaitFrame();
@@ -62,6 +66,7 @@ class V4l2Sensor : public Sensor {
   char device_[128] = {};
   uint32_t wanted_fourcc_ = 0;
   int32_t wanted_buffers_ = 0;
+  int32_t wanted_fps_ = 0;
 
   int fd_ = -1;
   SensorConfig config_;

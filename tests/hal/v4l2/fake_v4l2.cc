@@ -112,6 +112,19 @@ int FakeV4l2::Ioctl(int fd, unsigned long request, void* arg) {
       ++delivered_;
       return 0;
     }
+    case VIDIOC_G_PARM: {
+      auto* parm = static_cast<v4l2_streamparm*>(arg);
+      parm->parm.capture.capability = V4L2_CAP_TIMEPERFRAME;
+      parm->parm.capture.timeperframe = {1, fps};
+      return 0;
+    }
+    case VIDIOC_S_PARM: {
+      auto* parm = static_cast<v4l2_streamparm*>(arg);
+      const v4l2_fract& t = parm->parm.capture.timeperframe;
+      if (t.numerator == 0) return -EINVAL;
+      fps = t.denominator / t.numerator;
+      return 0;
+    }
     case VIDIOC_STREAMON:
       if (streaming) return -EBUSY;
       ++streamon_calls;

@@ -37,6 +37,7 @@ class FakeV4l2 : public V4l2Io {
   int streamon_calls = 0;
   int streamoff_calls = 0;
   uint32_t granted_buffers = 0;
+  uint32_t fps = 30;  // what S_PARM set
 
   static uint8_t Pattern(uint32_t frame, uint32_t plane, uint32_t y, uint32_t x) {
     return static_cast<uint8_t>(frame * 31 + plane * 101 + y * 7 + x);

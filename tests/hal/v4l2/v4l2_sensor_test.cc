@@ -120,6 +120,19 @@ TEST(V4l2SensorTest, FallsBackToBgrWhenThatIsAllTheDeviceHas) {
   EXPECT_EQ(mode.format, PixelFormat::kBgr8);
 }
 
+TEST(V4l2SensorTest, SetsTheRequestedFrameRate) {
+  FakeV4l2 dev;
+  V4l2Options options;
+  options.fps = 5;
+  V4l2Sensor sensor(options, &dev);
+  SensorMode mode;
+  ASSERT_TRUE(sensor.Configure(Burst(), &mode).ok());
+  EXPECT_EQ(dev.fps, 5u);
+  options.fps = 5000;
+  V4l2Sensor too_fast(options, &dev);
+  EXPECT_EQ(too_fast.Configure(Burst(), &mode).code(), Code::kInvalidArgument);
+}
+
 TEST(V4l2SensorTest, BurstLongerThanTheBuffersRequeues) {
   FakeV4l2 dev;
   V4l2Options options;
@@ -203,6 +216,7 @@ TEST(V4l2SensorTest, IoctlErrorsNameTheCallTheDeviceAndTheErrno) {
     dev.fail_errno = EIO;
     V4l2Options options;
     options.device = "/dev/video7";
+    options.fps = 10;
     V4l2Sensor sensor(options, &dev);
     SensorMode mode;
     Status s = sensor.Configure(Burst(), &mode);
