@@ -1,0 +1,49 @@
+// AtomicFile: writes a file under a hidden temporary name in the destination directory and
+// renames it over the final name only once every byte is on the medium. A failure at any step
+// (missing directory, full card, I/O error, the caller giving up) leaves neither the final name
+// nor the temporary behind.
+#pragma once
+
+#include <cstddef>
+
+#include "algo/core/status.h"
+
+namespace lb {
+
+class AtomicFile {
+ public:
+  static constexpr size_t kMaxPath = 1024;
+
+  AtomicFile() = default;
+  ~AtomicFile();  // aborts when not committed
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+
+  // Creates `.<name>.XXXXXX` (mode 0644, close-on-exec) next to `final_path`.
+  Status Open(const char* final_path);
+
+  // Writes all of `size` bytes (retrying short writes and EINTR). After a failure every later
+  // Write and Commit fail too, so a caller that missed one error cannot commit a partial file.
+  Status Write(const void* data, size_t size);
+
+  // fsync, close, rename over the final name, fsync the directory.
+  Status Commit();
+
+  // Closes and unlinks the temporary; harmless when nothing is open.
+  void Abort();
+
+  int fd() const { return fd_; }
+  bool is_open() const { return fd_ >= 0; }
+  const char* path() const { return final_path_; }
+
+ private:
+  Status Fail(int err, const char* what);
+
+  int fd_ = -1;
+  int error_ = 0;  // errno of the first failed write, sticky until Abort
+  char final_path_[kMaxPath] = {};
+  char temp_path_[kMaxPath] = {};
+  char dir_path_[kMaxPath] = {};
+};
+
+}  // namespace lb
