@@ -1,25 +1,24 @@
-// Foundation depth stage: winner-take-all over the labels with a 3x3 sum of absolute colour
-// differences averaged over all views. It has the final interface and memory discipline; the
-// graph-cut optimiser replaces the winner-take-all choice.
+// Depth by graph cuts: labels start at the winner-take-all choice of the data term, then
+// alpha-expansion cycles lower E(f) = sum D_p(f_p) + sum w_pq min(|f_p - f_q|, K), each move an
+// exact minimum cut on the pixel grid, until a cycle changes nothing or the cycle cap.
+// The 2-label move energy per neighbour pair, with x = 1 meaning "switch to alpha",
+// A = V(fp,fq), B = V(fp,alpha), C = V(alpha,fq), V(alpha,alpha) = 0, is
+//   A + (C - A) x_p - C x_q + (B + C - A) (1 - x_p) x_q,
+// and B + C - A >= 0 because truncated linear is a metric, so every move is a graph cut.
 #include "algo/depth/depth_stage.h"
 
-#include <cstdlib>
-
 namespace lb {
-namespace {
 
-int32_t LabelDispQ8(const DepthConfig& c, int32_t label) {
-  if (c.labels <= 1) return c.disp_min_q8;
+int32_t DepthStage::LabelDispQ8(int32_t label) const {
+  const DepthConfig& c = config_;
   return c.disp_min_q8 +
          static_cast<int32_t>((int64_t{c.disp_max_q8 - c.disp_min_q8} * label) / (c.labels - 1));
 }
 
-}  // namespace
-
 Status DepthStage::Validate(const DepthConfig& c) {
-  if (c.width < 8 || c.height < 8) {
-    return Status(Code::kInvalidArgument, "depth: working size %dx%d is below 8x8", c.width,
-                  c.height);
+  if (c.width < 8 || c.height < 8 || int64_t{c.width} * c.height > (int64_t{1} << 24)) {
+    return Status(Code::kInvalidArgument, "depth: working size %dx%d outside 8x8 .. 16M pixels",
+                  c.width, c.height);
   }
   if (c.views < 2 || c.views > DepthConfig::kMaxViews) {
     return Status(Code::kInvalidArgument, "depth: %d views (needs 2 to %d)", c.views,
@@ -37,6 +36,18 @@ Status DepthStage::Validate(const DepthConfig& c) {
     return Status(Code::kInvalidArgument, "depth: disparity range %d..%d (Q8) is empty or too wide",
                   c.disp_min_q8, c.disp_max_q8);
   }
+  // These bounds keep every node's terminal balance and arc capacity far below
+  // GridMaxflow::kMaxCapacity: |balance| <= 2295 + 8 * 4096 * 64.
+  if (c.color_trunc < 1 || c.color_trunc > 765 || c.census_weight < 0 || c.census_weight > 10 ||
+      c.smooth_weight < 0 || c.smooth_weight > 4096 || c.smooth_trunc < 1 || c.smooth_trunc > 64 ||
+      c.edge_threshold < 0 || c.edge_threshold > 255 || c.edge_weight_q8 < 0 ||
+      c.edge_weight_q8 > 256 || c.max_cycles < 0 || c.max_cycles > 32) {
+    return Status(Code::kInvalidArgument,
+                  "depth: cost parameters out of range (colour %d, census %d, smoothness %d "
+                  "trunc %d edge %d/%d, cycles %d)",
+                  c.color_trunc, c.census_weight, c.smooth_weight, c.smooth_trunc, c.edge_threshold,
+                  c.edge_weight_q8, c.max_cycles);
+  }
   return Status::Ok();
 }
 
@@ -50,7 +61,15 @@ size_t DepthStage::RequiredBytes(const DepthConfig& config) {
 
 Status DepthStage::Carve(Arena& arena) {
   const size_t start = arena.used();
-  best_cost_ = arena.Allocate<uint32_t>(static_cast<size_t>(config_.width) * config_.height);
+  const int32_t w = config_.width, h = config_.height;
+  const size_t n = static_cast<size_t>(w) * h;
+  data_.Carve(arena, w, h, config_.views);
+  maxflow_.Carve(arena, w * h);
+  labels_ = arena.Allocate<uint8_t>(n);
+  cost_ = arena.Allocate<uint16_t>(n);
+  cost_alpha_ = arena.Allocate<uint16_t>(n);
+  weight_right_ = arena.Allocate<uint16_t>(n);
+  weight_down_ = arena.Allocate<uint16_t>(n);
   stats_.arena_bytes = arena.used() - start;
   if (arena.overflowed()) return Status(Code::kOutOfMemory, "depth: arena too small");
   return Status::Ok();
@@ -61,49 +80,209 @@ Status DepthStage::Configure(const DepthConfig& config, Arena& arena) {
   config_ = config;
   stats_ = DepthStats{};
   stats_.labels = config.labels;
+  DataTermParams params;
+  params.color_trunc = config.color_trunc;
+  params.census_weight = config.census_weight;
+  data_.SetParams(params, config.reference);
   return Carve(arena);
+}
+
+void DepthStage::EdgeWeights(const ConstImageU8& ref) {
+  const int32_t w = config_.width, h = config_.height;
+  const int32_t flat = config_.smooth_weight;
+  const int32_t edge = (config_.smooth_weight * config_.edge_weight_q8 + 128) >> 8;
+  auto weight = [&](const uint8_t* a, const uint8_t* b) {
+    int32_t step = 0;
+    for (int32_t c = 0; c < 3; ++c) {
+      const int32_t d = a[c] > b[c] ? a[c] - b[c] : b[c] - a[c];
+      step = d > step ? d : step;
+    }
+    return static_cast<uint16_t>(step > config_.edge_threshold ? edge : flat);
+  };
+  for (int32_t y = 0; y < h; ++y) {
+    const uint8_t* row = ref.Row(y);
+    const uint8_t* below = ref.Row(y + 1 < h ? y + 1 : y);
+    for (int32_t x = 0; x < w; ++x) {
+      const int32_t p = y * w + x;
+      weight_right_[p] = x + 1 < w ? weight(row + 3 * x, row + 3 * x + 3) : 0;
+      weight_down_[p] = y + 1 < h ? weight(row + 3 * x, below + 3 * x) : 0;
+    }
+  }
+}
+
+// Energy of the current labels from the stored D_p(f_p) and the edge weights.
+static int64_t LabelEnergy(const uint8_t* labels, const uint16_t* cost, const uint16_t* right,
+                           const uint16_t* down, int32_t w, int32_t h, int32_t trunc) {
+  int64_t e = 0;
+  for (int32_t y = 0; y < h; ++y) {
+    int64_t row = 0;  // at most 8192 * (2295 + 2 * 4096 * 64): fits easily
+    for (int32_t x = 0; x < w; ++x) {
+      const int32_t p = y * w + x;
+      const int32_t f = labels[p];
+      row += cost[p];
+      if (x + 1 < w) {
+        const int32_t d = f > labels[p + 1] ? f - labels[p + 1] : labels[p + 1] - f;
+        row += int64_t{right[p]} * (d < trunc ? d : trunc);
+      }
+      if (y + 1 < h) {
+        const int32_t d = f > labels[p + w] ? f - labels[p + w] : labels[p + w] - f;
+        row += int64_t{down[p]} * (d < trunc ? d : trunc);
+      }
+    }
+    e += row;
+  }
+  return e;
+}
+
+void DepthStage::WinnerTakeAll() {
+  const int32_t w = config_.width, h = config_.height;
+  const int32_t n = w * h;
+  for (int32_t p = 0; p < n; ++p) {
+    cost_[p] = 0xffff;
+    labels_[p] = 0;
+  }
+  for (int32_t label = 0; label < config_.labels; ++label) {
+    data_.ComputeRows(LabelDispQ8(label), 0, h, cost_alpha_, w);
+    for (int32_t p = 0; p < n; ++p) {
+      if (cost_alpha_[p] < cost_[p]) {
+        cost_[p] = cost_alpha_[p];
+        labels_[p] = static_cast<uint8_t>(label);
+      }
+    }
+  }
+}
+
+bool DepthStage::Expand(int32_t alpha) {
+  const int32_t w = config_.width, h = config_.height;
+  data_.ComputeRows(LabelDispQ8(alpha), 0, h, cost_alpha_, w);
+  maxflow_.Reset(w, h);
+  for (int32_t y = 0; y < h; ++y) {
+    for (int32_t x = 0; x < w; ++x) {
+      const int32_t p = y * w + x;
+      const int32_t fp = labels_[p];
+      // Unary: D_p(alpha) - D_p(f_p) on x_p = 1 (0 when p already has alpha).
+      int32_t balance = cost_alpha_[p] - cost_[p];
+      if (x + 1 < w) {
+        const int32_t wr = weight_right_[p];
+        const int32_t fq = labels_[p + 1];
+        const int32_t a = wr * Smooth(fp, fq), b = wr * Smooth(fp, alpha);
+        const int32_t c = wr * Smooth(alpha, fq);
+        balance += c - a;
+        maxflow_.AddTerminalBalance(p + 1, -c);
+        maxflow_.AddEdge(p, GridMaxflow::kRight, b + c - a, 0);
+      }
+      if (y + 1 < h) {
+        const int32_t wd = weight_down_[p];
+        const int32_t fq = labels_[p + w];
+        const int32_t a = wd * Smooth(fp, fq), b = wd * Smooth(fp, alpha);
+        const int32_t c = wd * Smooth(alpha, fq);
+        balance += c - a;
+        maxflow_.AddTerminalBalance(p + w, -c);
+        maxflow_.AddEdge(p, GridMaxflow::kDown, b + c - a, 0);
+      }
+      maxflow_.AddTerminalBalance(p, balance);
+    }
+  }
+  (void)maxflow_.Solve();
+  for (int32_t p = 0; p < w * h; ++p) {
+    if (!maxflow_.InSource(p)) {
+      labels_[p] = static_cast<uint8_t>(alpha);
+      cost_[p] = cost_alpha_[p];
+    }
+  }
+  const int64_t before = energy_;
+  energy_ = LabelEnergy(labels_, cost_, weight_right_, weight_down_, w, h, config_.smooth_trunc);
+  return energy_ < before;
+}
+
+int64_t DepthStage::Energy(const uint8_t* labels) {
+  const int32_t w = config_.width, h = config_.height;
+  int64_t data = 0;
+  for (int32_t label = 0; label < config_.labels; ++label) {
+    data_.ComputeRows(LabelDispQ8(label), 0, h, cost_alpha_, w);
+    for (int32_t p = 0; p < w * h; ++p) {
+      if (labels[p] == label) data += cost_alpha_[p];
+    }
+  }
+  // The smoothness part with zero data costs: reuse LabelEnergy over a zero cost image.
+  for (int32_t p = 0; p < w * h; ++p) cost_alpha_[p] = 0;
+  return data +
+         LabelEnergy(labels, cost_alpha_, weight_right_, weight_down_, w, h, config_.smooth_trunc);
+}
+
+// Sub-label disparity: a parabola through D at f_p - 1, f_p, f_p + 1, its vertex clamped to half a
+// label either side. Runs after the optimiser, so it may borrow the move buffers.
+void DepthStage::Refine(ImageU16 disp_q8) {
+  const int32_t w = config_.width, h = config_.height, n = w * h;
+  uint16_t* below = cost_alpha_;     // D_p(f_p - 1)
+  uint16_t* above = weight_right_;   // D_p(f_p + 1)
+  uint16_t* scratch = weight_down_;  // D of the label being evaluated
+  if (config_.subpixel) {
+    for (int32_t p = 0; p < n; ++p) below[p] = above[p] = 0xffff;
+    for (int32_t label = 0; label < config_.labels; ++label) {
+      data_.ComputeRows(LabelDispQ8(label), 0, h, scratch, w);
+      for (int32_t p = 0; p < n; ++p) {
+        if (labels_[p] == label + 1) below[p] = scratch[p];
+        if (labels_[p] + 1 == label) above[p] = scratch[p];
+      }
+    }
+  }
+  for (int32_t y = 0; y < h; ++y) {
+    uint16_t* out = disp_q8.Row(y);
+    for (int32_t x = 0; x < w; ++x) {
+      const int32_t p = y * w + x;
+      const int32_t f = labels_[p];
+      int32_t d_q8 = LabelDispQ8(f);
+      if (config_.subpixel && f > 0 && f + 1 < config_.labels) {
+        const int32_t cm = below[p], c0 = cost_[p], cp = above[p];
+        const int32_t curvature = cm + cp - 2 * c0;
+        if (c0 <= cm && c0 <= cp && curvature > 0) {
+          const int32_t step_q8 = (LabelDispQ8(f + 1) - LabelDispQ8(f - 1)) / 2;
+          // Vertex at (cm - cp) / (2 * curvature) labels; |cm - cp| <= curvature keeps it
+          // within half a label. Truncating division, the same on every target.
+          d_q8 += ((cm - cp) * step_q8) / (2 * curvature);
+        }
+      }
+      out[x] = static_cast<uint16_t>(d_q8);
+    }
+  }
 }
 
 Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
   const DepthConfig& c = config_;
-  if (disp_q8.width != c.width || disp_q8.height != c.height) {
-    return Status(Code::kInvalidArgument, "depth: output is %dx%d, expected %dx%d", disp_q8.width,
-                  disp_q8.height, c.width, c.height);
+  if (disp_q8.width != c.width || disp_q8.height != c.height || disp_q8.channels != 1) {
+    return Status(Code::kInvalidArgument, "depth: output is %dx%dx%d, expected %dx%dx1",
+                  disp_q8.width, disp_q8.height, disp_q8.channels, c.width, c.height);
   }
-  const int32_t w = c.width, h = c.height;
-  for (int32_t i = 0; i < w * h; ++i) best_cost_[i] = UINT32_MAX;
-  const ConstImageU8& ref = views[c.reference];
-  for (int32_t label = 0; label < c.labels; ++label) {
-    const int32_t d_q8 = LabelDispQ8(c, label);
-    for (int32_t y = 0; y < h; ++y) {
-      for (int32_t x = 0; x < w; ++x) {
-        uint32_t cost = 0;
-        for (int32_t v = 0; v < c.views; ++v) {
-          if (v == c.reference) continue;
-          // Nearest-pixel shift; the view k steps right sees the point at x - k*d.
-          const int32_t shift = ((c.reference - v) * d_q8 + (1 << 7)) >> 8;
-          for (int32_t dy = -1; dy <= 1; ++dy) {
-            const int32_t yy = y + dy < 0 ? 0 : (y + dy >= h ? h - 1 : y + dy);
-            for (int32_t dx = -1; dx <= 1; ++dx) {
-              const int32_t xr = x + dx < 0 ? 0 : (x + dx >= w ? w - 1 : x + dx);
-              int32_t xv = xr + shift;
-              xv = xv < 0 ? 0 : (xv >= w ? w - 1 : xv);
-              const uint8_t* a = ref.At(xr, yy);
-              const uint8_t* b = views[v].At(xv, yy);
-              cost += static_cast<uint32_t>(std::abs(a[0] - b[0]) + std::abs(a[1] - b[1]) +
-                                            std::abs(a[2] - b[2]));
-            }
-          }
-        }
-        uint32_t& best = best_cost_[y * w + x];
-        if (cost < best) {
-          best = cost;
-          disp_q8.Row(y)[x] = static_cast<uint16_t>(d_q8);
-        }
-      }
+  for (int32_t v = 0; v < c.views; ++v) {
+    if (views[v].width != c.width || views[v].height != c.height || views[v].channels != 3 ||
+        views[v].data == nullptr) {
+      return Status(Code::kInvalidArgument, "depth: view %d is %dx%dx%d, expected %dx%d RGB", v,
+                    views[v].width, views[v].height, views[v].channels, c.width, c.height);
     }
   }
+  const int32_t w = c.width, h = c.height;
+  data_.Prepare(views);
+  EdgeWeights(views[c.reference]);
+  WinnerTakeAll();
+  energy_ = LabelEnergy(labels_, cost_, weight_right_, weight_down_, w, h, c.smooth_trunc);
+  stats_.initial_energy = energy_;
   stats_.cycles = 0;
+  stats_.moves = 0;
+  for (int32_t cycle = 0; cycle < c.max_cycles; ++cycle) {
+    bool lowered = false;
+    for (int32_t alpha = 0; alpha < c.labels; ++alpha) {
+      if (Expand(alpha)) {
+        lowered = true;
+        ++stats_.moves;
+      }
+    }
+    ++stats_.cycles;
+    if (!lowered) break;
+  }
+  stats_.energy = energy_;
+  Refine(disp_q8);
+  EdgeWeights(views[c.reference]);  // Refine borrowed the weight buffers
   return Status::Ok();
 }
 

@@ -10,6 +10,8 @@
 #include "algo/core/arena.h"
 #include "algo/core/image.h"
 #include "algo/core/status.h"
+#include "algo/depth/data_term.h"
+#include "algo/depth/grid_maxflow.h"
 
 namespace lb {
 
@@ -24,13 +26,29 @@ struct DepthConfig {
   int32_t labels = 0;       // number of disparity planes
   int32_t disp_min_q8 = 0;  // disparity of label 0 and of the last label, px per view step, Q8.8
   int32_t disp_max_q8 = 0;
+
+  // Data term (see data_term.h).
+  int32_t color_trunc = 45;   // truncation of |dR|+|dG|+|dB|, 1..765
+  int32_t census_weight = 6;  // cost per differing census bit, 0..10
+  // Smoothness V(a, b) = w_pq * min(|a - b|, smooth_trunc) over label indices: truncated linear,
+  // Potts when smooth_trunc is 1. w_pq is smooth_weight where the reference is flat and
+  // smooth_weight * edge_weight_q8 / 256 across a colour edge (largest channel step above
+  // edge_threshold), so label changes prefer image edges.
+  int32_t smooth_weight = 16;   // 0..4096
+  int32_t smooth_trunc = 8;     // 1..64
+  int32_t edge_threshold = 16;  // 0..255
+  int32_t edge_weight_q8 = 96;  // 0..256
+  int32_t max_cycles = 2;       // expansion cycles after the winner-take-all start, 0..32
+  bool subpixel = true;         // parabola fit between labels for the output
 };
 
 struct DepthStats {
   int32_t labels = 0;
-  int32_t cycles = 0;      // expansion cycles run
-  int64_t energy = 0;      // final energy
-  size_t arena_bytes = 0;  // bytes this stage carved from the arena
+  int32_t cycles = 0;          // expansion cycles run
+  int32_t moves = 0;           // expansion moves that lowered the energy
+  int64_t initial_energy = 0;  // energy of the winner-take-all labels
+  int64_t energy = 0;          // final energy
+  size_t arena_bytes = 0;      // bytes this stage carved from the arena
 };
 
 class DepthStage {
@@ -49,12 +67,38 @@ class DepthStage {
   const DepthStats& stats() const { return stats_; }
   const DepthConfig& config() const { return config_; }
 
+  // For tests, valid after Compute: the label map (row stride = width), its energy, one more
+  // expansion move (applied whatever it gives; true when it lowered the energy), and the energy
+  // of any label map recomputed from scratch (slow: D for every label).
+  const uint8_t* labels() const { return labels_; }
+  int64_t energy() const { return energy_; }
+  bool ExpandMove(int32_t alpha) { return Expand(alpha); }
+  int64_t Energy(const uint8_t* labels);
+  int32_t LabelDispQ8(int32_t label) const;
+
  private:
   Status Carve(Arena& arena);
+  void EdgeWeights(const ConstImageU8& ref);
+  void WinnerTakeAll();
+  // One alpha-expansion move; returns true when it lowered the energy.
+  bool Expand(int32_t alpha);
+  void Refine(ImageU16 disp_q8);
+  int32_t Smooth(int32_t a, int32_t b) const {
+    const int32_t d = a > b ? a - b : b - a;
+    return d < config_.smooth_trunc ? d : config_.smooth_trunc;
+  }
 
   DepthConfig config_;
   DepthStats stats_;
-  uint32_t* best_cost_ = nullptr;  // per pixel: lowest cost seen so far
+  DataTerm data_;
+  GridMaxflow maxflow_;
+  uint8_t* labels_ = nullptr;
+  uint16_t* cost_ = nullptr;  // D_p(f_p) of the current labels
+  uint16_t* cost_alpha_ =
+      nullptr;  // D_p(alpha) of the move in progress; D_p(f_p - 1) when refining
+  uint16_t* weight_right_ = nullptr;  // w_pq to the right neighbour; D_p(f_p + 1) when refining
+  uint16_t* weight_down_ = nullptr;
+  int64_t energy_ = 0;
 };
 
 }  // namespace lb

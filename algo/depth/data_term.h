@@ -1,0 +1,62 @@
+// Multi-view data term D_p(label): photo-consistency of reference pixel p with every other view
+// when p lies on the label's disparity plane.
+//
+// Per view: the view is sampled at x - k * d (k = view index minus reference index) with linear
+// interpolation (the shift is the same for the whole image, so one Q8 fraction per view and
+// label); the pixel cost is a truncated absolute colour difference plus a census (5x5, 24 bits)
+// Hamming distance interpolated the same way, capped at 255. Costs are summed over 3x3 per view.
+// Across views: the mean of the best half, so views in which p is occluded (about half of them
+// at most, on one side) do not dominate. Out-of-image samples cost the largest valid pixel cost.
+//
+// Range: pixel cost 0..255, window sum 0..2295, D (a mean of window sums) 0..2295, uint16.
+// No costs are stored: each call computes the rows it is asked for, through a 3-row ring.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "algo/core/arena.h"
+#include "algo/core/image.h"
+
+namespace lb {
+
+struct DataTermParams {
+  int32_t color_trunc = 45;   // truncation of the summed |dR|+|dG|+|dB|, 0..765
+  int32_t census_weight = 6;  // cost per differing census bit (24 bits), 0..10
+};
+
+class DataTerm {
+ public:
+  static constexpr int32_t kMaxCost = 2295;  // 9 * 255
+  static constexpr int32_t kCensusBits = 24;
+
+  // Carves the census images and row rings for `views` views of width x height.
+  void Carve(Arena& arena, int32_t width, int32_t height, int32_t views);
+  void SetParams(const DataTermParams& params, int32_t reference);
+
+  // Computes the census of every view. `views` stay borrowed until the next Prepare.
+  void Prepare(const ConstImageU8* views);
+
+  // D for rows y0..y1-1 at disparity dispQ8 (px per view step) into out (row stride in elements).
+  void ComputeRows(int32_t disp_q8, int32_t y0, int32_t y1, uint16_t* out, ptrdiff_t stride);
+
+  // The pixel cost cap (what an out-of-image sample costs).
+  int32_t invalid_cost() const { return invalid_cost_; }
+  const uint32_t* census(int32_t view) const { return census_[view]; }
+
+ private:
+  void PixelCostRow(int32_t view, int32_t y, int32_t disp_q8, uint16_t* out) const;
+  void WindowRow(int32_t view, int32_t y, int32_t disp_q8, uint16_t* hsum);
+
+  int32_t width_ = 0, height_ = 0, views_ = 0, reference_ = 0;
+  DataTermParams params_;
+  int32_t invalid_cost_ = 255;
+  const ConstImageU8* images_ = nullptr;
+  uint32_t* census_[16] = {};
+  uint8_t* luma_ = nullptr;    // one view's luma, for the census
+  uint16_t* pixel_ = nullptr;  // one row of pixel costs
+  uint16_t* hsum_ = nullptr;   // per view, 3 rows of horizontal 3-sums
+  uint16_t* best_ = nullptr;   // up to 8 rows: the sorted smallest window sums so far
+};
+
+}  // namespace lb
