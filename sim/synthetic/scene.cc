@@ -1,0 +1,672 @@
+#include "sim/synthetic/scene.h"
+
+#include <cmath>
+#include <cstring>
+
+#include "algo/core/fixed_point.h"
+
+// This file is compiled with -ffp-contract=off (see CMakeLists.txt): the double setup below must
+// round the same way on every architecture, and it uses no libm function except sqrt.
+
+namespace lb {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDesignW = 640, kDesignH = 480;
+constexpr double kWallDepth = 12.0;  // metres
+constexpr double kWallDisp = 0.5;    // design px per view step at disparity_scale 1
+constexpr double kGroundDisp = 6.0;  // the ground's disparity at the bottom row (design px)
+constexpr int64_t kOne40 = int64_t{1} << 40;
+
+// splitmix64: a tiny, portable, well-mixed generator (std distributions differ across libraries).
+struct Rng {
+  uint64_t state;
+  uint64_t Next() {
+    uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  }
+  double Uniform() { return static_cast<double>(Next() >> 11) * (1.0 / 9007199254740992.0); }
+  double Range(double lo, double hi) { return lo + (hi - lo) * Uniform(); }
+  int32_t Int(int32_t n) { return static_cast<int32_t>(Next() % static_cast<uint64_t>(n)); }
+};
+
+// Taylor series, accurate to double rounding for |x| <= pi/2, and identical on every target.
+void SinCos(double x, double* s, double* c) {
+  double sin_term = x, cos_term = 1, sum_sin = x, sum_cos = 1;
+  const double x2 = x * x;
+  for (int n = 1; n <= 14; ++n) {
+    sin_term *= -x2 / static_cast<double>((2 * n) * (2 * n + 1));
+    cos_term *= -x2 / static_cast<double>((2 * n - 1) * (2 * n));
+    sum_sin += sin_term;
+    sum_cos += cos_term;
+  }
+  *s = sum_sin;
+  *c = sum_cos;
+}
+
+int64_t ToFixed(double v, int frac) {
+  return static_cast<int64_t>(std::floor(v * static_cast<double>(int64_t{1} << frac) + 0.5));
+}
+
+using Mat3 = double[3][3];
+
+void Mul(const Mat3 a, const Mat3 b, Mat3 out) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      out[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j];
+}
+
+bool Invert(const Mat3 m, Mat3 out) {
+  const double c00 = m[1][1] * m[2][2] - m[1][2] * m[2][1];
+  const double c01 = m[1][2] * m[2][0] - m[1][0] * m[2][2];
+  const double c02 = m[1][0] * m[2][1] - m[1][1] * m[2][0];
+  const double det = m[0][0] * c00 + m[0][1] * c01 + m[0][2] * c02;
+  if (!(std::fabs(det) > 1e-300)) return false;
+  const double inv = 1.0 / det;
+  out[0][0] = c00 * inv;
+  out[1][0] = c01 * inv;
+  out[2][0] = c02 * inv;
+  out[0][1] = (m[0][2] * m[2][1] - m[0][1] * m[2][2]) * inv;
+  out[1][1] = (m[0][0] * m[2][2] - m[0][2] * m[2][0]) * inv;
+  out[2][1] = (m[0][1] * m[2][0] - m[0][0] * m[2][1]) * inv;
+  out[0][2] = (m[0][1] * m[1][2] - m[0][2] * m[1][1]) * inv;
+  out[1][2] = (m[0][2] * m[1][0] - m[0][0] * m[1][2]) * inv;
+  out[2][2] = (m[0][0] * m[1][1] - m[0][1] * m[1][0]) * inv;
+  return true;
+}
+
+void RandomUnit(Rng& rng, double v[3]) {
+  for (;;) {
+    for (int i = 0; i < 3; ++i) v[i] = rng.Range(-1, 1);
+    const double n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    if (n2 > 0.01 && n2 <= 1) {
+      const double n = std::sqrt(n2);
+      for (int i = 0; i < 3; ++i) v[i] /= n;
+      return;
+    }
+  }
+}
+
+// Floor division and modulo for a positive divisor.
+int64_t FloorDiv(int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+int64_t FloorMod(int64_t a, int64_t b) { return a - FloorDiv(a, b) * b; }
+
+uint32_t Hash2(int64_t a, int64_t b) {
+  uint64_t h = static_cast<uint64_t>(a) * 0x9E3779B97F4A7C15ull ^ static_cast<uint64_t>(b);
+  h = (h ^ (h >> 29)) * 0xBF58476D1CE4E5B9ull;
+  return static_cast<uint32_t>(h >> 32);
+}
+
+const uint8_t kPalette[][3] = {{200, 62, 50},  {52, 118, 200}, {232, 188, 62}, {70, 160, 92},
+                               {176, 88, 168}, {230, 132, 52}, {88, 188, 200}, {222, 218, 206},
+                               {120, 80, 60},  {40, 60, 90}};
+constexpr int kPaletteSize = sizeof(kPalette) / sizeof(kPalette[0]);
+
+// Texture cells in design px: colour blotches, then three octaves of detail.
+constexpr int32_t kCellMix = 56;
+constexpr int32_t kDetailCells[3] = {20, 7, 3};
+constexpr int32_t kDetailWeights[3] = {5, 4, 3};  // sum 12
+
+}  // namespace
+
+Status Scene::Configure(const SceneParams& params, int32_t width, int32_t height, int32_t views) {
+  if (width < kMinSize || width > kMaxSize || height < kMinSize || height > kMaxSize)
+    return Status(Code::kInvalidArgument, "synthetic scene: size %dx%d outside %d..%d", width,
+                  height, kMinSize, kMaxSize);
+  if (views < kMinViews || views > kMaxViews)
+    return Status(Code::kInvalidArgument, "synthetic scene: %d views outside %d..%d", views,
+                  kMinViews, kMaxViews);
+  const int32_t reference = params.reference < 0 ? views / 2 : params.reference;
+  if (reference >= views)
+    return Status(Code::kInvalidArgument, "synthetic scene: reference %d not among %d views",
+                  params.reference, views);
+  if (!(params.fov_deg >= 10 && params.fov_deg <= 120))
+    return Status(Code::kInvalidArgument, "synthetic scene: field of view %.1f outside 10..120",
+                  params.fov_deg);
+  if (!(params.disparity_scale > 0 && params.disparity_scale <= 8))
+    return Status(Code::kInvalidArgument, "synthetic scene: disparity scale %g outside (0, 8]",
+                  params.disparity_scale);
+  if (!(params.max_rotation_deg >= 0 && params.max_rotation_deg <= 10) ||
+      !(params.max_translation >= 0 && params.max_translation <= 0.1))
+    return Status(Code::kInvalidArgument,
+                  "synthetic scene: handheld bounds %g deg / %g outside 0..10 deg / 0..0.1",
+                  params.max_rotation_deg, params.max_translation);
+
+  params_ = params;
+  width_ = width;
+  height_ = height;
+  views_ = views;
+  reference_ = reference;
+  BuildLayout(params);
+  BuildFixedPoint();
+  for (int32_t v = 0; v < views; ++v) LB_RETURN_IF_ERROR(BuildView(v));
+  corner_rows_.assign(2 * (static_cast<size_t>(width) + 1), 0);
+  return Status::Ok();
+}
+
+void Scene::BuildLayout(const SceneParams& params) {
+  Rng rng{params.seed ^ 0x5CE7E5EEDull};
+  double s, c;
+  SinCos(params.fov_deg * kPi / 360.0, &s, &c);
+  focal_design_ = 0.5 * kDesignW * c / s;
+  const double base_baseline = kWallDisp * kWallDepth / focal_design_;
+  baseline_ = base_baseline * params.disparity_scale;
+  const auto depth_of = [&](double disp) { return focal_design_ * base_baseline / disp; };
+
+  for (int i = 0; i < 256 * 256; ++i) noise_[i] = static_cast<uint8_t>(rng.Next() >> 56);
+  for (int t = 0; t < 256; ++t)
+    fade_[t] = static_cast<uint8_t>((3 * t * t * 256 - 2 * t * t * t) >> 16);
+
+  object_count_ = 0;
+  auto add = [&](Shape shape, double depth, double x, double y, double r0, double r1, double angle,
+                 uint8_t pattern) -> Object& {
+    Object& o = objects_[object_count_++];
+    o = Object();
+    o.shape = shape;
+    o.depth = depth;
+    o.cx = x;
+    o.cy = y;
+    o.r0 = r0;
+    o.r1 = r1;
+    o.angle_deg = angle;
+    o.pattern = pattern;
+    o.salt_x = rng.Int(256);
+    o.salt_y = rng.Int(256);
+    const uint8_t* a = kPalette[rng.Int(kPaletteSize)];
+    const uint8_t* b = kPalette[rng.Int(kPaletteSize)];
+    for (int k = 0; k < 3; ++k) {
+      o.color_a[k] = a[k];
+      o.color_b[k] = static_cast<uint8_t>((a[k] + b[k] + 1) / 2);
+    }
+    return o;
+  };
+  auto set_colors = [](Object& o, uint8_t r, uint8_t g, uint8_t b, uint8_t r2, uint8_t g2,
+                       uint8_t b2) {
+    o.color_a[0] = r, o.color_a[1] = g, o.color_a[2] = b;
+    o.color_b[0] = r2, o.color_b[1] = g2, o.color_b[2] = b2;
+  };
+
+  set_colors(add(Shape::kWall, kWallDepth, 0, 0, 0, 0, 0, 3), 112, 92, 80, 150, 118, 92);
+  if (params.ground_plane) {
+    // Camera height that puts the ground's bottom row at kGroundDisp.
+    const double h = base_baseline * (0.5 * kDesignH) / kGroundDisp;
+    set_colors(add(Shape::kGround, h, 0, 0, 0, 0, 0, 4), 92, 104, 78, 138, 128, 108);
+  }
+  // Front objects: nominal position (design px from the centre), size and disparity, jittered
+  // by the seed within bounds that keep the depth order and the overlaps.
+  auto jit = [&](double v, double d) { return v + rng.Range(-d, d); };
+  auto sc = [&](double v) { return v * rng.Range(0.9, 1.1); };
+  auto dp = [&](double d) { return depth_of(d * rng.Range(0.93, 1.07)); };
+  add(Shape::kDisc, dp(2.5), jit(-120, 20), jit(-40, 20), sc(95), 0, 0,
+      static_cast<uint8_t>(rng.Int(3) == 0 ? 2 : 0));
+  if (rng.Int(2) == 0)
+    add(Shape::kBox, dp(3.5), jit(225, 15), jit(-165, 15), sc(52), sc(40), jit(0, 10), 0);
+  add(Shape::kBox, dp(4.5), jit(40, 20), jit(30, 15), sc(72), sc(112), jit(0, 8), 1);
+  add(Shape::kRing, dp(7.0), jit(190, 15), jit(-70, 15), sc(70), sc(30), 0, 2);
+  Object& pole = add(Shape::kBox, dp(9.5), jit(-20, 25), 0, 330, sc(5.5), jit(6, 4), 0);
+  set_colors(pole, 78, 52, 36, 132, 96, 64);
+  add(Shape::kDisc, dp(12.0), jit(-170, 15), jit(92, 10), sc(45), 0, 0, 1);
+
+  // Nearest first: the z-test then rarely needs to look at an outline twice.
+  int32_t n = 0;
+  for (int32_t i = object_count_ - 1; i >= 0; --i)
+    if (objects_[i].shape != Shape::kWall && objects_[i].shape != Shape::kGround) order_[n++] = i;
+  for (int32_t i = 0; i < object_count_; ++i)
+    if (objects_[i].shape == Shape::kGround) order_[n++] = i;
+  order_[n++] = 0;
+
+  light_count_ = 0;
+  if (params.point_lights) {
+    const int32_t count = 5 + rng.Int(3);
+    for (int32_t i = 0; i < count; ++i) {
+      lights_[light_count_++] = {ToFixed(rng.Range(-300, 300), 8), ToFixed(rng.Range(-225, -5), 8)};
+    }
+  }
+  // The depth midway (in inverse depth) between the wall and the nearest object.
+  double rho_max = 1 / kWallDepth;
+  for (int32_t i = 0; i < object_count_; ++i)
+    if (objects_[i].shape != Shape::kGround && 1 / objects_[i].depth > rho_max)
+      rho_max = 1 / objects_[i].depth;
+  scene_depth_ = 2 / (rho_max + 1 / kWallDepth);
+}
+
+void Scene::BuildFixedPoint() {
+  const double sx = width_ / kDesignW, sy = height_ / kDesignH;
+  const double s = sx < sy ? sx : sy;
+  px_per_design_ = s;
+  intrinsics_.fx = intrinsics_.fy = focal_design_ * s;
+  intrinsics_.cx = 0.5 * width_;
+  intrinsics_.cy = 0.5 * height_;
+  half_w_q16_ = int64_t{width_} << 15;
+  half_h_q16_ = int64_t{height_} << 15;
+  design_per_px_q24_ = ToFixed(1 / s, 24);
+  disp_per_rho_q16_ = ToFixed(intrinsics_.fx * baseline_, 16);
+  for (int32_t i = 0; i < object_count_; ++i) {
+    Object& o = objects_[i];
+    o.cx_q16 = ToFixed(0.5 * width_ + o.cx * s, 16);
+    o.cy_q16 = ToFixed(0.5 * height_ + o.cy * s, 16);
+    o.r0sq_q32 = ToFixed(o.r0 * s * o.r0 * s, 32);
+    o.r1sq_q32 = ToFixed(o.r1 * s * o.r1 * s, 32);
+    double sn, cs;
+    SinCos(o.angle_deg * kPi / 180, &sn, &cs);
+    o.cos_q15 = ToFixed(cs, 15);
+    o.sin_q15 = ToFixed(sn, 15);
+    o.half_len_q31 = ToFixed(o.r0 * s, 31);
+    o.half_wid_q31 = ToFixed(o.r1 * s, 31);
+    if (o.shape == Shape::kGround) {
+      const double h_cm = o.depth * 100;
+      ground_fh_ = ToFixed(intrinsics_.fy * h_cm, 24);
+      ground_h_q8_ = ToFixed(h_cm, 8);
+      // The ground is hidden behind the wall above this row offset; half of it keeps the
+      // texture's division away from the horizon.
+      ground_vmin_q16_ = ToFixed(0.5 * intrinsics_.fy * o.depth / kWallDepth, 16);
+    }
+  }
+}
+
+Status Scene::BuildView(int32_t view) {
+  Pose& pose = poses_[view];
+  pose = Pose();
+  if (params_.motion == CameraMotion::kRectified) {
+    pose.translation[0] = -(view - reference_) * baseline_;
+  } else if (view != reference_) {
+    Rng rng{params_.seed * 0x2545F4914F6CDD1Dull + static_cast<uint64_t>(view) * 0x9E37ull + 7};
+    double axis[3], dir[3];
+    RandomUnit(rng, axis);
+    // Magnitudes from the upper part of their range, and mostly sideways motion, as a burst
+    // from a hand gives: enough parallax for depth in every view.
+    const double angle = rng.Range(0.3, 1) * params_.max_rotation_deg * kPi / 180;
+    double s, c;
+    SinCos(angle, &s, &c);
+    const double k[3][3] = {{0, -axis[2], axis[1]}, {axis[2], 0, -axis[0]}, {-axis[1], axis[0], 0}};
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        pose.rotation[i][j] = (i == j ? c : 0) + s * k[i][j] + (1 - c) * axis[i] * axis[j];
+    RandomUnit(rng, dir);
+    dir[2] *= 0.3;
+    const double norm = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+    const double mag = rng.Range(0.5, 1) * params_.max_translation * scene_depth_ / norm;
+    for (int i = 0; i < 3; ++i) pose.translation[i] = dir[i] * mag;
+  }
+
+  const Intrinsics& in = intrinsics_;
+  const Mat3 k = {{in.fx, 0, in.cx}, {0, in.fy, in.cy}, {0, 0, 1}};
+  const Mat3 k_inv = {{1 / in.fx, 0, -in.cx / in.fx}, {0, 1 / in.fy, -in.cy / in.fy}, {0, 0, 1}};
+  for (int32_t i = 0; i < object_count_; ++i) {
+    const Object& o = objects_[i];
+    ViewMap& m = maps_[view][i];
+    m = ViewMap();
+    const double n[3] = {0, o.shape == Shape::kGround ? 1.0 : 0.0,
+                         o.shape == Shape::kGround ? 0.0 : 1.0};
+    const double d = o.depth;
+    // Reference -> view for points on the plane n.X = d: K (R + t n^T / d) K^-1.
+    Mat3 a, tmp, h_rv, h_vr;
+    for (int r = 0; r < 3; ++r)
+      for (int cidx = 0; cidx < 3; ++cidx)
+        a[r][cidx] = pose.rotation[r][cidx] + pose.translation[r] * n[cidx] / d;
+    Mul(k, a, tmp);
+    Mul(tmp, k_inv, h_rv);
+    if (!Invert(h_rv, h_vr))
+      return Status(Code::kInternal, "synthetic scene: view %d object %d has a singular mapping",
+                    view, i);
+    // Inputs in half pixels; normalised so the denominator's constant is 1.
+    const double w = h_vr[2][2];
+    const double* rows[3] = {h_vr[0], h_vr[1], h_vr[2]};
+    int64_t* outs[3] = {m.nx, m.ny, m.den};
+    for (int r = 0; r < 3; ++r) {
+      outs[r][0] = ToFixed(rows[r][0] * 0.5 / w, 40);
+      outs[r][1] = ToFixed(rows[r][1] * 0.5 / w, 40);
+      outs[r][2] = ToFixed(rows[r][2] / w, 40);
+    }
+    m.den[2] = kOne40;
+    m.affine = m.den[0] == 0 && m.den[1] == 0;
+    // Inverse depth along view rays: (n_v . K^-1 x) / d_v with n_v = R n, d_v = d + n_v . t.
+    double nv[3];
+    for (int r = 0; r < 3; ++r)
+      nv[r] = pose.rotation[r][0] * n[0] + pose.rotation[r][1] * n[1] + pose.rotation[r][2] * n[2];
+    const double dv =
+        d + nv[0] * pose.translation[0] + nv[1] * pose.translation[1] + nv[2] * pose.translation[2];
+    m.rho[0] = ToFixed(nv[0] / (2 * in.fx * dv), 40);
+    m.rho[1] = ToFixed(nv[1] / (2 * in.fy * dv), 40);
+    m.rho[2] = ToFixed((nv[2] - nv[0] * in.cx / in.fx - nv[1] * in.cy / in.fy) / dv, 40);
+
+    if (o.shape == Shape::kWall || o.shape == Shape::kGround) continue;
+    // Bounds: the outline's reference bounding box mapped into the view, plus a margin.
+    const double sc = px_per_design_;
+    double ex = o.r0 * sc, ey = o.r0 * sc;
+    if (o.shape == Shape::kBox) {
+      double sn, cs;
+      SinCos(o.angle_deg * kPi / 180, &sn, &cs);
+      ex = std::fabs(o.r0 * sn) * sc + std::fabs(o.r1 * cs) * sc;
+      ey = std::fabs(o.r0 * cs) * sc + std::fabs(o.r1 * sn) * sc;
+    }
+    const double cx = 0.5 * width_ + o.cx * sc, cy = 0.5 * height_ + o.cy * sc;
+    double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+    bool ok = true;
+    for (int corner = 0; corner < 4; ++corner) {
+      const double x = cx + ((corner & 1) ? ex : -ex), y = cy + ((corner & 2) ? ey : -ey);
+      const double pw = h_rv[2][0] * x + h_rv[2][1] * y + h_rv[2][2];
+      if (!(pw > 1e-9)) ok = false;
+      const double p[2] = {(h_rv[0][0] * x + h_rv[0][1] * y + h_rv[0][2]) / pw,
+                           (h_rv[1][0] * x + h_rv[1][1] * y + h_rv[1][2]) / pw};
+      for (int q = 0; q < 2; ++q) {
+        lo[q] = p[q] < lo[q] ? p[q] : lo[q];
+        hi[q] = p[q] > hi[q] ? p[q] : hi[q];
+      }
+    }
+    const double lim = 4.0 * kMaxSize;
+    if (ok && lo[0] > -lim && hi[0] < lim && lo[1] > -lim && hi[1] < lim) {
+      m.bounded = true;
+      m.x0 = static_cast<int32_t>(std::floor(2 * lo[0])) - 4;
+      m.x1 = static_cast<int32_t>(std::ceil(2 * hi[0])) + 4;
+      m.y0 = static_cast<int32_t>(std::floor(2 * lo[1])) - 4;
+      m.y1 = static_cast<int32_t>(std::ceil(2 * hi[1])) + 4;
+    }
+  }
+  return Status::Ok();
+}
+
+void Scene::PrepareRow(const ViewMap* maps, int32_t y2, RowMap* rows) const {
+  for (int32_t i = 0; i < object_count_; ++i) {
+    const ViewMap& m = maps[i];
+    rows[i] = {m.nx[1] * y2 + m.nx[2], m.ny[1] * y2 + m.ny[2], m.den[1] * y2 + m.den[2],
+               m.rho[1] * y2 + m.rho[2]};
+  }
+}
+
+void Scene::RefPoint(const ViewMap& m, const RowMap& r, int32_t x2, int64_t* xr_q16,
+                     int64_t* yr_q16) const {
+  const int64_t nx = m.nx[0] * x2 + r.nx;  // Q40
+  const int64_t ny = m.ny[0] * x2 + r.ny;
+  if (m.affine) {
+    *xr_q16 = fx::RoundShift<int64_t>(nx, 24);
+    *yr_q16 = fx::RoundShift<int64_t>(ny, 24);
+    return;
+  }
+  // Q40 / Q24 -> Q16; the denominator stays within a few percent of 1 for the allowed motion.
+  int64_t den_q24 = fx::RoundShift<int64_t>(m.den[0] * x2 + r.den, 16);
+  if (den_q24 < (int64_t{1} << 20)) den_q24 = int64_t{1} << 20;
+  *xr_q16 = nx / den_q24;
+  *yr_q16 = ny / den_q24;
+}
+
+bool Scene::Inside(const Object& o, int64_t xr_q16, int64_t yr_q16) const {
+  const int64_t dx = xr_q16 - o.cx_q16, dy = yr_q16 - o.cy_q16;
+  if (o.shape == Shape::kBox) {
+    const int64_t along = dx * o.sin_q15 + dy * o.cos_q15;  // Q31
+    const int64_t across = dx * o.cos_q15 - dy * o.sin_q15;
+    return along <= o.half_len_q31 && along >= -o.half_len_q31 && across <= o.half_wid_q31 &&
+           across >= -o.half_wid_q31;
+  }
+  const int64_t d2 = dx * dx + dy * dy;  // Q32
+  if (d2 > o.r0sq_q32) return false;
+  return o.shape != Shape::kRing || d2 >= o.r1sq_q32;
+}
+
+int32_t Scene::Winner(const ViewMap* maps, const RowMap* rows, int32_t x2, int32_t y2,
+                      int64_t* rho_q40) const {
+  int32_t best = 0;
+  int64_t best_rho = 0;  // nothing behind the camera
+  for (int32_t k = 0; k < object_count_; ++k) {
+    const int32_t i = order_[k];
+    const ViewMap& m = maps[i];
+    if (m.bounded && (x2 < m.x0 || x2 > m.x1 || y2 < m.y0 || y2 > m.y1)) continue;
+    const int64_t rho = m.rho[0] * x2 + rows[i].rho;
+    if (rho <= best_rho) continue;
+    const Object& o = objects_[i];
+    if (o.shape != Shape::kWall && o.shape != Shape::kGround) {
+      int64_t xr, yr;
+      RefPoint(m, rows[i], x2, &xr, &yr);
+      if (!Inside(o, xr, yr)) continue;
+    }
+    best = i;
+    best_rho = rho;
+  }
+  *rho_q40 = best_rho;
+  return best;
+}
+
+int32_t Scene::Noise(int64_t u_q8, int64_t v_q8, int32_t inv_cell_q16, int32_t sx,
+                     int32_t sy) const {
+  const int64_t lu = (u_q8 * inv_cell_q16) >> 16, lv = (v_q8 * inv_cell_q16) >> 16;  // Q8 cells
+  const int32_t iu = static_cast<int32_t>((lu >> 8) + sx) & 255;
+  const int32_t iv = static_cast<int32_t>((lv >> 8) + sy) & 255;
+  const int32_t wu = fade_[lu & 255], wv = fade_[lv & 255];
+  const uint8_t* r0 = noise_ + iv * 256;
+  const uint8_t* r1 = noise_ + ((iv + 1) & 255) * 256;
+  const int32_t iu1 = (iu + 1) & 255;
+  const int32_t top = r0[iu] * (256 - wu) + r0[iu1] * wu;  // Q8
+  const int32_t bot = r1[iu] * (256 - wu) + r1[iu1] * wu;
+  return (top * (256 - wv) + bot * wv) >> 8;  // 0..65280, Q8
+}
+
+void Scene::Shade(int32_t index, int64_t xr_q16, int64_t yr_q16, int32_t* rgb) const {
+  const Object& o = objects_[index];
+  int64_t u, v;  // texture coordinates, Q8: design px, or cm on the ground
+  if (o.shape == Shape::kGround) {
+    int64_t dy = yr_q16 - half_h_q16_;
+    if (dy < ground_vmin_q16_) dy = ground_vmin_q16_;
+    u = (xr_q16 - half_w_q16_) * ground_h_q8_ / dy;
+    v = ground_fh_ / dy;
+  } else {
+    u = ((xr_q16 - half_w_q16_) * design_per_px_q24_) >> 32;
+    v = ((yr_q16 - half_h_q16_) * design_per_px_q24_) >> 32;
+  }
+  const int32_t cell_scale = o.shape == Shape::kGround ? 2 : 1;
+  const int32_t mix = Noise(u, v, 65536 / (kCellMix * cell_scale), o.salt_x, o.salt_y) >> 8;
+  int32_t detail = 0;
+  for (int k = 0; k < 3; ++k)
+    detail += kDetailWeights[k] * Noise(u, v, 65536 / (kDetailCells[k] * cell_scale),
+                                        o.salt_x + 61 * (k + 1), o.salt_y + 97 * (k + 1));
+  detail = detail / 12 >> 8;              // 0..255, mostly 90..170
+  int32_t gain_q8 = 64 + detail * 3 / 2;  // about 0.75..1.25
+  int32_t base[3];
+  for (int c = 0; c < 3; ++c)
+    base[c] = (o.color_a[c] * (255 - mix) + o.color_b[c] * mix + 127) / 255;
+
+  const int64_t ui = u >> 8, vi = v >> 8;  // whole design px (cm on the ground)
+  switch (o.pattern) {
+    case 1:  // checker of 24 px squares
+      if ((FloorDiv(ui, 24) + FloorDiv(vi, 24)) & 1)
+        for (int c = 0; c < 3; ++c) base[c] = base[c] * 3 / 5;
+      break;
+    case 2:  // diagonal stripes
+      if (FloorDiv(ui + vi, 14) & 1) gain_q8 = gain_q8 * 7 / 10;
+      break;
+    case 3: {  // bricks 40 x 16 with 2 px mortar and a tint per brick
+      const int64_t row = FloorDiv(vi, 16);
+      const int64_t uu = ui + (row & 1) * 20;
+      if (FloorMod(vi, 16) < 2 || FloorMod(uu, 40) < 2) {
+        base[0] = 150, base[1] = 146, base[2] = 138;
+      } else {
+        const int32_t tint = static_cast<int32_t>(Hash2(row, FloorDiv(uu, 40)) >> 27) - 16;
+        for (int c = 0; c < 3; ++c) base[c] += tint;
+      }
+      break;
+    }
+    case 4:  // floor tiles of 40 cm with 1.5 cm grout
+      if (FloorMod(u, 40 * 256) < 384 || FloorMod(v, 40 * 256) < 384)
+        base[0] = base[1] = base[2] = 60;
+      break;
+    default:
+      break;
+  }
+  for (int c = 0; c < 3; ++c) rgb[c] = (base[c] * gain_q8 + 128) >> 8;
+
+  if (o.shape == Shape::kWall) {
+    // Point lights: a saturated core of 2.2 design px and a glow out to 6 px.
+    constexpr int64_t kCore2 = 317194;  // 2.2^2 in Q16
+    constexpr int64_t kGlow2 = 6 * 256 * 6 * 256;
+    for (int32_t i = 0; i < light_count_; ++i) {
+      const int64_t dx = u - lights_[i].x_q8, dy = v - lights_[i].y_q8;
+      if (dx > 6 * 256 || dx < -6 * 256 || dy > 6 * 256 || dy < -6 * 256) continue;
+      const int64_t d2 = dx * dx + dy * dy;
+      if (d2 >= kGlow2) continue;
+      const int32_t t_q8 =
+          d2 <= kCore2 ? 256 : static_cast<int32_t>(((kGlow2 - d2) << 8) / (kGlow2 - kCore2));
+      const int32_t w_q8 = t_q8 * t_q8 >> 8;
+      const int32_t light[3] = {255, 252, 240};
+      for (int c = 0; c < 3; ++c) rgb[c] += ((light[c] - rgb[c]) * w_q8) >> 8;
+    }
+  }
+}
+
+Status Scene::RenderRows(int32_t view, int32_t y0, int32_t rows, uint8_t* out_rgb8,
+                         ptrdiff_t stride) {
+  if (width_ == 0) return Status(Code::kInvalidArgument, "synthetic scene: not configured");
+  if (view < 0 || view >= views_)
+    return Status(Code::kInvalidArgument, "synthetic scene: view %d not among %d", view, views_);
+  if (y0 < 0 || rows < 0 || y0 + rows > height_)
+    return Status(Code::kInvalidArgument, "synthetic scene: rows %d..%d outside 0..%d", y0,
+                  y0 + rows, height_);
+  if (rows > 0 && (out_rgb8 == nullptr || stride < ptrdiff_t{width_} * 3))
+    return Status(Code::kInvalidArgument, "synthetic scene: output stride %td below %d bytes",
+                  stride, width_ * 3);
+  const ViewMap* maps = maps_[view];
+  RowMap corner_row[kMaxObjects], centre_row[kMaxObjects];
+  uint8_t* top = corner_rows_.data();
+  uint8_t* bottom = top + width_ + 1;
+  int64_t rho;
+  // Anti-aliasing: the visible object is found at the four pixel corners (shared with the
+  // neighbours), and the pixel averages the texture of each corner's object at its centre.
+  auto fill_corners = [&](int32_t y, uint8_t* ids) {
+    PrepareRow(maps, 2 * y, corner_row);
+    for (int32_t x = 0; x <= width_; ++x)
+      ids[x] = static_cast<uint8_t>(Winner(maps, corner_row, 2 * x, 2 * y, &rho));
+  };
+  if (rows > 0) fill_corners(y0, top);
+  for (int32_t y = y0; y < y0 + rows; ++y) {
+    fill_corners(y + 1, bottom);
+    PrepareRow(maps, 2 * y + 1, centre_row);
+    uint8_t* out = out_rgb8 + (y - y0) * stride;
+    for (int32_t x = 0; x < width_; ++x, out += 3) {
+      const uint8_t ids[4] = {top[x], top[x + 1], bottom[x], bottom[x + 1]};
+      int32_t acc[3] = {0, 0, 0};
+      int32_t done = 0;  // bit mask of the objects already shaded
+      for (int k = 0; k < 4; ++k) {
+        const int32_t i = ids[k];
+        if (done & (1 << i)) continue;
+        done |= 1 << i;
+        int32_t count = 0;
+        for (int q = k; q < 4; ++q) count += ids[q] == i;
+        int64_t xr, yr;
+        RefPoint(maps[i], centre_row[i], 2 * x + 1, &xr, &yr);
+        int32_t rgb[3];
+        Shade(i, xr, yr, rgb);
+        for (int c = 0; c < 3; ++c) acc[c] += count * rgb[c];
+      }
+      for (int c = 0; c < 3; ++c) out[c] = fx::ClampU8((acc[c] + 2) >> 2);
+    }
+    uint8_t* t = top;
+    top = bottom;
+    bottom = t;
+  }
+  return Status::Ok();
+}
+
+Status Scene::CheckTruthArgs(int32_t scale, int32_t y0, int32_t rows, const void* out,
+                             ptrdiff_t stride) const {
+  if (width_ == 0) return Status(Code::kInvalidArgument, "synthetic scene: not configured");
+  if (scale < 1 || width_ / scale < 1 || height_ / scale < 1)
+    return Status(Code::kInvalidArgument, "synthetic scene: scale %d does not fit %dx%d", scale,
+                  width_, height_);
+  if (y0 < 0 || rows < 0 || y0 + rows > height_ / scale)
+    return Status(Code::kInvalidArgument, "synthetic scene: truth rows %d..%d outside 0..%d", y0,
+                  y0 + rows, height_ / scale);
+  if (rows > 0 && (out == nullptr || stride < width_ / scale))
+    return Status(Code::kInvalidArgument, "synthetic scene: truth stride %td below %d", stride,
+                  width_ / scale);
+  return Status::Ok();
+}
+
+namespace {
+// Walks the reference view's grid at full / scale, sampling each block's centre.
+template <typename Fn>
+void ForEachTruthSample(int32_t scale, int32_t y0, int32_t rows, int32_t grid_w, Fn&& fn) {
+  for (int32_t y = y0; y < y0 + rows; ++y)
+    for (int32_t x = 0; x < grid_w; ++x) fn(x, y, (2 * x + 1) * scale, (2 * y + 1) * scale);
+}
+}  // namespace
+
+Status Scene::DisparityRows(int32_t scale, int32_t y0, int32_t rows, uint16_t* out_q8,
+                            ptrdiff_t stride) const {
+  LB_RETURN_IF_ERROR(CheckTruthArgs(scale, y0, rows, out_q8, stride));
+  const int32_t grid_w = width_ / scale;
+  const ViewMap* maps = maps_[reference_];
+  RowMap row[kMaxObjects];
+  int32_t last_y2 = -1;
+  ForEachTruthSample(scale, y0, rows, grid_w, [&](int32_t x, int32_t y, int32_t x2, int32_t y2) {
+    if (y2 != last_y2) PrepareRow(maps, last_y2 = y2, row);
+    int64_t rho;
+    Winner(maps, row, x2, y2, &rho);
+    // Q24 (1/m) x Q16 (px per 1/m) -> Q40, / scale, -> Q8.
+    const int64_t q40 = ((rho >> 16) * disp_per_rho_q16_) / scale;
+    out_q8[(y - y0) * stride + x] = fx::Saturate<uint16_t>(fx::RoundShift<int64_t>(q40, 32));
+  });
+  return Status::Ok();
+}
+
+Status Scene::InverseDepthRows(int32_t scale, int32_t y0, int32_t rows, uint16_t* out_q12,
+                               ptrdiff_t stride) const {
+  LB_RETURN_IF_ERROR(CheckTruthArgs(scale, y0, rows, out_q12, stride));
+  const int32_t grid_w = width_ / scale;
+  const ViewMap* maps = maps_[reference_];
+  RowMap row[kMaxObjects];
+  int32_t last_y2 = -1;
+  ForEachTruthSample(scale, y0, rows, grid_w, [&](int32_t x, int32_t y, int32_t x2, int32_t y2) {
+    if (y2 != last_y2) PrepareRow(maps, last_y2 = y2, row);
+    int64_t rho;
+    Winner(maps, row, x2, y2, &rho);
+    out_q12[(y - y0) * stride + x] = fx::Saturate<uint16_t>(fx::RoundShift<int64_t>(rho, 28));
+  });
+  return Status::Ok();
+}
+
+Status Scene::ObjectRows(int32_t view, int32_t scale, int32_t y0, int32_t rows, uint8_t* out,
+                         ptrdiff_t stride) const {
+  LB_RETURN_IF_ERROR(CheckTruthArgs(scale, y0, rows, out, stride));
+  if (view < 0 || view >= views_)
+    return Status(Code::kInvalidArgument, "synthetic scene: view %d not among %d", view, views_);
+  const int32_t grid_w = width_ / scale;
+  const ViewMap* maps = maps_[view];
+  RowMap row[kMaxObjects];
+  int32_t last_y2 = -1;
+  ForEachTruthSample(scale, y0, rows, grid_w, [&](int32_t x, int32_t y, int32_t x2, int32_t y2) {
+    if (y2 != last_y2) PrepareRow(maps, last_y2 = y2, row);
+    int64_t rho;
+    out[(y - y0) * stride + x] = static_cast<uint8_t>(Winner(maps, row, x2, y2, &rho));
+  });
+  return Status::Ok();
+}
+
+int32_t Scene::disparity_min_q8(int32_t scale) const {
+  // The wall is the farthest visible surface; the same arithmetic as DisparityRows.
+  const int64_t rho = maps_[reference_][0].rho[2];
+  return static_cast<int32_t>(
+      fx::RoundShift<int64_t>(((rho >> 16) * disp_per_rho_q16_) / scale, 32));
+}
+
+int32_t Scene::disparity_max_q8(int32_t scale) const {
+  int64_t rho_max = 0;
+  const ViewMap* maps = maps_[reference_];
+  for (int32_t i = 0; i < object_count_; ++i) {
+    // Fronto-parallel planes have a constant inverse depth; the ground's peaks at the bottom.
+    const int64_t rho = maps[i].rho[1] * (2 * height_) + maps[i].rho[2];
+    if (rho > rho_max) rho_max = rho;
+  }
+  return static_cast<int32_t>(
+      fx::RoundShift<int64_t>(((rho_max >> 16) * disp_per_rho_q16_) / scale, 32));
+}
+
+double Scene::disparity_min(int32_t scale) const { return disparity_min_q8(scale) / 256.0; }
+double Scene::disparity_max(int32_t scale) const { return disparity_max_q8(scale) / 256.0; }
+
+double Scene::object_depth(int32_t i) const {
+  const Object& o = objects_[i];
+  if (o.shape == Shape::kGround) return intrinsics_.fy * o.depth / (0.5 * height_);
+  return o.depth;
+}
+
+}  // namespace lb
