@@ -1,24 +1,43 @@
-// Foundation render stage: a gather blur whose box radius follows the disparity difference from
-// the focal plane. It has the final interface, streaming and memory discipline; the layered,
-// aperture-shaped renderer replaces the per-pixel kernel.
 #include "algo/render/render_stage.h"
-
-#include <cstdlib>
 
 namespace lb {
 namespace {
 
-constexpr int32_t kHistBins = 1024;  // disparity histogram bins of 1/4 px (Q8 >> 6)
+int32_t Min(int32_t a, int32_t b) { return a < b ? a : b; }
+int32_t Max(int32_t a, int32_t b) { return a > b ? a : b; }
 
-// Blur diameter at f/2.8 per pixel of disparity difference at full resolution: the burst acts as
-// an aperture a few view steps wide.
-constexpr float kDiameterPerDispAtF28 = 4.0f;
+// Largest |value| in a plane after the highlight boost, and the shift of c = (v * a) >> shift
+// that keeps a kernel row's term (2 half + 1 cells x 256 x c) below 2^31.
+int32_t ShiftFor(int32_t max_value, int32_t half) {
+  int32_t shift = 0;
+  const int64_t cells = 2 * int64_t{half} + 1;
+  while (cells * 256 * ((int64_t{max_value} * 256) >> shift) >= (int64_t{1} << 31)) ++shift;
+  return shift;
+}
 
 }  // namespace
+
+int32_t RenderStage::LayerRadiiQ4(int32_t max_radius, int32_t* out) {
+  // Half-pixel steps up to 3 px and whole pixels up to 8 px, where a step is visible; then
+  // about 15% apart, where a relative change in blur is what the eye sees.
+  const int32_t cap = max_radius * 16;
+  int32_t n = 0, r = 0;
+  while (r < cap && n < kMaxRadii - 1) {
+    if (out) out[n] = r;
+    ++n;
+    r = r < 48 ? r + 8 : (r < 128 ? r + 16 : Max(r + 16, r * 115 / 100));
+  }
+  if (out) out[n] = cap;
+  return n + 1;
+}
 
 Status RenderStage::Validate(const RenderConfig& c) {
   if (c.width < 16 || c.height < 16) {
     return Status(Code::kInvalidArgument, "render: output %dx%d is below 16x16", c.width, c.height);
+  }
+  if (c.width > 16384 || c.height > 16384) {
+    return Status(Code::kInvalidArgument, "render: output %dx%d is above 16384x16384", c.width,
+                  c.height);
   }
   if (c.working_scale < 1 || c.working_width * c.working_scale > c.width ||
       c.working_height * c.working_scale > c.height || c.working_width < 1 ||
@@ -33,6 +52,31 @@ Status RenderStage::Validate(const RenderConfig& c) {
   return Status::Ok();
 }
 
+Status RenderStage::ValidateParams(const RenderParams& p) {
+  if (!(p.f_number >= 1.0f && p.f_number <= 32.0f)) {
+    return Status(Code::kInvalidArgument, "render: f-number %.2f outside f/1 .. f/32",
+                  static_cast<double>(p.f_number));
+  }
+  if (p.aperture.blades != 0 && (p.aperture.blades < 3 || p.aperture.blades > 12)) {
+    return Status(Code::kInvalidArgument, "render: %d aperture blades (0 for a disc, or 3..12)",
+                  p.aperture.blades);
+  }
+  if (!(p.aperture.curvature >= 0.0f && p.aperture.curvature <= 1.0f)) {
+    return Status(Code::kInvalidArgument, "render: blade curvature %.2f outside 0..1",
+                  static_cast<double>(p.aperture.curvature));
+  }
+  if (!(p.aperture.rotation_deg >= -3600.0f && p.aperture.rotation_deg <= 3600.0f)) {
+    return Status(Code::kInvalidArgument,
+                  "render: aperture rotation %.1f deg is not a finite angle",
+                  static_cast<double>(p.aperture.rotation_deg));
+  }
+  if (!(p.highlight_gain >= 1.0f && p.highlight_gain <= 8.0f)) {
+    return Status(Code::kInvalidArgument, "render: highlight gain %.2f outside 1..8",
+                  static_cast<double>(p.highlight_gain));
+  }
+  return Status::Ok();
+}
+
 size_t RenderStage::RequiredBytes(const RenderConfig& config) {
   RenderStage planner;
   planner.config_ = config;
@@ -42,122 +86,168 @@ size_t RenderStage::RequiredBytes(const RenderConfig& config) {
 }
 
 Status RenderStage::Carve(Arena& arena) {
-  const int32_t cw = (config_.width + 1) / 2;
+  const RenderConfig& c = config_;
+  const int32_t cw = (c.width + 1) / 2, ch = (c.height + 1) / 2;
   strip_.count = 3;
-  strip_.planes[0] = arena.AllocateImage<uint8_t>(config_.width, RenderConfig::kStripRows);
+  strip_.planes[0] = arena.AllocateImage<uint8_t>(c.width, RenderConfig::kStripRows);
   strip_.planes[1] = arena.AllocateImage<uint8_t>(cw, RenderConfig::kStripRows / 2);
   strip_.planes[2] = arena.AllocateImage<uint8_t>(cw, RenderConfig::kStripRows / 2);
-  histogram_ = arena.Allocate<uint16_t>(kHistBins);
-  if (arena.overflowed()) return Status(Code::kOutOfMemory, "render: arena too small");
+  radii_ = LayerRadiiQ4(c.max_radius, nullptr);
+  layers_ = 2 * radii_ - 1;
+  luma_half_ = KernelHalf(static_cast<float>(c.max_radius));
+  chroma_half_ = KernelHalf(static_cast<float>(c.max_radius) * 0.5f);
+  radii_q4_ = arena.Allocate<int32_t>(static_cast<size_t>(radii_));
+  radius_of_layer_ = arena.Allocate<int32_t>(static_cast<size_t>(layers_));
+  layer_of_ = arena.Allocate<uint16_t>(static_cast<size_t>(c.max_radius) * 32 + 1);
+  disp_row_ = arena.Allocate<uint16_t>(static_cast<size_t>(c.width));
+  boost_q8_ = arena.Allocate<uint16_t>(256);
+  histogram_ = arena.Allocate<uint32_t>(256);
+  upsampler_.Carve(arena, c.width, c.height, c.working_scale, c.working_width, c.working_height);
+  luma_.Carve(arena, c.width, c.height, 1, RenderConfig::kStripRows, luma_half_, layers_, radii_);
+  chroma_.Carve(arena, cw, ch, 2, RenderConfig::kStripRows / 2, chroma_half_, layers_, radii_);
+  if (arena.overflowed()) {
+    return Status(Code::kOutOfMemory, "render: arena of %zu bytes is too small (%zu needed)",
+                  arena.size(), arena.used());
+  }
+  if (arena.planning()) return Status::Ok();
+
+  // Layers far to near: signed radii -r[n-1] .. -r[1], 0, r[1] .. r[n-1].
+  LayerRadiiQ4(c.max_radius, radii_q4_);
+  for (int32_t k = 0; k < layers_; ++k)
+    radius_of_layer_[k] = k < radii_ ? radii_ - 1 - k : k - radii_ + 1;
+  // Each signed radius to its layer and the weight of the next layer, linear in between.
+  const int32_t offset = c.max_radius * 16;
+  for (int32_t s = -offset; s <= offset; ++s) {
+    int32_t k = 0;
+    auto signed_q4 = [&](int32_t layer) {
+      return layer < radii_ - 1 ? -radii_q4_[radii_ - 1 - layer] : radii_q4_[layer - radii_ + 1];
+    };
+    while (k + 1 < layers_ && signed_q4(k + 1) <= s) ++k;
+    int32_t frac = 0;
+    if (k + 1 < layers_) {
+      const int32_t span = signed_q4(k + 1) - signed_q4(k);
+      frac = ((s - signed_q4(k)) * 256 + span / 2) / span;
+      if (frac >= 256) ++k, frac = 0;
+    }
+    layer_of_[s + offset] = static_cast<uint16_t>(k << 8 | frac);
+  }
   return Status::Ok();
 }
 
 Status RenderStage::Configure(const RenderConfig& config, Arena& arena) {
   LB_RETURN_IF_ERROR(Validate(config));
   config_ = config;
+  begun_ = false;
   return Carve(arena);
 }
 
 Status RenderStage::Begin(const ConstPlanarU8& ref, ConstImageU16 disp_q8,
                           const RenderParams& params) {
+  const int32_t cw = (config_.width + 1) / 2, ch = (config_.height + 1) / 2;
   if (ref.count != 3 || ref.planes[0].width != config_.width ||
-      ref.planes[0].height != config_.height) {
-    return Status(Code::kInvalidArgument, "render: reference is not %dx%d YCbCr", config_.width,
-                  config_.height);
+      ref.planes[0].height != config_.height || ref.planes[1].width != cw ||
+      ref.planes[1].height != ch || ref.planes[2].width != cw || ref.planes[2].height != ch ||
+      ref.planes[0].data == nullptr || ref.planes[1].data == nullptr ||
+      ref.planes[2].data == nullptr) {
+    return Status(Code::kInvalidArgument, "render: reference is not %dx%d YCbCr 4:2:0",
+                  config_.width, config_.height);
   }
-  if (disp_q8.width != config_.working_width || disp_q8.height != config_.working_height) {
+  if (disp_q8.width != config_.working_width || disp_q8.height != config_.working_height ||
+      disp_q8.data == nullptr) {
     return Status(Code::kInvalidArgument, "render: disparity is %dx%d, expected %dx%d",
                   disp_q8.width, disp_q8.height, config_.working_width, config_.working_height);
   }
-  if (!(params.f_number >= 1.0f && params.f_number <= 32.0f)) {
-    return Status(Code::kInvalidArgument, "render: f-number %.2f outside f/1 .. f/32",
-                  static_cast<double>(params.f_number));
-  }
+  LB_RETURN_IF_ERROR(ValidateParams(params));
   ref_ = ref;
   disp_ = disp_q8;
   params_ = params;
   next_row_ = 0;
 
-  // Focus region in working pixels; the default is the central ninth of the image.
-  FocusRegion r = params.focus;
-  if (r.width <= 0 || r.height <= 0) {
-    r = {config_.width / 3, config_.height / 3, config_.width / 3, config_.height / 3};
+  const FocusRegion& r = params.focus;
+  const int32_t focus =
+      FocusDisparityQ8(disp_, config_.working_scale, r.x, r.y, r.width, r.height, histogram_);
+  lens_.Set(params.f_number, config_.working_scale, config_.max_radius, focus);
+
+  const ApertureShape shape(params.aperture);
+  for (int32_t i = 0; i < radii_; ++i) {
+    const float radius = static_cast<float>(radii_q4_[i]) / 16.0f;
+    luma_.SetKernel(i, shape, radius);
+    chroma_.SetKernel(i, shape, radius * 0.5f);
   }
-  const int32_t s = config_.working_scale;
-  int32_t x0 = r.x / s, y0 = r.y / s, x1 = (r.x + r.width) / s, y1 = (r.y + r.height) / s;
-  x0 = x0 < 0 ? 0 : (x0 >= disp_.width ? disp_.width - 1 : x0);
-  y0 = y0 < 0 ? 0 : (y0 >= disp_.height ? disp_.height - 1 : y0);
-  x1 = x1 <= x0 ? x0 + 1 : (x1 > disp_.width ? disp_.width : x1);
-  y1 = y1 <= y0 ? y0 + 1 : (y1 > disp_.height ? disp_.height : y1);
-  // The focal disparity is the median of the region: robust to a few mislabelled pixels.
-  for (int32_t i = 0; i < kHistBins; ++i) histogram_[i] = 0;
-  int32_t total = 0;
-  for (int32_t y = y0; y < y1; ++y) {
-    for (int32_t x = x0; x < x1; ++x) {
-      int32_t bin = disp_.Row(y)[x] >> 6;
-      bin = bin >= kHistBins ? kHistBins - 1 : bin;
-      if (histogram_[bin] < UINT16_MAX) ++histogram_[bin];
-      ++total;
+  // Highlight gain ramps from 1 at the threshold to the full gain at 255.
+  const int32_t threshold = params.highlight_threshold;
+  for (int32_t y = 0; y < 256; ++y) {
+    double gain = 1.0;
+    if (y >= threshold && params.highlight_gain > 1.0f) {
+      gain += (params.highlight_gain - 1.0) * (y - threshold + 1) / (256 - threshold);
     }
+    boost_q8_[y] = static_cast<uint16_t>(gain * 256.0 + 0.5);
   }
-  int32_t seen = 0, median_bin = 0;
-  for (; median_bin < kHistBins; ++median_bin) {
-    seen += histogram_[median_bin];
-    if (2 * seen >= total) break;
+  int32_t max_luma = 0, max_gain = 0;
+  for (int32_t y = 0; y < 256; ++y) {
+    max_luma = Max(max_luma, (y * boost_q8_[y] + 128) >> 8);
+    max_gain = Max(max_gain, boost_q8_[y]);
   }
-  focus_disp_q8_ = (median_bin << 6) + 32;
-  // Radius in full-resolution px per px of working disparity, fixed point (Q8 of px per Q8 px).
-  const float diameter = kDiameterPerDispAtF28 * 2.8f / params.f_number * static_cast<float>(s);
-  blur_per_disp_q8_ = static_cast<int32_t>(diameter * 0.5f * 256.0f + 0.5f);
+  luma_.Begin(ShiftFor(max_luma, luma_half_));
+  chroma_.Begin(ShiftFor((128 * max_gain + 128) >> 8, chroma_half_));
+  upsampler_.Begin(ref, disp_q8);
+  begun_ = true;
   return Status::Ok();
 }
 
-int32_t RenderStage::RadiusQ8(int32_t disp_q8) const {
-  const int64_t diff = std::abs(disp_q8 - focus_disp_q8_);
-  int64_t r = (diff * blur_per_disp_q8_) >> 8;
-  const int64_t cap = int64_t{config_.max_radius} << 8;
-  return static_cast<int32_t>(r > cap ? cap : r);
+void RenderStage::FillLumaRow(int32_t y) {
+  upsampler_.Row(y, disp_row_);
+  int16_t* s = luma_.RadiusRow(y);
+  int16_t* v = luma_.ValueRow(y, 0);
+  const uint8_t* luma = ref_.planes[0].Row(y);
+  for (int32_t x = 0; x < config_.width; ++x) {
+    s[x] = static_cast<int16_t>(lens_.SignedRadiusQ4(disp_row_[x]));
+    v[x] = static_cast<int16_t>((luma[x] * boost_q8_[luma[x]] + 128) >> 8);
+  }
+  luma_.CommitRow(y, layer_of_, config_.max_radius * 16);
+}
+
+void RenderStage::FillChromaRow(int32_t cy) {
+  // The chroma sample's radius is the mean of its 2x2 luma block's; its boost follows the
+  // block's mean luma, applied to the chroma's distance from grey.
+  const int32_t y0 = 2 * cy, y1 = Min(2 * cy + 1, config_.height - 1);
+  const int16_t* s0 = luma_.RadiusRow(y0);
+  const int16_t* s1 = luma_.RadiusRow(y1);
+  const uint8_t* l0 = ref_.planes[0].Row(y0);
+  const uint8_t* l1 = ref_.planes[0].Row(y1);
+  const uint8_t* cb = ref_.planes[1].Row(cy);
+  const uint8_t* cr = ref_.planes[2].Row(cy);
+  int16_t* s = chroma_.RadiusRow(cy);
+  int16_t* vb = chroma_.ValueRow(cy, 0);
+  int16_t* vr = chroma_.ValueRow(cy, 1);
+  const int32_t cw = (config_.width + 1) / 2;
+  for (int32_t x = 0; x < cw; ++x) {
+    const int32_t a = 2 * x, b = Min(2 * x + 1, config_.width - 1);
+    s[x] = static_cast<int16_t>((s0[a] + s0[b] + s1[a] + s1[b] + 2) >> 2);
+    const int32_t gain = boost_q8_[(l0[a] + l0[b] + l1[a] + l1[b] + 2) >> 2];
+    vb[x] = static_cast<int16_t>(((cb[x] - 128) * gain + 128) >> 8);
+    vr[x] = static_cast<int16_t>(((cr[x] - 128) * gain + 128) >> 8);
+  }
+  chroma_.CommitRow(cy, layer_of_, config_.max_radius * 16);
 }
 
 Status RenderStage::NextStrip(ConstPlanarU8* strip, int32_t* y0, int32_t* rows) {
-  const int32_t h = config_.height;
+  if (!begun_) return Status(Code::kInvalidArgument, "render: NextStrip before Begin");
+  const int32_t h = config_.height, ch = (h + 1) / 2;
   *y0 = next_row_;
-  *rows = h - next_row_ < RenderConfig::kStripRows ? h - next_row_ : RenderConfig::kStripRows;
+  *rows = Min(RenderConfig::kStripRows, h - next_row_);
   if (*rows <= 0) {
     *rows = 0;
     return Status::Ok();
   }
-  const int32_t s = config_.working_scale;
-  for (int32_t p = 0; p < 3; ++p) {
-    const ConstImageU8& src = ref_.planes[p];
-    const ImageU8& dst = strip_.planes[p];
-    const int32_t sub = p == 0 ? 1 : 2;  // chroma is half size in both directions
-    const int32_t py0 = *y0 / sub, prows = (*rows + sub - 1) / sub;
-    for (int32_t yy = 0; yy < prows && py0 + yy < src.height; ++yy) {
-      const int32_t y = py0 + yy;
-      for (int32_t x = 0; x < src.width; ++x) {
-        int32_t wx = x * sub / s, wy = y * sub / s;
-        wx = wx >= disp_.width ? disp_.width - 1 : wx;
-        wy = wy >= disp_.height ? disp_.height - 1 : wy;
-        const int32_t radius = (RadiusQ8(disp_.Row(wy)[wx]) / sub + 128) >> 8;
-        // Sparse box gather: at most 9x9 taps whatever the radius.
-        const int32_t step = radius / 4 + 1;
-        int32_t sum = 0, count = 0;
-        for (int32_t dy = -radius; dy <= radius; dy += step) {
-          int32_t sy = y + dy;
-          sy = sy < 0 ? 0 : (sy >= src.height ? src.height - 1 : sy);
-          const uint8_t* row = src.Row(sy);
-          for (int32_t dx = -radius; dx <= radius; dx += step) {
-            int32_t sx = x + dx;
-            sx = sx < 0 ? 0 : (sx >= src.width ? src.width - 1 : sx);
-            sum += row[sx];
-            ++count;
-          }
-        }
-        dst.Row(yy)[x] = static_cast<uint8_t>((sum + count / 2) / count);
-      }
-    }
-  }
+  const int32_t cy0 = *y0 / 2, cn = (*rows + 1) / 2;
+  const int32_t chroma_end = Min(ch, cy0 + cn + chroma_half_);
+  const int32_t luma_end = Min(h, Max(*y0 + *rows + luma_half_, 2 * chroma_end));
+  while (luma_.next_row() < luma_end) FillLumaRow(luma_.next_row());
+  while (chroma_.next_row() < chroma_end) FillChromaRow(chroma_.next_row());
+  const int32_t offset = config_.max_radius * 16;
+  luma_.RenderStrip(*y0, *rows, layer_of_, offset, radius_of_layer_, 0, &strip_.planes[0]);
+  chroma_.RenderStrip(cy0, cn, layer_of_, offset, radius_of_layer_, 128, &strip_.planes[1]);
   next_row_ += *rows;
   *strip = strip_.AsConst();
   return Status::Ok();

@@ -2,6 +2,12 @@
 // (YCbCr 4:2:0) and the working-resolution disparity, and produces the output strip by strip
 // (16 luma rows and 8 chroma rows at a time, the JPEG encoder's MCU row), so no full-resolution
 // output is ever held.
+//
+// Per strip: the disparity is upsampled edge-aware to full resolution (depth_upsample.h), turned
+// into a signed blur radius by the lens model (lens_model.h: linear in |d - d_focus|, scaled by
+// 1/f-number, capped at max_radius), each pixel is split between two neighbouring depth layers,
+// and the layers are blurred by the aperture's shape (aperture.h) and composited back to front
+// (layer_plane.h). Everything is fixed point after Begin; the output is the same on every CPU.
 #pragma once
 
 #include <cstddef>
@@ -10,6 +16,9 @@
 #include "algo/core/arena.h"
 #include "algo/core/image.h"
 #include "algo/core/status.h"
+#include "algo/render/depth_upsample.h"
+#include "algo/render/layer_plane.h"
+#include "algo/render/lens_model.h"
 
 namespace lb {
 
@@ -20,7 +29,7 @@ struct FocusRegion {
 
 struct Aperture {
   int32_t blades = 0;         // 0 = a disc; 3..12 = a polygonal iris
-  float rotation_deg = 0.0f;  // rotation of the polygon
+  float rotation_deg = 0.0f;  // rotation of the polygon (0: a flat blade edge faces +x)
   float curvature = 0.0f;     // 0 = straight blades, 1 = a disc
 };
 
@@ -28,8 +37,10 @@ struct RenderParams {
   FocusRegion focus;
   float f_number = 2.8f;  // as set on a lens: f/1.4 .. f/16
   Aperture aperture;
-  uint8_t highlight_threshold = 255;  // luma at or above which highlights are boosted
-  float highlight_gain = 1.0f;        // 1 = no boost
+  // Highlights: luma at or above the threshold is multiplied by a gain that ramps from 1 at the
+  // threshold to highlight_gain at 255 before blurring, so point lights make bright bokeh balls.
+  uint8_t highlight_threshold = 255;
+  float highlight_gain = 1.0f;  // 1 = no boost, at most 8
 };
 
 struct RenderConfig {
@@ -58,12 +69,27 @@ class RenderStage {
   // `*rows` is 0 once the image is complete.
   Status NextStrip(ConstPlanarU8* strip, int32_t* y0, int32_t* rows);
 
-  // The disparity (Q8.8) that the focus region put in focus, valid after Begin.
-  int32_t focus_disp_q8() const { return focus_disp_q8_; }
+  // What the lens model computed in Begin (for GFocus metadata and re-rendering):
+  // the disparity (Q8.8, working px) that the focus region put in focus,
+  int32_t focus_disp_q8() const { return lens_.focus_disp_q8(); }
+  // the blur radius in full-resolution px per working px of disparity difference,
+  float radius_per_disp() const { return lens_.radius_per_disp(); }
+  // and the blur radius of a point at infinity (disparity 0), before the max_radius cap.
+  float blur_at_infinity() const {
+    return radius_per_disp() * static_cast<float>(lens_.focus_disp_q8()) / 256.0f;
+  }
+  // Signed blur radius (Q4 full-resolution px; + nearer, - farther) of a disparity, after Begin.
+  int32_t SignedRadiusQ4(int32_t disp_q8) const { return lens_.SignedRadiusQ4(disp_q8); }
+
+  static constexpr int32_t kMaxRadii = 40;  // distinct layer radii (0..max_radius)
+  // Radii of the depth layers, Q4 px, ascending from 0; returns how many (out may be null).
+  static int32_t LayerRadiiQ4(int32_t max_radius, int32_t* out);
+  static Status ValidateParams(const RenderParams& params);
 
  private:
   Status Carve(Arena& arena);
-  int32_t RadiusQ8(int32_t disp_q8) const;
+  void FillLumaRow(int32_t y);
+  void FillChromaRow(int32_t y);
 
   RenderConfig config_;
   ConstPlanarU8 ref_;
@@ -71,9 +97,18 @@ class RenderStage {
   RenderParams params_;
   PlanarU8 strip_;
   int32_t next_row_ = 0;
-  int32_t focus_disp_q8_ = 0;
-  int32_t blur_per_disp_q8_ = 0;   // radius (Q8 px) per Q8 disparity difference, scaled by 256
-  uint16_t* histogram_ = nullptr;  // disparity histogram for the focus statistic
+  bool begun_ = false;
+  LensModel lens_;
+  DepthUpsampler upsampler_;
+  LayerPlane luma_, chroma_;
+  int32_t radii_ = 0, layers_ = 0;
+  int32_t luma_half_ = 0, chroma_half_ = 0;
+  int32_t* radii_q4_ = nullptr;         // radii_
+  int32_t* radius_of_layer_ = nullptr;  // layers_: kernel index of each layer, far to near
+  uint16_t* layer_of_ = nullptr;        // [signed radius Q4 + max_radius * 16]: layer << 8 | frac
+  uint16_t* disp_row_ = nullptr;        // one upsampled row
+  uint16_t* boost_q8_ = nullptr;        // [luma]: highlight gain, Q8
+  uint32_t* histogram_ = nullptr;       // 256 bins for the focus median
 };
 
 }  // namespace lb

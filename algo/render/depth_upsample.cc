@@ -1,0 +1,125 @@
+#include "algo/render/depth_upsample.h"
+
+namespace lb {
+namespace {
+
+int32_t Abs(int32_t v) { return v < 0 ? -v : v; }
+int32_t Min(int32_t a, int32_t b) { return a < b ? a : b; }
+int32_t Max(int32_t a, int32_t b) { return a > b ? a : b; }
+
+}  // namespace
+
+void DepthUpsampler::Carve(Arena& arena, int32_t width, int32_t height, int32_t scale,
+                           int32_t working_width, int32_t working_height) {
+  width_ = width, height_ = height, scale_ = scale, ww_ = working_width, wh_ = working_height;
+  for (Guide& g : guide_) g.yuv = arena.Allocate<uint8_t>(static_cast<size_t>(3) * ww_);
+  uniform_ = arena.Allocate<uint8_t>(static_cast<size_t>(ww_));
+  spatial_q8_ = arena.Allocate<uint16_t>(static_cast<size_t>(3) * scale_);
+  range_q8_ = arena.Allocate<uint16_t>(766);
+  if (arena.planning() || arena.overflowed()) return;
+  // Spatial term (1 - (d / 1.75)^2)^2 of the distance d in working px between a sub-position and
+  // a neighbour's centre: every neighbour of the 3x3 keeps some weight, the near ones most.
+  for (int32_t f = 0; f < scale_; ++f) {
+    const double u = (f + 0.5) / scale_ - 0.5;
+    for (int32_t o = 0; o < 3; ++o) {
+      const double d = (u - (o - 1)) / 1.75;
+      const double w = d * d >= 1.0 ? 0.0 : (1.0 - d * d) * (1.0 - d * d);
+      spatial_q8_[f * 3 + o] = static_cast<uint16_t>(w * 256.0 + 0.5);
+    }
+  }
+  // Range term sigma^4 / (sigma^2 + D^2)^2, in integers.
+  const int64_t s2 = int64_t{kRangeSigma} * kRangeSigma;
+  for (int64_t d = 0; d <= 765; ++d) {
+    const int64_t den = (s2 + d * d) * (s2 + d * d);
+    range_q8_[d] = static_cast<uint16_t>((256 * s2 * s2 + den / 2) / den);
+  }
+}
+
+void DepthUpsampler::Begin(const ConstPlanarU8& ref, ConstImageU16 disp_q8) {
+  ref_ = ref;
+  disp_ = disp_q8;
+  for (Guide& g : guide_) g.tag = -1;
+  uniform_tag_ = -1;
+}
+
+const uint8_t* DepthUpsampler::GuideRow(int32_t wy) {
+  Guide& g = guide_[wy & 3];
+  if (g.tag == wy) return g.yuv;
+  g.tag = wy;
+  const int32_t s = scale_;
+  const int32_t cw = ref_.planes[1].width, ch = ref_.planes[1].height;
+  for (int32_t wx = 0; wx < ww_; ++wx) {
+    uint32_t sum = 0;
+    for (int32_t y = wy * s; y < wy * s + s; ++y) {
+      const uint8_t* row = ref_.planes[0].Row(y);
+      for (int32_t x = wx * s; x < wx * s + s; ++x) sum += row[x];
+    }
+    g.yuv[wx] = static_cast<uint8_t>((sum + s * s / 2) / (s * s));
+    const int32_t cx0 = wx * s / 2, cx1 = Min((wx * s + s - 1) / 2, cw - 1);
+    const int32_t cy0 = wy * s / 2, cy1 = Min((wy * s + s - 1) / 2, ch - 1);
+    const uint32_t n = static_cast<uint32_t>((cx1 - cx0 + 1) * (cy1 - cy0 + 1));
+    for (int32_t p = 1; p < 3; ++p) {
+      uint32_t csum = 0;
+      for (int32_t y = cy0; y <= cy1; ++y) {
+        const uint8_t* row = ref_.planes[p].Row(y);
+        for (int32_t x = cx0; x <= cx1; ++x) csum += row[x];
+      }
+      g.yuv[p * ww_ + wx] = static_cast<uint8_t>((csum + n / 2) / n);
+    }
+  }
+  return g.yuv;
+}
+
+const uint8_t* DepthUpsampler::UniformRow(int32_t wy) {
+  if (uniform_tag_ == wy) return uniform_;
+  uniform_tag_ = wy;
+  const uint16_t* rows[3] = {disp_.Row(Max(wy - 1, 0)), disp_.Row(wy),
+                             disp_.Row(Min(wy + 1, wh_ - 1))};
+  for (int32_t wx = 0; wx < ww_; ++wx) {
+    const int32_t l = Max(wx - 1, 0), r = Min(wx + 1, ww_ - 1);
+    const uint16_t v = rows[1][wx];
+    bool same = true;
+    for (int32_t i = 0; i < 3; ++i)
+      same = same && rows[i][l] == v && rows[i][wx] == v && rows[i][r] == v;
+    uniform_[wx] = same ? 1 : 0;
+  }
+  return uniform_;
+}
+
+void DepthUpsampler::Row(int32_t y, uint16_t* out) {
+  const int32_t s = scale_;
+  const int32_t wy = Min(y / s, wh_ - 1);
+  const int32_t fy = Min(y - wy * s, s - 1);
+  const int32_t wys[3] = {Max(wy - 1, 0), wy, Min(wy + 1, wh_ - 1)};
+  const uint8_t* guide[3] = {GuideRow(wys[0]), GuideRow(wys[1]), GuideRow(wys[2])};
+  const uint16_t* disp[3] = {disp_.Row(wys[0]), disp_.Row(wys[1]), disp_.Row(wys[2])};
+  const uint8_t* uniform = UniformRow(wy);
+  const uint8_t* luma = ref_.planes[0].Row(y);
+  const uint8_t* cb = ref_.planes[1].Row(y / 2);
+  const uint8_t* cr = ref_.planes[2].Row(y / 2);
+  const uint16_t* wsy = spatial_q8_ + fy * 3;
+  for (int32_t x = 0; x < width_; ++x) {
+    const int32_t wx = Min(x / s, ww_ - 1);
+    if (uniform[wx]) {
+      out[x] = disp[1][wx];
+      continue;
+    }
+    const uint16_t* wsx = spatial_q8_ + Min(x - wx * s, s - 1) * 3;
+    const int32_t qx[3] = {Max(wx - 1, 0), wx, Min(wx + 1, ww_ - 1)};
+    const int32_t py = luma[x], pb = cb[x / 2], pr = cr[x / 2];
+    uint32_t sum_w = 0, sum_wd = 0;  // weights Q8 <= 256: at most 9 * 256 * 65535 < 2^32
+    for (int32_t oy = 0; oy < 3; ++oy) {
+      const uint8_t* g = guide[oy];
+      for (int32_t ox = 0; ox < 3; ++ox) {
+        const int32_t q = qx[ox];
+        const int32_t dist = Abs(py - g[q]) + Abs(pb - g[ww_ + q]) + Abs(pr - g[2 * ww_ + q]);
+        const uint32_t w = ((wsy[oy] * wsx[ox]) >> 8) * range_q8_[dist] >> 8;
+        sum_w += w;
+        sum_wd += w * disp[oy][q];
+      }
+    }
+    out[x] = sum_w ? static_cast<uint16_t>((sum_wd + sum_w / 2) / sum_w) : disp[1][wx];
+  }
+}
+
+}  // namespace lb

@@ -1,0 +1,310 @@
+#include "algo/render/render_stage.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <new>
+#include <vector>
+
+#include "tests/algo/render/render_util.h"
+
+// Counts heap allocations so a test can prove the render allocates nothing after Configure.
+static std::atomic<int64_t> g_allocations{0};
+void* operator new(size_t n) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(n ? n : 1)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, size_t) noexcept { std::free(p); }
+
+namespace lb {
+namespace {
+
+// A synthetic image described per full-resolution pixel: luma, chroma and disparity (working
+// px), rendered through the stage at `scale`.
+struct Image {
+  int32_t w = 0, h = 0, scale = 1;
+  std::vector<uint8_t> y, cb, cr;
+  std::vector<uint16_t> disp;
+  Image(int32_t width, int32_t height, int32_t s) : w(width), h(height), scale(s) {
+    y.assign(w * h, 0);
+    cb.assign(((w + 1) / 2) * ((h + 1) / 2), 128);
+    cr.assign(cb.size(), 128);
+    disp.assign((w / s) * (h / s), 0);
+  }
+  ConstPlanarU8 Planar() const {
+    ConstPlanarU8 p;
+    p.count = 3;
+    p.planes[0] = MakeView(y.data(), w, h);
+    p.planes[1] = MakeView(cb.data(), (w + 1) / 2, (h + 1) / 2);
+    p.planes[2] = MakeView(cr.data(), (w + 1) / 2, (h + 1) / 2);
+    return p;
+  }
+  ConstImageU16 Disp() const { return MakeView(disp.data(), w / scale, h / scale); }
+  uint8_t& Y(int32_t x, int32_t yy) { return y[yy * w + x]; }
+  uint16_t& D(int32_t wx, int32_t wy) { return disp[wy * (w / scale) + wx]; }
+};
+
+test::Rendered Render(const Image& im, const test::RenderSetup& setup) {
+  test::Rendered out;
+  const Status s = test::RenderAll(im.Planar(), im.Disp(), im.scale, setup, &out);
+  EXPECT_TRUE(s.ok()) << s.message();
+  return out;
+}
+
+TEST(RenderStage, AllInFocusIsTheIdentity) {
+  Image im(97, 75, 3);  // odd sizes: a lone chroma column and row, a short last strip
+  for (size_t i = 0; i < im.y.size(); ++i) im.y[i] = static_cast<uint8_t>(i * 37 % 251);
+  for (size_t i = 0; i < im.cb.size(); ++i) im.cb[i] = static_cast<uint8_t>(i * 11 % 256);
+  for (size_t i = 0; i < im.cr.size(); ++i) im.cr[i] = static_cast<uint8_t>(i * 5 % 256);
+  for (uint16_t& d : im.disp) d = 3 << 8;
+  const test::Rendered out = Render(im, {});
+  EXPECT_EQ(out.y, im.y);
+  EXPECT_EQ(out.cb, im.cb);
+  EXPECT_EQ(out.cr, im.cr);
+  EXPECT_EQ(out.strip_rows, (std::vector<int32_t>{16, 16, 16, 16, 11}));
+}
+
+TEST(RenderStage, FlatColourStaysFlatWhateverTheDepth) {
+  Image im(64, 48, 4);
+  for (uint8_t& v : im.y) v = 140;
+  for (uint8_t& v : im.cb) v = 90;
+  for (uint8_t& v : im.cr) v = 170;
+  for (size_t i = 0; i < im.disp.size(); ++i) im.disp[i] = static_cast<uint16_t>(i * 997 % 3000);
+  test::RenderSetup setup;
+  setup.params.f_number = 1.4f;
+  const test::Rendered out = Render(im, setup);
+  for (uint8_t v : out.y) ASSERT_NEAR(v, 140, 1);
+  for (uint8_t v : out.cb) ASSERT_NEAR(v, 90, 1);
+  for (uint8_t v : out.cr) ASSERT_NEAR(v, 170, 1);
+}
+
+// Left half at disparity `left_disp` with luma `left_y`, right half likewise; focus on one side.
+Image TwoHalves(int32_t left_y, uint16_t left_disp, int32_t right_y, uint16_t right_disp) {
+  Image im(96, 64, 4);
+  for (int32_t y = 0; y < im.h; ++y) {
+    for (int32_t x = 0; x < im.w; ++x) im.Y(x, y) = static_cast<uint8_t>(x < 48 ? left_y : right_y);
+  }
+  for (int32_t wy = 0; wy < 16; ++wy) {
+    for (int32_t wx = 0; wx < 24; ++wx) im.D(wx, wy) = wx < 12 ? left_disp : right_disp;
+  }
+  return im;
+}
+
+TEST(RenderStage, SharpForegroundDoesNotBleedIntoBlurredBackground) {
+  // Left: far background (disparity 1), dark. Right: near foreground (disparity 3), bright, in
+  // focus. At f/2.8 and scale 4 the background blurs by 16 px.
+  const Image im = TwoHalves(40, 1 << 8, 200, 3 << 8);
+  test::RenderSetup setup;
+  setup.params.focus = {60, 10, 30, 40};
+  const test::Rendered out = Render(im, setup);
+  for (int32_t y = 0; y < im.h; ++y) {
+    for (int32_t x = 0; x < im.w; ++x) {
+      const int32_t v = out.y[y * im.w + x];
+      if (x >= 48) {
+        ASSERT_EQ(v, 200) << x << "," << y;  // the foreground stays sharp
+      }
+      if (x < 48) {
+        ASSERT_NEAR(v, 40, 1) << x << "," << y;  // no glow of the foreground
+      }
+    }
+  }
+}
+
+TEST(RenderStage, BlurredForegroundSpreadsOverSharpBackground) {
+  // Left: near foreground (disparity 3), bright, blurred by 16 px. Right: far background
+  // (disparity 1), dark, in focus.
+  const Image im = TwoHalves(200, 3 << 8, 40, 1 << 8);
+  test::RenderSetup setup;
+  setup.params.focus = {60, 10, 30, 40};
+  const test::Rendered out = Render(im, setup);
+  const int32_t row = 32 * im.w;
+  EXPECT_GT(out.y[row + 49], 100);  // just behind the foreground's edge: covered by its blur
+  EXPECT_GT(out.y[row + 58], 45);   // 10 px in: still partly covered
+  EXPECT_LT(out.y[row + 58], out.y[row + 49]);
+  EXPECT_EQ(out.y[row + 66], 40);        // beyond the 16 px radius: untouched
+  EXPECT_NEAR(out.y[row + 20], 200, 1);  // the foreground's inside keeps its colour
+}
+
+// A dark plane at disparity 1 with a bright 3x3 spot; the focus is elsewhere (disparity 3 in
+// the bottom-right corner), so the point blurs by radius 8 * 2 / (f/2.8 -> 1) = 16 px.
+Image PointLight(int32_t px, int32_t py) {
+  Image im(96, 96, 4);
+  for (uint8_t& v : im.y) v = 20;
+  for (int32_t dy = -1; dy <= 1; ++dy) {
+    for (int32_t dx = -1; dx <= 1; ++dx) im.Y(px + dx, py + dy) = 255;
+  }
+  for (int32_t wy = 0; wy < 24; ++wy) {
+    for (int32_t wx = 0; wx < 24; ++wx) im.D(wx, wy) = (wx >= 20 && wy >= 20) ? 3 << 8 : 1 << 8;
+  }
+  return im;
+}
+
+TEST(RenderStage, PointSpreadsOverTheApertureOfTheLensModelRadius) {
+  const Image im = PointLight(40, 40);
+  test::RenderSetup setup;
+  setup.max_radius = 32;
+  setup.params.focus = {84, 84, 8, 8};
+  const test::Rendered disc = Render(im, setup);
+  EXPECT_FLOAT_EQ(disc.radius_per_disp, 8.0f);
+  EXPECT_FLOAT_EQ(disc.focus_disp, 3.0f);
+  auto at = [&](const test::Rendered& r, int32_t dx, int32_t dy) {
+    return static_cast<int32_t>(r.y[(40 + dy) * im.w + 40 + dx]);
+  };
+  // 9 x 235 spread over a disc of area pi 16^2 ~ 804 px: about 2.6 each.
+  int64_t inside = 0, outside = 0;
+  for (int32_t dy = -24; dy <= 24; ++dy) {
+    for (int32_t dx = -24; dx <= 24; ++dx) {
+      const double d = std::sqrt(dx * dx + dy * dy);
+      if (d <= 14) {
+        EXPECT_GE(at(disc, dx, dy), 22) << dx << "," << dy;
+      }
+      if (d <= 15) inside += at(disc, dx, dy) - 20;
+      if (d >= 19) outside += std::abs(at(disc, dx, dy) - 20);
+    }
+  }
+  EXPECT_EQ(outside, 0);
+  EXPECT_GT(inside, 1500);
+
+  // Highlight boost: the same point with gain 8 is several times brighter.
+  setup.params.highlight_threshold = 200;
+  setup.params.highlight_gain = 8.0f;
+  const test::Rendered boosted = Render(im, setup);
+  int64_t boosted_inside = 0;
+  for (int32_t dy = -15; dy <= 15; ++dy) {
+    for (int32_t dx = -15; dx <= 15; ++dx) {
+      if (dx * dx + dy * dy <= 225) boosted_inside += at(boosted, dx, dy) - 20;
+    }
+  }
+  EXPECT_GT(boosted_inside, 5 * inside);
+}
+
+TEST(RenderStage, HexagonalIrisGivesHexagonalBokeh) {
+  const Image im = PointLight(48, 40);
+  test::RenderSetup setup;
+  setup.max_radius = 32;
+  setup.params.focus = {84, 84, 8, 8};
+  setup.params.highlight_threshold = 200;
+  setup.params.highlight_gain = 8.0f;
+  setup.params.aperture = {6, 0.0f, 0.0f};  // flat edges face +-x, vertices point +-y
+  const test::Rendered hex = Render(im, setup);
+  auto lit = [&](int32_t dx, int32_t dy) { return hex.y[(40 + dy) * im.w + 48 + dx] > 20; };
+  // The spot is 3x3: apothem 16 cos 30 + 1 = 14.9: lit at 13 along x, dark at 17; along y
+  // (a vertex) lit at 16.
+  EXPECT_TRUE(lit(13, 0));
+  EXPECT_TRUE(lit(-13, 0));
+  EXPECT_FALSE(lit(17, 0));
+  EXPECT_FALSE(lit(-17, 0));
+  EXPECT_TRUE(lit(0, 16));
+  EXPECT_TRUE(lit(0, -16));
+}
+
+TEST(RenderStage, NothingIsAllocatedAfterConfigure) {
+  test::TestScene scene = test::MakeLayeredScene(80, 64, 4);
+  RenderConfig config;
+  config.width = 80, config.height = 64, config.working_scale = 4;
+  config.working_width = 20, config.working_height = 16, config.max_radius = 12;
+  std::vector<uint8_t> block(RenderStage::RequiredBytes(config) + 64);
+  Arena arena(block.data() + (64 - reinterpret_cast<uintptr_t>(block.data()) % 64),
+              block.size() - 64);
+  RenderStage stage;
+  ASSERT_TRUE(stage.Configure(config, arena).ok());
+  RenderParams params;
+  params.aperture = {7, 10.0f, 0.3f};
+  params.highlight_gain = 3.0f;
+  params.highlight_threshold = 220;
+  const int64_t before = g_allocations.load();
+  bool ok = stage.Begin(scene.Planar(), scene.WorkingDisp(), params).ok();
+  int32_t total = 0;
+  for (int32_t rows = 1; ok && rows > 0;) {
+    ConstPlanarU8 strip;
+    int32_t y0 = 0;
+    ok = stage.NextStrip(&strip, &y0, &rows).ok();
+    total += rows;
+  }
+  const int64_t after = g_allocations.load();
+  EXPECT_TRUE(ok);
+  EXPECT_EQ(total, 64);
+  EXPECT_EQ(after - before, 0);
+  EXPECT_LT(RenderStage::RequiredBytes(config), size_t{1} << 20);
+}
+
+TEST(RenderStage, RejectsBadInputWithAClearMessage) {
+  RenderConfig config;
+  config.width = 64, config.height = 48, config.working_scale = 4;
+  config.working_width = 16, config.working_height = 12;
+  EXPECT_EQ(RenderStage::Validate(config).code(), Code::kOk);
+  RenderConfig bad = config;
+  bad.max_radius = 200;
+  EXPECT_EQ(RenderStage::Validate(bad).code(), Code::kInvalidArgument);
+  bad = config;
+  bad.working_width = 17;
+  EXPECT_EQ(RenderStage::Validate(bad).code(), Code::kInvalidArgument);
+
+  // An arena one byte short is reported, not overrun.
+  const size_t need = RenderStage::RequiredBytes(config);
+  std::vector<uint8_t> block(need + 64);
+  uint8_t* base = block.data() + (64 - reinterpret_cast<uintptr_t>(block.data()) % 64);
+  RenderStage stage;
+  Arena small(base, need - 1);
+  EXPECT_EQ(stage.Configure(config, small).code(), Code::kOutOfMemory);
+  Arena arena(base, need);
+  ASSERT_TRUE(stage.Configure(config, arena).ok());
+
+  ConstPlanarU8 strip;
+  int32_t y0 = 0, rows = 0;
+  EXPECT_EQ(stage.NextStrip(&strip, &y0, &rows).code(), Code::kInvalidArgument);
+
+  Image im(64, 48, 4);
+  RenderParams p;
+  EXPECT_TRUE(stage.Begin(im.Planar(), im.Disp(), p).ok());
+  Image wrong(64, 32, 4);
+  Status s = stage.Begin(wrong.Planar(), im.Disp(), p);
+  EXPECT_EQ(s.code(), Code::kInvalidArgument);
+  EXPECT_STREQ(s.message(), "render: reference is not 64x48 YCbCr 4:2:0");
+  s = stage.Begin(im.Planar(), wrong.Disp(), p);
+  EXPECT_STREQ(s.message(), "render: disparity is 16x8, expected 16x12");
+  for (float f : {0.5f, 40.0f, NAN}) {
+    p = RenderParams{};
+    p.f_number = f;
+    EXPECT_EQ(stage.Begin(im.Planar(), im.Disp(), p).code(), Code::kInvalidArgument) << f;
+  }
+  p = RenderParams{};
+  p.aperture.blades = 2;
+  EXPECT_STREQ(stage.Begin(im.Planar(), im.Disp(), p).message(),
+               "render: 2 aperture blades (0 for a disc, or 3..12)");
+  p = RenderParams{};
+  p.aperture.curvature = 1.5f;
+  EXPECT_EQ(stage.Begin(im.Planar(), im.Disp(), p).code(), Code::kInvalidArgument);
+  p = RenderParams{};
+  p.highlight_gain = 0.5f;
+  EXPECT_EQ(stage.Begin(im.Planar(), im.Disp(), p).code(), Code::kInvalidArgument);
+  p = RenderParams{};
+  p.aperture.rotation_deg = INFINITY;
+  EXPECT_EQ(stage.Begin(im.Planar(), im.Disp(), p).code(), Code::kInvalidArgument);
+}
+
+// The output bytes of a fixed render: the same value on x86-64, aarch64 and armhf (the unit
+// tests also run under qemu) proves the render is bit-identical across them.
+TEST(RenderStage, OutputIsBitIdenticalAcrossPlatforms) {
+  const test::TestScene scene = test::MakeLayeredScene(96, 64, 4);
+  test::RenderSetup setup;
+  setup.max_radius = 12;
+  setup.params.f_number = 2.0f;
+  setup.params.aperture = {5, 17.0f, 0.25f};
+  setup.params.highlight_threshold = 230;
+  setup.params.highlight_gain = 4.0f;
+  test::Rendered out;
+  ASSERT_TRUE(test::RenderAll(scene.Planar(), scene.WorkingDisp(), 4, setup, &out).ok());
+  uint64_t hash = 1469598103934665603ull;  // FNV-1a
+  for (const std::vector<uint8_t>* p : {&out.y, &out.cb, &out.cr}) {
+    for (uint8_t v : *p) hash = (hash ^ v) * 1099511628211ull;
+  }
+  EXPECT_EQ(hash, 5766607482171684382ull);
+}
+
+}  // namespace
+}  // namespace lb
