@@ -127,7 +127,7 @@ copy_with_libs() {  # FILE [DEST]: the file and every shared library ldd lists f
   local file=$1 dest=${2:-$1}
   mkdir -p "$root$(dirname "$dest")"
   cp -L "$file" "$root$dest"
-  ldd "$file" 2>/dev/null | grep -o '/[^ ]*' | while read -r lib; do
+  { ldd "$file" 2>/dev/null || true; } | { grep -o '/[^ ]*' || true; } | while read -r lib; do
     [[ -e $root$lib ]] && continue
     mkdir -p "$root$(dirname "$lib")"
     cp -L "$lib" "$root$lib"
@@ -146,8 +146,8 @@ if ((libcamera)); then
     [[ -d $d ]] || continue
     mkdir -p "$root$d"
     cp -a "$d/." "$root$d/"
-    find "$d" -name '*.so*' -type f | while read -r lib; do copy_with_libs "$lib"; done
-    find "$d" -type f -perm -u+x ! -name '*.so*' | while read -r exe; do copy_with_libs "$exe"; done
+    # IPA modules and proxy workers: each with the libraries it links.
+    find "$d" -type f \( -name '*.so' -o -perm -u+x \) | while read -r f; do copy_with_libs "$f"; done
   done
 fi
 

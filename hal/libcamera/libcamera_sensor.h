@@ -1,0 +1,46 @@
+// libcamera sensor (Debian 12's libcamera 0.0.3): one StillCapture stream, buffers from a
+// FrameBufferAllocator mapped once at Configure, one request per buffer reused across the
+// burst. When the camera exposes the controls, exposure and white balance are metered on one
+// frame and then held for the whole burst (exposure_hold.h). Every frame reaches the sink as one
+// strip straight from its mapped buffer. A gap in the frame sequence numbers or a frame the
+// pipeline handler marks failed abandons the burst, as in the V4L2 sensor.
+//
+// libcamera allows one CameraManager per process: a process holds one LibcameraSensor at a time.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "hal/sensor.h"
+
+namespace lb {
+
+struct LibcameraOptions {
+  const char* camera_id = "";  // empty: the first camera the manager lists; copied
+  bool hold_exposure = true;   // meter one frame, then fix exposure and white balance
+};
+
+class LibcameraSensor : public Sensor {
+ public:
+  explicit LibcameraSensor(const LibcameraOptions& options);
+  ~LibcameraSensor() override;
+  LibcameraSensor(const LibcameraSensor&) = delete;
+  LibcameraSensor& operator=(const LibcameraSensor&) = delete;
+
+  const char* name() const override { return "libcamera"; }
+  Status Configure(const SensorConfig& config, SensorMode* mode) override;
+  Status CaptureBurst(FrameSink& sink) override;
+  void Stop() override;
+
+  // What the last burst held constant (false where the camera has no such controls).
+  bool exposure_held() const;
+  bool white_balance_held() const;
+  // The id of the configured camera ("" before Configure).
+  const char* camera_id() const;
+
+ private:
+  struct Impl;  // keeps libcamera's headers out of this interface
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace lb
