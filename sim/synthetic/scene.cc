@@ -194,20 +194,38 @@ void Scene::BuildLayout(const SceneParams& params) {
     const double h = base_baseline * (0.5 * kDesignH) / kGroundDisp;
     set_colors(add(Shape::kGround, h, 0, 0, 0, 0, 0, 4), 92, 104, 78, 138, 128, 108);
   }
-  // Front objects: nominal position (design px from the centre), size and disparity, jittered
-  // by the seed within bounds that keep the depth order and the overlaps.
-  auto jit = [&](double v, double d) { return v + rng.Range(-d, d); };
-  auto sc = [&](double v) { return v * rng.Range(0.9, 1.1); };
-  auto dp = [&](double d) { return depth_of(d * rng.Range(0.93, 1.07)); };
-  add(Shape::kDisc, dp(2.5), jit(-120, 20), jit(-40, 20), sc(95), 0, 0,
-      static_cast<uint8_t>(rng.Int(3) == 0 ? 2 : 0));
-  if (rng.Int(2) == 0)
-    add(Shape::kBox, dp(3.5), jit(225, 15), jit(-165, 15), sc(52), sc(40), jit(0, 10), 0);
-  add(Shape::kBox, dp(4.5), jit(40, 20), jit(30, 15), sc(72), sc(112), jit(0, 8), 1);
-  add(Shape::kRing, dp(7.0), jit(190, 15), jit(-70, 15), sc(70), sc(30), 0, 2);
-  Object& pole = add(Shape::kBox, dp(9.5), jit(-20, 25), 0, 330, sc(5.5), jit(6, 4), 0);
-  set_colors(pole, 78, 52, 36, 132, 96, 64);
-  add(Shape::kDisc, dp(12.0), jit(-170, 15), jit(92, 10), sc(45), 0, 0, 1);
+  // Front objects: nominal disparity (design px per step at disparity_scale 1), position
+  // (design px from the centre), size and angle, jittered by the seed within bounds that keep
+  // the depth order and the overlaps. Every draw is its own statement: the order of evaluation
+  // of function arguments differs between compilers and targets.
+  struct Spec {
+    Shape shape;
+    double disp, x, y, jx, jy, r0, r1, angle, jangle;
+    bool scale_r0;  // false for the pole, whose length crosses the frame
+    uint8_t pattern;
+    bool optional;
+  };
+  const bool with_sign = rng.Int(2) == 0;  // the optional small board at the top right
+  const uint8_t disc_pattern = rng.Int(3) == 0 ? 2 : 0;
+  const Spec specs[] = {
+      {Shape::kDisc, 2.5, -120, -40, 20, 20, 95, 0, 0, 0, true, disc_pattern, false},
+      {Shape::kBox, 3.5, 225, -165, 15, 15, 52, 40, 0, 10, true, 0, true},
+      {Shape::kBox, 4.5, 40, 30, 20, 15, 72, 112, 0, 8, true, 1, false},
+      {Shape::kRing, 7.0, 190, -70, 15, 15, 70, 30, 0, 0, true, 2, false},
+      {Shape::kBox, 9.5, -20, 0, 25, 0, 330, 5.5, 6, 4, false, 0, false},
+      {Shape::kDisc, 12.0, -170, 92, 15, 10, 45, 0, 0, 0, true, 1, false},
+  };
+  for (const Spec& sp : specs) {
+    if (sp.optional && !with_sign) continue;
+    const double disp = sp.disp * rng.Range(0.93, 1.07);
+    const double x = sp.x + rng.Range(-sp.jx, sp.jx);
+    const double y = sp.y + rng.Range(-sp.jy, sp.jy);
+    const double r0 = sp.scale_r0 ? sp.r0 * rng.Range(0.9, 1.1) : sp.r0;
+    const double r1 = sp.r1 * rng.Range(0.9, 1.1);
+    const double angle = sp.angle + rng.Range(-sp.jangle, sp.jangle);
+    Object& o = add(sp.shape, depth_of(disp), x, y, r0, r1, angle, sp.pattern);
+    if (!sp.scale_r0) set_colors(o, 78, 52, 36, 132, 96, 64);
+  }
 
   // Nearest first: the z-test then rarely needs to look at an outline twice.
   int32_t n = 0;
@@ -221,7 +239,9 @@ void Scene::BuildLayout(const SceneParams& params) {
   if (params.point_lights) {
     const int32_t count = 5 + rng.Int(3);
     for (int32_t i = 0; i < count; ++i) {
-      lights_[light_count_++] = {ToFixed(rng.Range(-300, 300), 8), ToFixed(rng.Range(-225, -5), 8)};
+      const int64_t x = ToFixed(rng.Range(-300, 300), 8);
+      const int64_t y = ToFixed(rng.Range(-225, -5), 8);
+      lights_[light_count_++] = {x, y};
     }
   }
   // The depth midway (in inverse depth) between the wall and the nearest object.
