@@ -70,6 +70,7 @@ Status DepthStage::Carve(Arena& arena) {
   cost_alpha_ = arena.Allocate<uint16_t>(n);
   weight_right_ = arena.Allocate<uint16_t>(n);
   weight_down_ = arena.Allocate<uint16_t>(n);
+  state_ = arena.Allocate<uint8_t>(n);
   stats_.arena_bytes = arena.used() - start;
   if (arena.overflowed()) return Status(Code::kOutOfMemory, "depth: arena too small");
   return Status::Ok();
@@ -155,37 +156,90 @@ void DepthStage::WinnerTakeAll() {
 bool DepthStage::Expand(int32_t alpha) {
   const int32_t w = config_.width, h = config_.height;
   data_.ComputeRows(LabelDispQ8(alpha), 0, h, cost_alpha_, w);
-  maxflow_.Reset(w, h);
+  // Pass 1: pixels whose choice does not depend on their neighbours are fixed before the cut.
+  // Flipping p to alpha changes the energy by u_p plus, per neighbour q, C - A (q keeps its
+  // label) or -B (q takes alpha); if that is > 0 whatever the neighbours do, p keeps its label
+  // in every optimal move, and if it is < 0 whatever they do, p takes alpha.
+  bool any_free = false, any_take = false;
   for (int32_t y = 0; y < h; ++y) {
     for (int32_t x = 0; x < w; ++x) {
       const int32_t p = y * w + x;
       const int32_t fp = labels_[p];
-      // Unary: D_p(alpha) - D_p(f_p) on x_p = 1 (0 when p already has alpha).
-      int32_t balance = cost_alpha_[p] - cost_[p];
-      if (x + 1 < w) {
-        const int32_t wr = weight_right_[p];
-        const int32_t fq = labels_[p + 1];
-        const int32_t a = wr * Smooth(fp, fq), b = wr * Smooth(fp, alpha);
-        const int32_t c = wr * Smooth(alpha, fq);
-        balance += c - a;
-        maxflow_.AddTerminalBalance(p + 1, -c);
-        maxflow_.AddEdge(p, GridMaxflow::kRight, b + c - a, 0);
+      if (fp == alpha) {
+        state_[p] = kKeep;
+        continue;
       }
-      if (y + 1 < h) {
-        const int32_t wd = weight_down_[p];
-        const int32_t fq = labels_[p + w];
-        const int32_t a = wd * Smooth(fp, fq), b = wd * Smooth(fp, alpha);
-        const int32_t c = wd * Smooth(alpha, fq);
-        balance += c - a;
-        maxflow_.AddTerminalBalance(p + w, -c);
-        maxflow_.AddEdge(p, GridMaxflow::kDown, b + c - a, 0);
+      const int32_t u = cost_alpha_[p] - cost_[p];
+      // Most pixels: alpha is far worse than any smoothness saving (each pair term moves the
+      // difference by at most w_pq * trunc).
+      const int32_t reach = (weight_right_[p] + (x > 0 ? weight_right_[p - 1] : 0) +
+                             weight_down_[p] + (y > 0 ? weight_down_[p - w] : 0)) *
+                            config_.smooth_trunc;
+      if (u > reach) {
+        state_[p] = kKeep;
+        continue;
       }
-      maxflow_.AddTerminalBalance(p, balance);
+      int32_t lo = u, hi = u;
+      auto edge = [&](int32_t q, int32_t wpq) {
+        const int32_t fq = labels_[q];
+        const int32_t keep = wpq * (Smooth(alpha, fq) - Smooth(fp, fq));
+        const int32_t take = -wpq * Smooth(fp, alpha);
+        lo += keep < take ? keep : take;
+        hi += keep < take ? take : keep;
+      };
+      if (x + 1 < w) edge(p + 1, weight_right_[p]);
+      if (x > 0) edge(p - 1, weight_right_[p - 1]);
+      if (y + 1 < h) edge(p + w, weight_down_[p]);
+      if (y > 0) edge(p - w, weight_down_[p - w]);
+      if (lo > 0) {
+        state_[p] = kKeep;
+      } else if (hi < 0) {
+        state_[p] = kTake;
+        any_take = true;
+      } else {
+        state_[p] = kFree;
+        any_free = true;
+      }
     }
   }
-  (void)maxflow_.Solve();
+  if (!any_free && !any_take) return false;
+  // Pass 2: the cut over the free pixels; a fixed neighbour turns a pair term into a unary one.
+  if (any_free) {
+    maxflow_.Reset(w, h);
+    for (int32_t y = 0; y < h; ++y) {
+      for (int32_t x = 0; x < w; ++x) {
+        const int32_t p = y * w + x;
+        const int32_t fp = labels_[p];
+        const uint8_t sp = state_[p];
+        int32_t balance = sp == kFree ? cost_alpha_[p] - cost_[p] : 0;
+        auto pair = [&](int32_t q, int32_t wpq, GridMaxflow::Dir dir) {
+          const uint8_t sq = state_[q];
+          if (sp != kFree && sq != kFree) return;
+          const int32_t fq = labels_[q];
+          // A pixel fixed to alpha behaves as alpha on both sides of its pair terms.
+          const int32_t lp = sp == kTake ? alpha : fp, lq = sq == kTake ? alpha : fq;
+          const int32_t a = wpq * Smooth(lp, lq), b = wpq * Smooth(lp, alpha);
+          const int32_t c = wpq * Smooth(alpha, lq);
+          if (sp == kFree && sq == kFree) {
+            balance += c - a;
+            maxflow_.AddTerminalBalance(q, -c);
+            maxflow_.AddEdge(p, dir, b + c - a, 0);
+          } else if (sp == kFree) {
+            balance += c - a;  // q fixed: E(x_p, q) = a + (c - a) x_p
+          } else {
+            maxflow_.AddTerminalBalance(q, b - a);  // p fixed: E(p, x_q) = a + (b - a) x_q
+          }
+        };
+        if (x + 1 < w) pair(p + 1, weight_right_[p], GridMaxflow::kRight);
+        if (y + 1 < h) pair(p + w, weight_down_[p], GridMaxflow::kDown);
+        if (sp == kFree) maxflow_.AddTerminalBalance(p, balance);
+      }
+    }
+    (void)maxflow_.Solve();
+  }
   for (int32_t p = 0; p < w * h; ++p) {
-    if (!maxflow_.InSource(p)) {
+    const uint8_t sp = state_[p];
+    if (sp == kTake || (sp == kFree && !maxflow_.InSource(p))) {
       labels_[p] = static_cast<uint8_t>(alpha);
       cost_[p] = cost_alpha_[p];
     }

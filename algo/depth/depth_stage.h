@@ -98,6 +98,8 @@ class DepthStage {
       nullptr;  // D_p(alpha) of the move in progress; D_p(f_p - 1) when refining
   uint16_t* weight_right_ = nullptr;  // w_pq to the right neighbour; D_p(f_p + 1) when refining
   uint16_t* weight_down_ = nullptr;
+  enum : uint8_t { kFree = 0, kKeep = 1, kTake = 2 };
+  uint8_t* state_ = nullptr;  // per pixel in a move: free for the cut, or fixed
   int64_t energy_ = 0;
 };
 
