@@ -1,0 +1,42 @@
+// Depth map encodings of the refocusable JPEG (GDepth, see shared/notes/formats.md) for our
+// disparity maps. Disparity (Q8.8 px per view step) is proportional to inverse depth; with no
+// metric scale we take depth = 1 / disparity in px, so near = 1 / disp_max and far = 1 / disp_min.
+// RangeInverse is then linear in disparity:
+//   dn = (far - near * far / d) / (far - near) = (disp_max - disp) / (disp_max - disp_min)
+// quantised to 8 or 16 bits (0 = near). The per-pixel path is integer-only, so the bytes are the
+// same on every platform.
+#pragma once
+
+#include <cstdint>
+
+#include "algo/core/image.h"
+#include "algo/core/status.h"
+
+namespace lb {
+
+struct DisparityRange {
+  int32_t min_q8 = 0;  // farthest plane; 0 (infinity) is encoded as 1/256 px
+  int32_t max_q8 = 0;  // nearest plane
+};
+
+// Checks the range and gives the GDepth Near and Far for it.
+Status DepthNearFar(const DisparityRange& range, double* near_depth, double* far_depth);
+
+// The disparity range that a file's Near and Far describe (inverse of DepthNearFar).
+Status DisparityRangeFromNearFar(double near_depth, double far_depth, DisparityRange* range);
+
+// dispQ8 -> RangeInverse value of `bits` (8 or 16) bits, rounded to nearest; disparities outside
+// the range clamp to its ends. The range must have passed DepthNearFar.
+uint16_t EncodeRangeInverse(int32_t disp_q8, const DisparityRange& range, int bits);
+
+// RangeInverse value -> dispQ8, rounded to nearest. With 16 bits and a range of at most 65535
+// Q8 steps, Decode(Encode(d)) == d for every d in the range.
+int32_t DecodeRangeInverse(uint16_t value, const DisparityRange& range, int bits);
+
+// Whole maps: `values` and `disp_q8` have the same size.
+Status EncodeDepthMap(ConstImageU16 disp_q8, const DisparityRange& range, int bits,
+                      ImageU16 values);
+Status DecodeDepthMap(ConstImageU16 values, const DisparityRange& range, int bits,
+                      ImageU16 disp_q8);
+
+}  // namespace lb
