@@ -5,6 +5,7 @@ namespace {
 
 int32_t Min(int32_t a, int32_t b) { return a < b ? a : b; }
 int32_t Max(int32_t a, int32_t b) { return a > b ? a : b; }
+int32_t Clamp(int32_t v, int32_t lo, int32_t hi) { return v < lo ? lo : (v > hi ? hi : v); }
 
 // Rounded signed division, den > 0 (half away from zero; the same on every platform).
 int64_t RoundDiv(int64_t num, int64_t den) {
@@ -12,157 +13,315 @@ int64_t RoundDiv(int64_t num, int64_t den) {
 }
 
 // Adds one kernel row's weighted sums to acc[x0..x1]. p[i] is the row prefix up to column i.
-// The plain C reference loop; it is written so compilers vectorise it.
+// The plain C reference loop, written so compilers vectorise it: the row term is formed in
+// wrapping uint32 (its true value is below 2^31 in magnitude, see layer_plane.h).
 void GatherRow(const uint32_t* p, const KernelRow& k, int64_t* acc, int32_t x0, int32_t x1) {
   const uint32_t* pa = p + k.left - 1;
   const uint32_t* pb = p + k.left;
   const uint32_t* pc = p + k.right + 1;
   const uint32_t* pd = p + k.right + 2;
-  const int32_t w = k.w, wl = k.wl, wr = k.wr;
+  const uint32_t w = static_cast<uint32_t>(k.w), wl = static_cast<uint32_t>(k.wl),
+                 wr = static_cast<uint32_t>(k.wr);
   for (int32_t x = x0; x <= x1; ++x) {
-    const int32_t span = static_cast<int32_t>(pc[x] - pb[x]);
-    const int32_t left = static_cast<int32_t>(pb[x] - pa[x]);
-    const int32_t right = static_cast<int32_t>(pd[x] - pc[x]);
-    acc[x] += w * span + wl * left + wr * right;
+    const uint32_t t = w * (pc[x] - pb[x]) + wl * (pb[x] - pa[x]) + wr * (pd[x] - pc[x]);
+    acc[x] += static_cast<int32_t>(t);
   }
 }
 
+struct KernelPlan {
+  float radius;
+  int32_t level, half;
+};
+
+KernelPlan PlanKernel(int32_t radius_q4, int32_t sub) {
+  KernelPlan k;
+  k.radius = static_cast<float>(radius_q4) / (16.0f * static_cast<float>(sub));
+  k.level = 0;
+  while (k.level < LayerPlane::kMaxLevel &&
+         k.radius > LayerPlane::kLevelRadius * static_cast<float>(1 << k.level)) {
+    ++k.level;
+  }
+  k.half = KernelHalf(k.radius / static_cast<float>(1 << k.level));
+  return k;
+}
+
+// Rows a kernel reads beyond the rows it renders: its half, plus the bilinear tap and the box
+// of a reduced level.
+int32_t KernelReach(const KernelPlan& k) { return k.level == 0 ? k.half : (k.half + 2) << k.level; }
+
 }  // namespace
 
+int32_t LayerPlane::Reach(int32_t sub, const int32_t* radii_q4, int32_t radii) {
+  int32_t reach = 0;
+  for (int32_t i = 0; i < radii; ++i) reach = Max(reach, KernelReach(PlanKernel(radii_q4[i], sub)));
+  return reach;
+}
+
 void LayerPlane::Carve(Arena& arena, int32_t width, int32_t height, int32_t channels,
-                       int32_t strip_rows, int32_t max_half, int32_t layers, int32_t radii) {
-  width_ = width, height_ = height, channels_ = channels, strip_rows_ = strip_rows;
-  max_half_ = max_half, layers_ = layers, radii_ = radii;
-  // Rows [y0 - half, y0 + strip + half) plus two rows of look-ahead for the chroma of the next
-  // strip, plus slack so a row is never overwritten while a strip reads it.
-  ring_rows_ = strip_rows + 2 * max_half + 4;
-  pitch_ = static_cast<int32_t>(Arena::RoundUp((width + 2 * max_half + 4) * sizeof(uint32_t)) /
+                       int32_t strip_rows, int32_t sub, const int32_t* radii_q4, int32_t radii,
+                       int32_t layers, int32_t extra_rows) {
+  width_ = width, height_ = height, channels_ = channels, strip_rows_ = strip_rows, sub_ = sub;
+  layers_ = layers, radii_ = radii;
+  int32_t max_half = 0;
+  window_rows_ = 1, low_rows_ = 1, reach_ = 0;
+  for (int32_t i = 0; i < radii; ++i) {
+    const KernelPlan k = PlanKernel(radii_q4[i], sub);
+    radius_[i] = k.radius, level_[i] = k.level, half_[i] = k.half;
+    max_half = Max(max_half, k.half);
+    reach_ = Max(reach_, KernelReach(k));
+    const int32_t rows = k.level == 0 ? strip_rows : (strip_rows >> k.level) + 3;
+    window_rows_ = Max(window_rows_, rows + 2 * k.half);
+    if (k.level > 0) low_rows_ = Max(low_rows_, rows);
+  }
+  kernel_rows_ = 2 * max_half + 1;
+  // Rows [y0 - reach, y0 + strip + reach) plus the caller's look-ahead and slack.
+  ring_rows_ = strip_rows + 2 * reach_ + extra_rows + 4;
+  pitch_ = static_cast<int32_t>(Arena::RoundUp((width + 2 * max_half + 8) * sizeof(uint32_t)) /
                                 sizeof(uint32_t));
   const size_t ring = static_cast<size_t>(ring_rows_) * width;
-  const size_t window = static_cast<size_t>(strip_rows + 2 * max_half);
   const size_t planes = static_cast<size_t>(channels + 1);
   ring_s_ = arena.Allocate<int16_t>(ring);
   ring_v_ = arena.Allocate<int16_t>(ring * channels);
-  ranges_ = arena.Allocate<int16_t>(static_cast<size_t>(ring_rows_) * layers * 2);
-  prefix_ = arena.Allocate<uint32_t>(window * planes * pitch_);
-  active_ = arena.Allocate<uint8_t>(window);
-  acc_ = arena.Allocate<int64_t>(planes * width);
+  tile_shift_ = 6;
+  while ((width + (1 << tile_shift_) - 1) >> tile_shift_ > 64) ++tile_shift_;
+  tiles_ = arena.Allocate<uint64_t>(static_cast<size_t>(ring_rows_) * layers);
+  prefix_ = arena.Allocate<uint32_t>(static_cast<size_t>(window_rows_) * planes * pitch_);
+  active_ = arena.Allocate<uint8_t>(static_cast<size_t>(window_rows_));
+  box_ = arena.Allocate<int32_t>(planes * pitch_);
+  acc_ = arena.Allocate<int64_t>(planes * pitch_);
+  layer_ = arena.Allocate<int32_t>(static_cast<size_t>(low_rows_) * planes * pitch_);
+  full_ = arena.Allocate<int32_t>(planes * pitch_);
   out_ = arena.Allocate<int32_t>(static_cast<size_t>(strip_rows) * planes * width);
-  kernels_ = arena.Allocate<KernelRow>(static_cast<size_t>(radii) * (2 * max_half + 1));
-  halves_ = arena.Allocate<int32_t>(static_cast<size_t>(radii));
-  reciprocal_ = arena.Allocate<uint64_t>(static_cast<size_t>(radii));
+  kernels_ = arena.Allocate<KernelRow>(static_cast<size_t>(radii) * kernel_rows_);
 }
 
-void LayerPlane::SetKernel(int32_t i, const ApertureShape& shape, float radius_px) {
-  int32_t half = KernelHalf(radius_px);
-  half = half > max_half_ ? max_half_ : half;
-  halves_[i] = half;
-  const uint32_t total = BuildKernel(shape, radius_px, half, kernels_ + i * (2 * max_half_ + 1));
-  reciprocal_[i] = (uint64_t{1} << 40) / total;
+void LayerPlane::Begin(const ApertureShape& shape, int32_t shift) {
+  for (int32_t i = 0; i < radii_; ++i) {
+    const float r = radius_[i] / static_cast<float>(1 << level_[i]);
+    const uint32_t total = BuildKernel(shape, r, half_[i], kernels_ + i * kernel_rows_);
+    reciprocal_[i] = (uint64_t{1} << 40) / total;
+  }
+  shift_ = shift;
+  next_row_ = 0;
 }
 
 void LayerPlane::CommitRow(int32_t y, const uint16_t* layer_of, int32_t offset) {
-  int16_t* range = ranges_ + Slot(y) * layers_ * 2;
-  for (int32_t k = 0; k < layers_; ++k) range[2 * k] = INT16_MAX, range[2 * k + 1] = -1;
+  uint64_t* tiles = tiles_ + Slot(y) * layers_;
+  for (int32_t k = 0; k < layers_; ++k) tiles[k] = 0;
   const int16_t* s = RadiusRow(y);
   for (int32_t x = 0; x < width_; ++x) {
     const uint16_t e = layer_of[s[x] + offset];
-    const int32_t k = e >> 8;
-    int16_t* r = range + 2 * k;
-    if (r[0] > x) r[0] = static_cast<int16_t>(x);
-    r[1] = static_cast<int16_t>(x);
-    if (e & 255) {
-      if (r[2] > x) r[2] = static_cast<int16_t>(x);
-      r[3] = static_cast<int16_t>(x);
-    }
+    const uint64_t bit = uint64_t{1} << (x >> tile_shift_);
+    tiles[e >> 8] |= bit;
+    if (e & 255) tiles[(e >> 8) + 1] |= bit;
   }
   next_row_ = y + 1;
 }
 
-void LayerPlane::RenderLayer(int32_t k, int32_t y0, int32_t n, const uint16_t* layer_of,
-                             int32_t offset, int32_t ri) {
-  const int32_t h = halves_[ri];
-  const KernelRow* kernel = kernels_ + ri * (2 * max_half_ + 1);
-  const int32_t jlo = Max(0, y0 - h), jhi = Min(height_, y0 + n + h);
-  int32_t lo = width_, hi = -1;
-  for (int32_t j = jlo; j < jhi; ++j) {
-    const int16_t* r = ranges_ + (Slot(j) * layers_ + k) * 2;
-    lo = Min(lo, r[0]);
-    hi = Max(hi, r[1]);
-  }
-  if (hi < lo) return;  // no pixel of this layer reaches the strip
-  const int32_t out_lo = Max(0, lo - h), out_hi = Min(width_ - 1, hi + h);
-  const int32_t p_lo = out_lo - h, p_hi = out_hi + h + 2;
+uint64_t LayerPlane::Tiles(int32_t k, int32_t y0, int32_t y1) const {
+  uint64_t t = 0;
+  for (int32_t j = Max(0, y0); j < Min(height_, y1); ++j) t |= tiles_[Slot(j) * layers_ + k];
+  return t;
+}
+
+void LayerPlane::BuildPrefix(int32_t k, int32_t level, int32_t h, int32_t jlo, int32_t jhi,
+                             int32_t x0, int32_t x1, uint64_t run, int32_t base,
+                             const uint16_t* layer_of, int32_t offset) {
   const int32_t planes = channels_ + 1;
-  const int32_t base = y0 - max_half_;  // window row 0
-  const int32_t pad = max_half_ + 1;
-
-  // Row prefix sums of the layer's premultiplied values and of its weight (alpha).
-  for (int32_t j = jlo; j < jhi; ++j) {
-    const int16_t* r = ranges_ + (Slot(j) * layers_ + k) * 2;
-    uint8_t& active = active_[j - base];
-    active = r[1] >= r[0];
+  const int32_t pad = pitch_ - width_ - (pitch_ - width_) / 2;  // room for indices below 0
+  const int32_t q0 = x0 >> level, q1 = x1 >> level;             // the run's columns at this level
+  for (int32_t m = jlo; m < jhi; ++m) {
+    uint8_t& active = active_[m - base];
+    active = (Tiles(k, m << level, (m + 1) << level) & run) != 0;
     if (!active) continue;
-    const int32_t rlo = r[0], rhi = r[1];
-    const int16_t* s = RadiusRow(j);
     uint32_t* p[kMaxChannels + 1];
-    const int16_t* v[kMaxChannels];
     for (int32_t c = 0; c < planes; ++c) {
-      p[c] = prefix_ + ((j - base) * planes + c) * static_cast<ptrdiff_t>(pitch_) + pad;
-      if (c < channels_) v[c] = ValueRow(j, c);
+      p[c] = prefix_ + ((m - base) * planes + c) * static_cast<ptrdiff_t>(pitch_) + pad;
+      for (int32_t x = q0 - h; x <= q0; ++x) p[c][x] = 0;
     }
-    for (int32_t c = 0; c < planes; ++c) {
-      for (int32_t i = p_lo; i <= rlo; ++i) p[c][i] = 0;
-    }
-    for (int32_t x = rlo; x <= rhi; ++x) {
-      const uint16_t e = layer_of[s[x] + offset];
-      const int32_t first = e >> 8, frac = e & 255;
-      const int32_t a = first == k ? 256 - frac : (first + 1 == k ? frac : 0);
-      for (int32_t c = 0; c < channels_; ++c) {
-        p[c][x + 1] = p[c][x] + static_cast<uint32_t>((v[c][x] * a) >> shift_);
+    if (level == 0) {
+      const int16_t* s = RadiusRow(m);
+      const int16_t* v[kMaxChannels];
+      for (int32_t c = 0; c < channels_; ++c) v[c] = ValueRow(m, c);
+      for (int32_t x = x0; x <= x1; ++x) {
+        const uint16_t e = layer_of[s[x] + offset];
+        const int32_t first = e >> 8, frac = e & 255;
+        const int32_t a = first == k ? 256 - frac : (first + 1 == k ? frac : 0);
+        for (int32_t c = 0; c < channels_; ++c) {
+          p[c][x + 1] = p[c][x] + static_cast<uint32_t>((v[c][x] * a) >> shift_);
+        }
+        p[channels_][x + 1] = p[channels_][x] + static_cast<uint32_t>(a);
       }
-      p[channels_][x + 1] = p[channels_][x] + static_cast<uint32_t>(a);
+    } else {
+      // Box means over 2^level x 2^level pixels of the layer's values and weights.
+      for (int32_t c = 0; c < planes; ++c) {
+        int32_t* box = box_ + c * static_cast<ptrdiff_t>(pitch_);
+        for (int32_t i = q0; i <= q1; ++i) box[i] = 0;
+      }
+      const int32_t end = Min(height_, (m + 1) << level);
+      for (int32_t j = m << level; j < end; ++j) {
+        if (!(tiles_[Slot(j) * layers_ + k] & run)) continue;
+        const int16_t* s = RadiusRow(j);
+        for (int32_t x = x0; x <= x1; ++x) {
+          const uint16_t e = layer_of[s[x] + offset];
+          const int32_t first = e >> 8, frac = e & 255;
+          const int32_t a = first == k ? 256 - frac : (first + 1 == k ? frac : 0);
+          if (a == 0) continue;
+          for (int32_t c = 0; c < channels_; ++c) {
+            box_[c * static_cast<ptrdiff_t>(pitch_) + (x >> level)] +=
+                (ValueRow(j, c)[x] * a) >> shift_;
+          }
+          box_[channels_ * static_cast<ptrdiff_t>(pitch_) + (x >> level)] += a;
+        }
+      }
+      const int32_t round = 1 << (2 * level - 1);
+      for (int32_t c = 0; c < planes; ++c) {
+        const int32_t* box = box_ + c * static_cast<ptrdiff_t>(pitch_);
+        for (int32_t i = q0; i <= q1; ++i) {
+          p[c][i + 1] = p[c][i] + static_cast<uint32_t>((box[i] + round) >> (2 * level));
+        }
+      }
     }
+    // Beyond the run the prefix stays flat: the kernel reads up to `h` + 1 columns outside.
     for (int32_t c = 0; c < planes; ++c) {
-      const uint32_t last = p[c][rhi + 1];
-      for (int32_t i = rhi + 2; i <= p_hi; ++i) p[c][i] = last;
+      for (int32_t x = q1 + 2; x <= q1 + h + 1; ++x) p[c][x] = p[c][q1 + 1];
     }
   }
+}
 
-  // Gather each output row, normalise the layer to Q16 and lay it over what is behind.
-  const uint64_t rec = reciprocal_[ri];
-  for (int32_t y = y0; y < y0 + n; ++y) {
+void LayerPlane::GatherNormalise(int32_t kernel, int32_t m, int32_t jlo, int32_t jhi, int32_t base,
+                                 int32_t x0, int32_t x1, int32_t* layer, ptrdiff_t stride) {
+  const int32_t planes = channels_ + 1;
+  const int32_t pad = pitch_ - width_ - (pitch_ - width_) / 2;
+  const int32_t h = half_[kernel];
+  const KernelRow* rows = kernels_ + kernel * kernel_rows_;
+  for (int32_t c = 0; c < planes; ++c) {
+    int64_t* acc = acc_ + c * static_cast<ptrdiff_t>(pitch_);
+    for (int32_t x = x0; x <= x1; ++x) acc[x] = 0;
+  }
+  for (int32_t dy = -h; dy <= h; ++dy) {
+    const int32_t j = m + dy;
+    if (j < jlo || j >= jhi || !active_[j - base]) continue;
+    const KernelRow& kr = rows[dy + h];
+    if (kr.w == 0 && kr.wl == 0 && kr.wr == 0) continue;
     for (int32_t c = 0; c < planes; ++c) {
-      int64_t* acc = acc_ + c * static_cast<ptrdiff_t>(width_);
-      for (int32_t x = out_lo; x <= out_hi; ++x) acc[x] = 0;
+      const uint32_t* p =
+          prefix_ + ((j - base) * planes + c) * static_cast<ptrdiff_t>(pitch_) + pad;
+      GatherRow(p, kr, acc_ + c * static_cast<ptrdiff_t>(pitch_), x0, x1);
     }
-    for (int32_t dy = -h; dy <= h; ++dy) {
-      const int32_t j = y + dy;
-      if (j < jlo || j >= jhi || !active_[j - base]) continue;
-      const KernelRow& kr = kernel[dy + h];
-      if (kr.w == 0 && kr.wl == 0 && kr.wr == 0) continue;
-      for (int32_t c = 0; c < planes; ++c) {
-        const uint32_t* p =
-            prefix_ + ((j - base) * planes + c) * static_cast<ptrdiff_t>(pitch_) + pad;
-        GatherRow(p, kr, acc_ + c * static_cast<ptrdiff_t>(width_), out_lo, out_hi);
+  }
+  // alpha = acc / (total * 256) in Q16 (rec = 2^40 / total); colour likewise, undoing the shift.
+  const uint64_t rec = reciprocal_[kernel];
+  const int64_t* acc_a = acc_ + channels_ * static_cast<ptrdiff_t>(pitch_);
+  int32_t* alpha = layer + channels_ * stride;
+  for (int32_t x = x0; x <= x1; ++x) {
+    const uint64_t a = (static_cast<uint64_t>(acc_a[x]) * rec) >> 32;
+    alpha[x] = static_cast<int32_t>(a > 65536 ? 65536 : a);
+  }
+  for (int32_t c = 0; c < channels_; ++c) {
+    const int64_t* acc = acc_ + c * static_cast<ptrdiff_t>(pitch_);
+    int32_t* colour = layer + c * stride;
+    for (int32_t x = x0; x <= x1; ++x) {
+      colour[x] = static_cast<int32_t>((acc[x] * static_cast<int64_t>(rec)) >> (32 - shift_));
+    }
+  }
+}
+
+void LayerPlane::Composite(const int32_t* layer, ptrdiff_t stride, int32_t x0, int32_t x1,
+                           int32_t* out) {
+  const int32_t* alpha = layer + channels_ * stride;
+  int32_t* out_a = out + channels_ * static_cast<ptrdiff_t>(width_);
+  for (int32_t c = 0; c < channels_; ++c) {
+    const int32_t* colour = layer + c * stride;
+    int32_t* o = out + c * static_cast<ptrdiff_t>(width_);
+    for (int32_t x = x0; x <= x1; ++x) {
+      const int64_t keep = 65536 - alpha[x];
+      o[x] = static_cast<int32_t>(((o[x] * keep + 32768) >> 16) + colour[x]);
+    }
+  }
+  for (int32_t x = x0; x <= x1; ++x) {
+    const int64_t keep = 65536 - alpha[x];
+    out_a[x] = static_cast<int32_t>(((out_a[x] * keep + 32768) >> 16) + alpha[x]);
+  }
+}
+
+void LayerPlane::RenderLayer(int32_t k, int32_t y0, int32_t n, const uint16_t* layer_of,
+                             int32_t offset, int32_t i) {
+  const int32_t level = level_[i];
+  const int32_t reach = level == 0 ? half_[i] : (half_[i] + 2) << level;
+  uint64_t tiles = Tiles(k, y0 - reach, y0 + n + reach);
+  if (!tiles) return;  // no pixel of this layer reaches the strip
+  // Grow by the reach: a run of grown tiles holds every source pixel its outputs depend on.
+  const int32_t count = (width_ + (1 << tile_shift_) - 1) >> tile_shift_;
+  const uint64_t all = count == 64 ? ~uint64_t{0} : (uint64_t{1} << count) - 1;
+  for (int32_t d = 0; d < ((reach + (1 << tile_shift_) - 1) >> tile_shift_); ++d) {
+    tiles |= (tiles << 1) | (tiles >> 1);
+  }
+  tiles &= all;
+  for (int32_t t = 0; t < count;) {
+    if (!((tiles >> t) & 1)) {
+      ++t;
+      continue;
+    }
+    int32_t e = t;
+    while (e + 1 < count && ((tiles >> (e + 1)) & 1)) ++e;
+    const uint64_t run = (e - t + 1 == 64) ? ~uint64_t{0} : ((uint64_t{1} << (e - t + 1)) - 1) << t;
+    RenderRun(k, y0, n, layer_of, offset, i, t << tile_shift_,
+              Min(width_, (e + 1) << tile_shift_) - 1, run);
+    t = e + 1;
+  }
+}
+
+void LayerPlane::RenderRun(int32_t k, int32_t y0, int32_t n, const uint16_t* layer_of,
+                           int32_t offset, int32_t i, int32_t x0, int32_t x1, uint64_t run) {
+  const int32_t level = level_[i], h = half_[i];
+  const int32_t planes = channels_ + 1;
+  const ptrdiff_t row_stride = planes * static_cast<ptrdiff_t>(width_);
+  if (level == 0) {
+    const int32_t jlo = Max(0, y0 - h), jhi = Min(height_, y0 + n + h);
+    const int32_t base = y0 - h;
+    BuildPrefix(k, 0, h, jlo, jhi, x0, x1, run, base, layer_of, offset);
+    for (int32_t y = y0; y < y0 + n; ++y) {
+      GatherNormalise(i, y, jlo, jhi, base, x0, x1, layer_, pitch_);
+      Composite(layer_, pitch_, x0, x1, out_ + (y - y0) * row_stride);
+    }
+    return;
+  }
+  // Reduced level: low-res row m covers plane rows [m f, m f + f); plane row y samples the
+  // low-res image at (2y + 1 - f) / 2f, Q8.
+  const int32_t f = 1 << level;
+  const int32_t low_h = (height_ + f - 1) >> level;
+  auto coord_q8 = [level, f](int32_t v) { return ((2 * v + 1 - f) * 128) >> level; };
+  const int32_t m_first = Max(0, coord_q8(y0) >> 8);
+  const int32_t m_last = Min(low_h - 1, (coord_q8(y0 + n - 1) >> 8) + 1);
+  const int32_t jlo = Max(0, m_first - h), jhi = Min(low_h, m_last + 1 + h);
+  const int32_t base = m_first - h;
+  const int32_t q_lo = x0 >> level, q_hi = x1 >> level;
+  BuildPrefix(k, level, h, jlo, jhi, x0, x1, run, base, layer_of, offset);
+  const ptrdiff_t low_stride = planes * static_cast<ptrdiff_t>(pitch_);
+  for (int32_t m = m_first; m <= m_last; ++m) {
+    GatherNormalise(i, m, jlo, jhi, base, q_lo, q_hi, layer_ + (m - m_first) * low_stride, pitch_);
+  }
+  for (int32_t y = y0; y < y0 + n; ++y) {
+    const int32_t uy = coord_q8(y);
+    const int32_t ma = Clamp(uy >> 8, m_first, m_last), mb = Clamp((uy >> 8) + 1, m_first, m_last);
+    const int64_t fy = uy & 255;
+    const int32_t* ra = layer_ + (ma - m_first) * low_stride;
+    const int32_t* rb = layer_ + (mb - m_first) * low_stride;
+    for (int32_t c = 0; c < planes; ++c) {
+      const int32_t* a = ra + c * static_cast<ptrdiff_t>(pitch_);
+      const int32_t* b = rb + c * static_cast<ptrdiff_t>(pitch_);
+      int32_t* dst = full_ + c * static_cast<ptrdiff_t>(pitch_);
+      for (int32_t x = x0; x <= x1; ++x) {
+        const int32_t ux = coord_q8(x);
+        const int32_t ta = Clamp(ux >> 8, q_lo, q_hi), tb = Clamp((ux >> 8) + 1, q_lo, q_hi);
+        const int64_t fx = ux & 255;
+        const int64_t top = a[ta] * (256 - fx) + a[tb] * fx;
+        const int64_t bottom = b[ta] * (256 - fx) + b[tb] * fx;
+        dst[x] = static_cast<int32_t>((top * (256 - fy) + bottom * fy + 32768) >> 16);
       }
     }
-    int32_t* out = out_ + (y - y0) * planes * static_cast<ptrdiff_t>(width_);
-    const int64_t* acc_a = acc_ + channels_ * static_cast<ptrdiff_t>(width_);
-    int32_t* out_a = out + channels_ * static_cast<ptrdiff_t>(width_);
-    for (int32_t x = out_lo; x <= out_hi; ++x) {
-      // alpha = acc / (total * 256) in Q16; acc <= total * 256, rec = 2^40 / total.
-      int64_t alpha = static_cast<int64_t>((static_cast<uint64_t>(acc_a[x]) * rec) >> 32);
-      alpha = alpha > 65536 ? 65536 : alpha;
-      const int64_t keep = 65536 - alpha;
-      for (int32_t c = 0; c < channels_; ++c) {
-        const int64_t* acc = acc_ + c * static_cast<ptrdiff_t>(width_);
-        int32_t* o = out + c * static_cast<ptrdiff_t>(width_);
-        const int64_t colour = (acc[x] * static_cast<int64_t>(rec)) >> (32 - shift_);
-        o[x] = static_cast<int32_t>(((o[x] * keep + 32768) >> 16) + colour);
-      }
-      out_a[x] = static_cast<int32_t>(((out_a[x] * keep + 32768) >> 16) + alpha);
-    }
+    Composite(full_, pitch_, x0, x1, out_ + (y - y0) * row_stride);
   }
 }
 

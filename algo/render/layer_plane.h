@@ -7,8 +7,14 @@
 // over the background; a sharp foreground stays in its own layer and does not bleed; and the
 // background's hole behind an object is renormalised from its visible pixels instead of glowing.
 //
-// Memory: a ring of rows (signed radius and boosted colour per pixel) sized strip + 2 * largest
-// kernel half, and one layer's row prefix sums for one strip's window; nothing at full size.
+// Speed: a kernel row is a span read from row prefix sums (cost per pixel ~ kernel height), and
+// a layer whose radius exceeds kLevelRadius is blurred at 1/2, 1/4 .. resolution (box-averaged
+// colour and coverage, kernel scaled down, result upsampled bilinearly): a large blur has no fine
+// detail to lose, and its cost per output pixel stays about constant. Layers that have no pixel
+// near a strip are skipped, and so are the column tiles (64 px or more) a layer does not reach.
+//
+// Memory: a ring of rows (signed radius and boosted colour per pixel) sized strip + 2 * the
+// largest reach, one layer's prefix sums for one strip's window, and strip-sized accumulators.
 // Fixed point: colour value v (int16, Y * gain or (C - 128) * gain), layer weight a (Q8);
 // prefix of c = (v * a) >> shift in uint32 (wrapping, only differences are used, each below
 // 2^31); a kernel row's term w * span in int32 (shift chosen so it cannot overflow); the
@@ -27,15 +33,27 @@ namespace lb {
 class LayerPlane {
  public:
   static constexpr int32_t kMaxChannels = 2;
+  static constexpr int32_t kMaxKernels = 40;
+  static constexpr int32_t kMaxLevel = 4;
+  // Largest radius (px of the level it runs at) blurred at a level; above, the next level.
+  static constexpr float kLevelRadius = 8.0f;
 
-  // `sub` is 1 for luma, 2 for chroma; `layers` the number of depth layers; `radii` the number of
-  // distinct kernel radii; `max_half` the largest kernel half at this plane's scale.
+  // `sub` is 1 for luma, 2 for chroma (radii are given in luma px, Q4); `layers` the number of
+  // depth layers; kernels[i] has radius radii_q4[i] / 16 / sub.
+  // `extra_rows` of ring are kept for a caller that reads ahead (the chroma of the next strip).
   void Carve(Arena& arena, int32_t width, int32_t height, int32_t channels, int32_t strip_rows,
-             int32_t max_half, int32_t layers, int32_t radii);
+             int32_t sub, const int32_t* radii_q4, int32_t radii, int32_t layers,
+             int32_t extra_rows);
+  // Rows beyond a strip (above or below) that rendering it reads, for a configuration.
+  static int32_t Reach(int32_t sub, const int32_t* radii_q4, int32_t radii);
 
-  // Begin-time: kernel i blurs by radius_px[i] (this plane's px); `shift` scales c (see above).
-  void SetKernel(int32_t i, const ApertureShape& shape, float radius_px);
-  void Begin(int32_t shift) { shift_ = shift, next_row_ = 0; }
+  // Rows beyond a strip (above or below) that rendering it reads, in this plane's rows.
+  int32_t reach() const { return reach_; }
+  // Largest kernel half, at the level the kernel runs at.
+  int32_t max_half() const { return (kernel_rows_ - 1) / 2; }
+
+  // Begin-time: builds the kernels for this aperture; `shift` scales c (see above).
+  void Begin(const ApertureShape& shape, int32_t shift);
 
   // The ring row for plane row y, to be filled by the caller: signed radius Q4 and values.
   int16_t* RadiusRow(int32_t y) { return ring_s_ + Slot(y) * static_cast<ptrdiff_t>(width_); }
@@ -49,27 +67,48 @@ class LayerPlane {
   int32_t ring_rows() const { return ring_rows_; }
 
   // Renders plane rows [y0, y0 + n) of every layer (back to front), `radius_of_layer[k]` being
-  // the kernel index of layer k; writes 8-bit results (value + bias) into `dst`.
+  // the kernel index of layer k; writes 8-bit results (value + bias) into dst[0 .. channels).
   void RenderStrip(int32_t y0, int32_t n, const uint16_t* layer_of, int32_t offset,
                    const int32_t* radius_of_layer, int32_t bias, ImageU8* dst);
 
  private:
   int32_t Slot(int32_t y) const { return y % ring_rows_; }
   void RenderLayer(int32_t k, int32_t y0, int32_t n, const uint16_t* layer_of, int32_t offset,
-                   int32_t radius_index);
+                   int32_t kernel);
+  // Builds the prefix rows of layer k at `level` for low-res rows [jlo, jhi) from the plane's
+  // columns [x0, x1] (a run of tiles): values outside the run are zero.
+  void BuildPrefix(int32_t k, int32_t level, int32_t half, int32_t jlo, int32_t jhi, int32_t x0,
+                   int32_t x1, uint64_t run, int32_t window_base, const uint16_t* layer_of,
+                   int32_t offset);
+  void RenderRun(int32_t k, int32_t y0, int32_t n, const uint16_t* layer_of, int32_t offset,
+                 int32_t kernel, int32_t x0, int32_t x1, uint64_t run);
+  // Tiles of layer k in plane rows [y0, y1).
+  uint64_t Tiles(int32_t k, int32_t y0, int32_t y1) const;
+  // Gathers low-res row m of the layer into layer_ (normalised Q16) over columns [x0, x1].
+  void GatherNormalise(int32_t kernel, int32_t m, int32_t jlo, int32_t jhi, int32_t window_base,
+                       int32_t x0, int32_t x1, int32_t* layer, ptrdiff_t layer_stride);
+  void Composite(const int32_t* layer, ptrdiff_t layer_stride, int32_t x0, int32_t x1,
+                 int32_t* out);
 
-  int32_t width_ = 0, height_ = 0, channels_ = 1, strip_rows_ = 0, max_half_ = 0;
+  int32_t width_ = 0, height_ = 0, channels_ = 1, strip_rows_ = 0, sub_ = 1;
   int32_t layers_ = 0, radii_ = 0, ring_rows_ = 0, pitch_ = 0, shift_ = 0, next_row_ = 0;
-  int16_t* ring_s_ = nullptr;       // ring_rows x width: signed radius, Q4 full-resolution px
-  int16_t* ring_v_ = nullptr;       // ring_rows x channels x width
-  int16_t* ranges_ = nullptr;       // ring_rows x layers x 2: first and last column of the layer
-  uint32_t* prefix_ = nullptr;      // (strip_rows + 2 max_half) x (channels + 1) x pitch
-  uint8_t* active_ = nullptr;       // per window row: the layer has pixels there
-  int64_t* acc_ = nullptr;          // (channels + 1) x width
-  int32_t* out_ = nullptr;          // strip_rows x (channels + 1) x width, premultiplied Q16
-  KernelRow* kernels_ = nullptr;    // radii x (2 max_half + 1)
-  int32_t* halves_ = nullptr;       // per kernel
-  uint64_t* reciprocal_ = nullptr;  // per kernel: 2^40 / total weight
+  int32_t reach_ = 0, kernel_rows_ = 0, window_rows_ = 0, low_rows_ = 0;
+  float radius_[kMaxKernels] = {};  // this plane's px
+  int32_t level_[kMaxKernels] = {};
+  int32_t half_[kMaxKernels] = {};         // at the kernel's level
+  uint64_t reciprocal_[kMaxKernels] = {};  // 2^40 / total kernel weight
+  int16_t* ring_s_ = nullptr;     // ring_rows x width: signed radius, Q4 full-resolution px
+  int16_t* ring_v_ = nullptr;     // ring_rows x channels x width
+  uint64_t* tiles_ = nullptr;     // ring_rows x layers: bit t = the layer has a pixel in tile t
+  int32_t tile_shift_ = 6;        // tiles of 2^tile_shift columns, at most 64 of them
+  uint32_t* prefix_ = nullptr;    // window_rows x (channels + 1) x pitch
+  uint8_t* active_ = nullptr;     // per window row: the layer has pixels there
+  int32_t* box_ = nullptr;        // (channels + 1) x pitch: one low-res row's box sums
+  int64_t* acc_ = nullptr;        // (channels + 1) x pitch
+  int32_t* layer_ = nullptr;      // low_rows x (channels + 1) x pitch: normalised layer, Q16
+  int32_t* full_ = nullptr;       // (channels + 1) x pitch: one upsampled row of a layer, Q16
+  int32_t* out_ = nullptr;        // strip_rows x (channels + 1) x width, premultiplied Q16
+  KernelRow* kernels_ = nullptr;  // radii x kernel_rows
 };
 
 }  // namespace lb

@@ -92,10 +92,11 @@ Status RenderStage::Carve(Arena& arena) {
   strip_.planes[0] = arena.AllocateImage<uint8_t>(c.width, RenderConfig::kStripRows);
   strip_.planes[1] = arena.AllocateImage<uint8_t>(cw, RenderConfig::kStripRows / 2);
   strip_.planes[2] = arena.AllocateImage<uint8_t>(cw, RenderConfig::kStripRows / 2);
-  radii_ = LayerRadiiQ4(c.max_radius, nullptr);
+  int32_t radii_q4[kMaxRadii];
+  radii_ = LayerRadiiQ4(c.max_radius, radii_q4);
   layers_ = 2 * radii_ - 1;
-  luma_half_ = KernelHalf(static_cast<float>(c.max_radius));
-  chroma_half_ = KernelHalf(static_cast<float>(c.max_radius) * 0.5f);
+  luma_reach_ = LayerPlane::Reach(1, radii_q4, radii_);
+  chroma_reach_ = LayerPlane::Reach(2, radii_q4, radii_);
   radii_q4_ = arena.Allocate<int32_t>(static_cast<size_t>(radii_));
   radius_of_layer_ = arena.Allocate<int32_t>(static_cast<size_t>(layers_));
   layer_of_ = arena.Allocate<uint16_t>(static_cast<size_t>(c.max_radius) * 32 + 1);
@@ -103,8 +104,11 @@ Status RenderStage::Carve(Arena& arena) {
   boost_q8_ = arena.Allocate<uint16_t>(256);
   histogram_ = arena.Allocate<uint32_t>(256);
   upsampler_.Carve(arena, c.width, c.height, c.working_scale, c.working_width, c.working_height);
-  luma_.Carve(arena, c.width, c.height, 1, RenderConfig::kStripRows, luma_half_, layers_, radii_);
-  chroma_.Carve(arena, cw, ch, 2, RenderConfig::kStripRows / 2, chroma_half_, layers_, radii_);
+  // The luma ring also serves the chroma rows that the next chroma strip reads ahead.
+  const int32_t look_ahead = Max(0, 2 * chroma_reach_ - luma_reach_) + 2;
+  luma_.Carve(arena, c.width, c.height, 1, RenderConfig::kStripRows, 1, radii_q4, radii_, layers_,
+              look_ahead);
+  chroma_.Carve(arena, cw, ch, 2, RenderConfig::kStripRows / 2, 2, radii_q4, radii_, layers_, 0);
   if (arena.overflowed()) {
     return Status(Code::kOutOfMemory, "render: arena of %zu bytes is too small (%zu needed)",
                   arena.size(), arena.used());
@@ -169,11 +173,6 @@ Status RenderStage::Begin(const ConstPlanarU8& ref, ConstImageU16 disp_q8,
   lens_.Set(params.f_number, config_.working_scale, config_.max_radius, focus);
 
   const ApertureShape shape(params.aperture);
-  for (int32_t i = 0; i < radii_; ++i) {
-    const float radius = static_cast<float>(radii_q4_[i]) / 16.0f;
-    luma_.SetKernel(i, shape, radius);
-    chroma_.SetKernel(i, shape, radius * 0.5f);
-  }
   // Highlight gain ramps from 1 at the threshold to the full gain at 255.
   const int32_t threshold = params.highlight_threshold;
   for (int32_t y = 0; y < 256; ++y) {
@@ -188,8 +187,8 @@ Status RenderStage::Begin(const ConstPlanarU8& ref, ConstImageU16 disp_q8,
     max_luma = Max(max_luma, (y * boost_q8_[y] + 128) >> 8);
     max_gain = Max(max_gain, boost_q8_[y]);
   }
-  luma_.Begin(ShiftFor(max_luma, luma_half_));
-  chroma_.Begin(ShiftFor((128 * max_gain + 128) >> 8, chroma_half_));
+  luma_.Begin(shape, ShiftFor(max_luma, luma_.max_half()));
+  chroma_.Begin(shape, ShiftFor((128 * max_gain + 128) >> 8, chroma_.max_half()));
   upsampler_.Begin(ref, disp_q8);
   begun_ = true;
   return Status::Ok();
@@ -241,8 +240,8 @@ Status RenderStage::NextStrip(ConstPlanarU8* strip, int32_t* y0, int32_t* rows) 
     return Status::Ok();
   }
   const int32_t cy0 = *y0 / 2, cn = (*rows + 1) / 2;
-  const int32_t chroma_end = Min(ch, cy0 + cn + chroma_half_);
-  const int32_t luma_end = Min(h, Max(*y0 + *rows + luma_half_, 2 * chroma_end));
+  const int32_t chroma_end = Min(ch, cy0 + cn + chroma_reach_);
+  const int32_t luma_end = Min(h, Max(*y0 + *rows + luma_reach_, 2 * chroma_end));
   while (luma_.next_row() < luma_end) FillLumaRow(luma_.next_row());
   while (chroma_.next_row() < chroma_end) FillChromaRow(chroma_.next_row());
   const int32_t offset = config_.max_radius * 16;

@@ -102,7 +102,7 @@ class RenderStage {
   DepthUpsampler upsampler_;
   LayerPlane luma_, chroma_;
   int32_t radii_ = 0, layers_ = 0;
-  int32_t luma_half_ = 0, chroma_half_ = 0;
+  int32_t luma_reach_ = 0, chroma_reach_ = 0;
   int32_t* radii_q4_ = nullptr;         // radii_
   int32_t* radius_of_layer_ = nullptr;  // layers_: kernel index of each layer, far to near
   uint16_t* layer_of_ = nullptr;        // [signed radius Q4 + max_radius * 16]: layer << 8 | frac
