@@ -147,13 +147,19 @@ class Scene {
   struct RowMap {
     int64_t nx, ny, den, rho;
   };
+  // One row of one view: every object's state, and the objects whose bounds reach the row, in
+  // test order.
+  struct RowState {
+    RowMap obj[kMaxObjects];
+    int32_t active[kMaxObjects];
+    int32_t active_count;
+  };
 
   void BuildLayout(const SceneParams& params);
   void BuildFixedPoint();
   Status BuildView(int32_t view);
-  void PrepareRow(const ViewMap* maps, int32_t y2, RowMap* rows) const;
-  int32_t Winner(const ViewMap* maps, const RowMap* rows, int32_t x2, int32_t y2,
-                 int64_t* rho_q40) const;
+  void PrepareRow(const ViewMap* maps, int32_t y2, RowState* row) const;
+  int32_t Winner(const ViewMap* maps, const RowState& row, int32_t x2, int64_t* rho_q40) const;
   void RefPoint(const ViewMap& m, const RowMap& r, int32_t x2, int64_t* xr_q16,
                 int64_t* yr_q16) const;
   bool Inside(const Object& o, int64_t xr_q16, int64_t yr_q16) const;
@@ -178,7 +184,7 @@ class Scene {
   // Fixed-point resolution constants.
   int64_t half_w_q16_ = 0, half_h_q16_ = 0;
   int64_t design_per_px_q24_ = 0;  // design px per pixel, Q24
-  int64_t ground_fh_ = 0;          // focal * camera height in px * cm, Q24
+  int64_t ground_fh_q8_ = 0;       // focal * camera height in px * cm, Q8
   int64_t ground_h_q8_ = 0;        // camera height in cm, Q8
   int64_t ground_vmin_q16_ = 0;    // smallest row offset below the centre the ground texture uses
   int64_t disp_per_rho_q16_ = 0;   // full-resolution px per view step per (1/m), Q16

@@ -101,7 +101,7 @@ TEST(SceneTest, BytesMatchTheGoldenOnEveryArchitecture) {
     disp_bytes.push_back(static_cast<uint8_t>(d >> 8));
   }
   const uint64_t got[3] = {Fnv(Render(rect, 0).rgb), Fnv(Render(hand, 4).rgb), Fnv(disp_bytes)};
-  const uint64_t want[3] = {6039463710478473635ull, 15855771406344765541ull,
+  const uint64_t want[3] = {12772850599364790446ull, 4224695231029635668ull,
                             9157636644924199465ull};
   for (int i = 0; i < 3; ++i) EXPECT_EQ(got[i], want[i]) << "hash " << i;
 }
@@ -131,13 +131,13 @@ TEST(SceneTest, StripsEqualWholeFrame) {
 // v. Checked on interior pixels that view v also sees (same object there); a wrong disparity
 // must match clearly worse, so the check has teeth.
 TEST(SceneTest, RectifiedDisparityMatchesTheViews) {
-  Scene scene = Make(960, 720, 5);
+  Scene scene = Make(800, 600, 5);
   const int32_t w = scene.width(), h = scene.height(), ref = scene.reference();
   ASSERT_EQ(ref, 2);
   const Frame rf = Render(scene, ref);
   const std::vector<uint16_t> disp = Disparity(scene);
   const std::vector<uint8_t> ref_ids = Objects(scene, ref);
-  for (int32_t v : {0, 1, 3, 4}) {
+  for (int32_t v : {0, 4}) {  // the largest baselines, on either side
     const Frame vf = Render(scene, v);
     const std::vector<uint8_t> ids = Objects(scene, v);
     double err = 0, err_wrong = 0;
@@ -162,7 +162,7 @@ TEST(SceneTest, RectifiedDisparityMatchesTheViews) {
         ++n;
       }
     }
-    ASSERT_GT(n, 20000) << "view " << v;
+    ASSERT_GT(n, 12000) << "view " << v;
     EXPECT_LT(err / n, 2.5) << "view " << v;
     // Texture edges (mortar, checker) are point-sampled, so a few pixels interpolate badly.
     EXPECT_LT(double(bad) / n, 0.04) << "view " << v;
@@ -176,7 +176,7 @@ TEST(SceneTest, HandheldPosesAndDepthMatchTheViews) {
   SceneParams params;
   params.motion = CameraMotion::kHandheld;
   params.seed = 11;
-  Scene scene = Make(960, 720, 5, params);
+  Scene scene = Make(800, 600, 3, params);
   const int32_t w = scene.width(), h = scene.height(), ref = scene.reference();
   const Intrinsics& k = scene.intrinsics();
   const Frame rf = Render(scene, ref);
@@ -229,9 +229,11 @@ TEST(SceneTest, HandheldPosesAndDepthMatchTheViews) {
       }
     }
     ASSERT_GT(n_par, 2000) << "view " << v;
-    EXPECT_GT(err_wrong / n_par, 2 * err_par / n_par) << "view " << v;
-    ASSERT_GT(n, 20000) << "view " << v;
-    EXPECT_LT(err / n, 2.5) << "view " << v;
+    EXPECT_LT(err_par / n_par, 1.5) << "view " << v;
+    EXPECT_GT(err_wrong / n_par, 4 * err_par / n_par) << "view " << v;
+    // The brick and tile lines are sharp, and interpolating them in 2-D costs a little more.
+    ASSERT_GT(n, 12000) << "view " << v;
+    EXPECT_LT(err / n, 3.0) << "view " << v;
   }
 }
 
@@ -383,7 +385,7 @@ TEST(SceneTest, TwelveMegapixelStrip) {
 }
 
 TEST(SceneTest, PointLightsNearlySaturate) {
-  Scene scene = Make(1280, 960, 5);
+  Scene scene = Make(960, 720, 5);
   const Frame f = Render(scene, 2);
   int64_t bright = 0;
   for (size_t p = 0; p < f.rgb.size(); p += 3)
