@@ -90,7 +90,8 @@ Status PngReader::Decode() {
 
   if (color == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png_);
   if (gray && depth < 8) png_set_expand_gray_1_2_4_to_8(png_);
-  if ((color & PNG_COLOR_MASK_ALPHA) != 0) png_set_strip_alpha(png_);
+  // Unconditional: palette expansion turns a tRNS chunk into an alpha channel too.
+  png_set_strip_alpha(png_);
   if (wide && HostIsLittleEndian()) png_set_swap(png_);
   const int passes = png_set_interlace_handling(png_);
   png_read_update_info(png_, info_);

@@ -38,8 +38,9 @@ void Pnm(const std::string& dir) {
   Save(dir, "gray_strips.pgm", lb::test::EncodePnm("P5", 3, 20, 255, Ramp(60, 255)));
 }
 
-Bytes Png(int width, int height, int color_type, int bit_depth, bool interlaced) {
-  lb::test::PngSpec spec{width, height, color_type, bit_depth, interlaced, {}, {}};
+Bytes Png(int width, int height, int color_type, int bit_depth, bool interlaced,
+          bool transparent = false) {
+  lb::test::PngSpec spec{width, height, color_type, bit_depth, interlaced, {}, {}, transparent};
   const int channels[] = {1, 0, 3, 1, 2, 0, 4};
   const size_t row_bytes =
       (static_cast<size_t>(width) * static_cast<size_t>(channels[color_type]) * bit_depth + 7) / 8;
@@ -63,6 +64,8 @@ void PngSeeds(const std::string& dir) {
   Save(dir, "gray1.png", Png(9, 2, PNG_COLOR_TYPE_GRAY, 1, false));
   Save(dir, "adam7_rgb8.png", Png(11, 9, PNG_COLOR_TYPE_RGB, 8, true));
   Save(dir, "adam7_palette4.png", Png(7, 7, PNG_COLOR_TYPE_PALETTE, 4, true));
+  Save(dir, "palette8_trns.png", Png(4, 4, PNG_COLOR_TYPE_PALETTE, 8, false, true));
+  Save(dir, "gray4_trns.png", Png(5, 3, PNG_COLOR_TYPE_GRAY, 4, false, true));
 }
 
 Bytes Jpeg(int width, int height, int components, bool progressive) {

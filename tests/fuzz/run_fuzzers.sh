@@ -15,10 +15,16 @@ case $seconds in '' | *[!0-9]*) usage ;; esac
 root=$(cd "$(dirname "$0")/../.." && pwd)
 build=$(realpath -m "${2:-$root/build/fuzz}")
 
+mkdir -p "$build"
+build_log=$build/fuzz-build.log
 if [ ! -f "$build/CMakeCache.txt" ]; then
-  (cd "$root" && cmake --preset fuzz -B "$build" >/dev/null) || { echo "fuzz: configure failed" >&2; exit 1; }
+  if ! (cd "$root" && cmake --preset fuzz -B "$build") >"$build_log" 2>&1; then
+    tail -n 20 "$build_log" >&2; echo "fuzz: configure failed" >&2; exit 1
+  fi
 fi
-cmake --build "$build" --target fuzzers >/dev/null || { echo "fuzz: build failed" >&2; exit 1; }
+if ! cmake --build "$build" --target fuzzers >"$build_log" 2>&1; then
+  grep -m 10 -E 'error|FAILED' "$build_log" >&2; echo "fuzz: build failed (log $build_log)" >&2; exit 1
+fi
 
 bin_dir=$build/tests/fuzz
 work=$build/fuzz-run

@@ -95,6 +95,27 @@ TEST(PngReader, StripsAlphaAndExpandsPaletteAndLowBitDepths) {
   EXPECT_EQ(pixels, (std::vector<uint8_t>{255, 0, 255, 0, 0, 255, 0, 255, 255}));
 }
 
+TEST(PngReader, IgnoresTransparencyChunks) {
+  ImageFileInfo info;
+  std::vector<uint8_t> pixels;
+  PngSpec palette{2, 1, PNG_COLOR_TYPE_PALETTE, 8, false, {9, 8, 7, 1, 2, 3}, {0, 1}, true};
+  Status s = Read(Encode(palette), &info, &pixels);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(info.format, PixelFormat::kRgb8);
+  EXPECT_EQ(pixels, (std::vector<uint8_t>{9, 8, 7, 1, 2, 3}));
+
+  PngSpec gray{2, 1, PNG_COLOR_TYPE_GRAY, 4, false, {}, {0x0f}, true};
+  s = Read(Encode(gray), &info, &pixels);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(pixels, (std::vector<uint8_t>{0, 255}));
+
+  PngSpec rgb{1, 1, PNG_COLOR_TYPE_RGB, 16, false, {}, {0, 0, 0, 0, 0, 0}, true};
+  s = Read(Encode(rgb), &info, &pixels);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(info.format, PixelFormat::kRgb16);
+  EXPECT_EQ(pixels, std::vector<uint8_t>(6, 0));
+}
+
 TEST(PngReader, BrokenCrcInIdatIsAnError) {
   Bytes bytes = Encode(Rgb8(8, 8, false));
   const long idat = test::FindPngChunk(bytes, "IDAT");

@@ -53,6 +53,15 @@ bool EncodePng(const PngSpec& spec, Bytes* out) {
     }
     png_set_PLTE(png, info, colors.data(), static_cast<int>(colors.size()));
   }
+  if (spec.transparent) {
+    const png_byte alpha[1] = {0};
+    png_color_16 value = {};
+    if (spec.color_type == PNG_COLOR_TYPE_PALETTE) {
+      png_set_tRNS(png, info, alpha, 1, nullptr);
+    } else {
+      png_set_tRNS(png, info, nullptr, 0, &value);
+    }
+  }
   png_write_info(png, info);
   const size_t row_bytes = png_get_rowbytes(png, info);
   std::vector<png_bytep> rows(spec.height);

@@ -25,6 +25,7 @@ struct PngSpec {
   std::vector<uint8_t> palette_rgb;  // for color type 3
   // Rows in PNG's own layout: packed low bit depths, 16-bit big-endian.
   Bytes rows;
+  bool transparent = false;  // a tRNS chunk: palette entry 0, or grey/colour value 0
 };
 // Returns false when libpng refuses the spec.
 bool EncodePng(const PngSpec& spec, Bytes* out);
