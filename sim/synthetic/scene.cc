@@ -640,9 +640,7 @@ Status Scene::DisparityRows(int32_t scale, int32_t y0, int32_t rows, uint16_t* o
     if (y2 != last_y2) PrepareRow(maps, last_y2 = y2, &row);
     int64_t rho;
     Winner(maps, row, x2, &rho);
-    // Q24 (1/m) x Q16 (px per 1/m) -> Q40, / scale, -> Q8.
-    const int64_t q40 = ((rho >> 16) * disp_per_rho_q16_) / scale;
-    out_q8[(y - y0) * stride + x] = fx::Saturate<uint16_t>(fx::RoundShift<int64_t>(q40, 32));
+    out_q8[(y - y0) * stride + x] = static_cast<uint16_t>(DispQ8(rho, scale));
   });
   return Status::Ok();
 }
@@ -680,14 +678,16 @@ Status Scene::ObjectRows(int32_t view, int32_t scale, int32_t y0, int32_t rows, 
   return Status::Ok();
 }
 
-int32_t Scene::disparity_min_q8(int32_t scale) const {
-  // The wall is the farthest visible surface; the same arithmetic as DisparityRows.
-  const int64_t rho = maps_[reference_][0].rho[2];
-  return static_cast<int32_t>(
-      fx::RoundShift<int64_t>(((rho >> 16) * disp_per_rho_q16_) / scale, 32));
+// Q24 (1/m) x Q16 (px per 1/m) -> Q40, / scale, -> Q8: the arithmetic of DisparityRows.
+int32_t Scene::DispQ8(int64_t rho_q40, int32_t scale) const {
+  const int64_t q40 = ((rho_q40 >> 16) * disp_per_rho_q16_) / scale;
+  return fx::Saturate<uint16_t>(fx::RoundShift<int64_t>(q40, 32));
 }
 
-int32_t Scene::disparity_max_q8(int32_t scale) const {
+// The wall is the farthest visible surface.
+int64_t Scene::RhoMinQ40() const { return maps_[reference_][0].rho[2]; }
+
+int64_t Scene::RhoMaxQ40() const {
   int64_t rho_max = 0;
   const ViewMap* maps = maps_[reference_];
   for (int32_t i = 0; i < object_count_; ++i) {
@@ -695,8 +695,16 @@ int32_t Scene::disparity_max_q8(int32_t scale) const {
     const int64_t rho = maps[i].rho[1] * (2 * height_) + maps[i].rho[2];
     if (rho > rho_max) rho_max = rho;
   }
-  return static_cast<int32_t>(
-      fx::RoundShift<int64_t>(((rho_max >> 16) * disp_per_rho_q16_) / scale, 32));
+  return rho_max;
+}
+
+int32_t Scene::disparity_min_q8(int32_t scale) const { return DispQ8(RhoMinQ40(), scale); }
+int32_t Scene::disparity_max_q8(int32_t scale) const { return DispQ8(RhoMaxQ40(), scale); }
+int32_t Scene::inverse_depth_min_q12() const {
+  return fx::Saturate<uint16_t>(fx::RoundShift<int64_t>(RhoMinQ40(), 28));
+}
+int32_t Scene::inverse_depth_max_q12() const {
+  return fx::Saturate<uint16_t>(fx::RoundShift<int64_t>(RhoMaxQ40(), 28));
 }
 
 double Scene::disparity_min(int32_t scale) const { return disparity_min_q8(scale) / 256.0; }

@@ -52,7 +52,8 @@ struct SceneParams {
   bool point_lights = true;
 };
 
-// Pinhole intrinsics in pixels of the rendered resolution.
+// Pinhole intrinsics in pixels of the rendered resolution; pixel (i, j) has its centre at
+// (i + 0.5, j + 0.5).
 struct Intrinsics {
   double fx = 0, fy = 0, cx = 0, cy = 0;
 };
@@ -102,6 +103,9 @@ class Scene {
   int32_t disparity_max_q8(int32_t scale = 1) const;
   double disparity_min(int32_t scale = 1) const;
   double disparity_max(int32_t scale = 1) const;
+  // The same bounds as inverse depth (1/m, Q4.12), for the handheld mode.
+  int32_t inverse_depth_min_q12() const;
+  int32_t inverse_depth_max_q12() const;
 
   int32_t width() const { return width_; }
   int32_t height() const { return height_; }
@@ -156,6 +160,9 @@ class Scene {
   };
 
   void BuildLayout(const SceneParams& params);
+  int64_t RhoMinQ40() const;
+  int64_t RhoMaxQ40() const;
+  int32_t DispQ8(int64_t rho_q40, int32_t scale) const;
   void BuildFixedPoint();
   Status BuildView(int32_t view);
   void PrepareRow(const ViewMap* maps, int32_t y2, RowState* row) const;

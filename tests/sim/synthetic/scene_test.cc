@@ -182,6 +182,9 @@ TEST(SceneTest, HandheldPosesAndDepthMatchTheViews) {
   const Frame rf = Render(scene, ref);
   std::vector<uint16_t> rho_q12(size_t(w) * h);
   ASSERT_TRUE(scene.InverseDepthRows(1, 0, h, rho_q12.data(), w).ok());
+  EXPECT_EQ(*std::min_element(rho_q12.begin(), rho_q12.end()), scene.inverse_depth_min_q12());
+  EXPECT_LE(*std::max_element(rho_q12.begin(), rho_q12.end()), scene.inverse_depth_max_q12());
+  EXPECT_NEAR(scene.inverse_depth_min_q12() / 4096.0, 1 / 12.0, 0.001);  // the wall at 12 m
   const std::vector<uint8_t> ref_ids = Objects(scene, ref);
   for (int32_t v = 0; v < scene.views(); ++v) {
     if (v == ref) continue;
