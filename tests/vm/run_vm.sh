@@ -5,7 +5,10 @@
 # exit status comes back over the serial console as "LBVM-RESULT <name> <status>".
 #
 #   run_vm.sh --cache DIR --work DIR [--modules "vivid uinput evdev"] [--vimc] [--libcamera]
-#             [--timeout SECONDS] PROGRAM...
+#             [--tool PROGRAM]... [--timeout SECONDS] TEST...
+#
+# A TEST is a program, or a scenario script (*.sh, run by busybox sh) that drives the --tool
+# programs and the programs under test; all of them lie in /tests, which is on PATH.
 #
 # --cache holds what is slow to get and shared between build trees (kernel package, vimc.ko);
 # --work the initramfs and the console log of this run. --vimc builds the vimc driver out of
@@ -20,6 +23,7 @@ set -euo pipefail
 
 cache="" work="" modules="vivid uinput evdev" vimc=0 libcamera=0 timeout_s=300
 programs=()
+tools=()
 while (($#)); do
   case "$1" in
     --cache) cache=$2; shift 2 ;;
@@ -27,8 +31,9 @@ while (($#)); do
     --modules) modules=$2; shift 2 ;;
     --vimc) vimc=1; shift ;;
     --libcamera) libcamera=1; shift ;;
+    --tool) tools+=("$2"); shift 2 ;;
     --timeout) timeout_s=$2; shift 2 ;;
-    -h|--help) sed -n '2,21p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
     -*) echo "run_vm.sh: unknown option $1" >&2; exit 2 ;;
     *) programs+=("$1"); shift ;;
   esac
@@ -135,11 +140,15 @@ copy_with_libs() {  # FILE [DEST]: the file and every shared library ldd lists f
 }
 
 names=()
-for p in "${programs[@]}"; do
+for p in "${programs[@]}" "${tools[@]}"; do
   name=$(basename "$p")
-  copy_with_libs "$p" "/tests/$name"
-  names+=("$name")
+  if [[ $name == *.sh ]]; then
+    cp "$p" "$root/tests/$name"
+  else
+    copy_with_libs "$p" "/tests/$name"
+  fi
 done
+for p in "${programs[@]}"; do names+=("$(basename "$p")"); done
 
 if ((libcamera)); then
   for d in /usr/lib/x86_64-linux-gnu/libcamera /usr/libexec/libcamera /usr/share/libcamera; do
@@ -154,7 +163,7 @@ fi
 cat >"$root/init" <<INIT
 #!/bin/busybox sh
 /bin/busybox --install -s /bin
-export PATH=/bin
+export PATH=/bin:/tests
 mount -t proc proc /proc
 mount -t sysfs sys /sys
 mount -t devtmpfs dev /dev
@@ -173,7 +182,10 @@ fi
 echo LBVM-BOOTED
 for t in ${names[*]}; do
   echo "LBVM-START \$t"
-  LB_REQUIRE_DEVICES=1 GTEST_COLOR=no /tests/\$t
+  case \$t in
+    *.sh) LB_REQUIRE_DEVICES=1 sh /tests/\$t ;;
+    *) LB_REQUIRE_DEVICES=1 GTEST_COLOR=no /tests/\$t ;;
+  esac
   echo "LBVM-RESULT \$t \$?"
 done
 echo LBVM-DONE
