@@ -13,9 +13,15 @@ int64_t RoundDiv(int64_t num, int64_t den) {
 }
 
 // Adds one kernel row's weighted sums to acc[x0..x1]. p[i] is the row prefix up to column i.
-// The plain C reference loop, written so compilers vectorise it: the row term is formed in
-// wrapping uint32 (its true value is below 2^31 in magnitude, see layer_plane.h).
-void GatherRow(const uint32_t* p, const KernelRow& k, int64_t* acc, int32_t x0, int32_t x1) {
+// The plain C reference loop, written so compilers vectorise it: sums are formed in wrapping
+// uint32; their true values are below 2^31 in magnitude (see layer_plane.h), so the final sum
+// read as int32 is exact.
+// On x86-64 an AVX2 clone (8 lanes, native 32-bit multiplies) is picked once at load time by
+// the CPU's flags; integer arithmetic, so both clones give the same bits.
+#if defined(__x86_64__) && !defined(__clang__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void GatherRow(const uint32_t* p, const KernelRow& k, uint32_t* acc, int32_t x0, int32_t x1) {
   const uint32_t* pa = p + k.left - 1;
   const uint32_t* pb = p + k.left;
   const uint32_t* pc = p + k.right + 1;
@@ -24,7 +30,28 @@ void GatherRow(const uint32_t* p, const KernelRow& k, int64_t* acc, int32_t x0, 
                  wr = static_cast<uint32_t>(k.wr);
   for (int32_t x = x0; x <= x1; ++x) {
     const uint32_t t = w * (pc[x] - pb[x]) + wl * (pb[x] - pa[x]) + wr * (pd[x] - pc[x]);
-    acc[x] += static_cast<int32_t>(t);
+    acc[x] += t;
+  }
+}
+
+// Lays one layer row over what is behind: out = out * (1 - alpha) + colour, Q16, rounded.
+#if defined(__x86_64__) && !defined(__clang__)
+__attribute__((target_clones("avx2", "default")))
+#endif
+void CompositeRow(int32_t* out, const int32_t* colour, const int32_t* alpha, int32_t x0,
+                  int32_t x1) {
+  for (int32_t x = x0; x <= x1; ++x) {
+    const int64_t keep = 65536 - alpha[x];
+    out[x] = static_cast<int32_t>(((out[x] * keep + 32768) >> 16) + colour[x]);
+  }
+}
+
+// Linear interpolation of a low-res row at each output column's tap (col[-1] .. col[n] valid).
+void LerpRow(const int32_t* col, const int16_t* tap, const uint8_t* frac, int32_t* dst, int32_t x0,
+             int32_t x1) {
+  for (int32_t x = x0; x <= x1; ++x) {
+    const int32_t a = col[tap[x]], b = col[tap[x] + 1];
+    dst[x] = a + static_cast<int32_t>((int64_t{b - a} * frac[x] + 128) >> 8);
   }
 }
 
@@ -88,11 +115,24 @@ void LayerPlane::Carve(Arena& arena, int32_t width, int32_t height, int32_t chan
   prefix_ = arena.Allocate<uint32_t>(static_cast<size_t>(window_rows_) * planes * pitch_);
   active_ = arena.Allocate<uint8_t>(static_cast<size_t>(window_rows_));
   box_ = arena.Allocate<int32_t>(planes * pitch_);
-  acc_ = arena.Allocate<int64_t>(planes * pitch_);
+  acc_ = arena.Allocate<uint32_t>(planes * pitch_);
   layer_ = arena.Allocate<int32_t>(static_cast<size_t>(low_rows_) * planes * pitch_);
   full_ = arena.Allocate<int32_t>(planes * pitch_);
   out_ = arena.Allocate<int32_t>(static_cast<size_t>(strip_rows) * planes * width);
   kernels_ = arena.Allocate<KernelRow>(static_cast<size_t>(radii) * kernel_rows_);
+  // Column l of a reduced level samples the low-res row at (2x + 1 - f) / 2f, Q8.
+  int32_t max_level = 0;
+  for (int32_t i = 0; i < radii; ++i) max_level = Max(max_level, level_[i]);
+  for (int32_t l = 1; l <= max_level; ++l) {
+    tap_[l] = arena.Allocate<int16_t>(static_cast<size_t>(width));
+    frac_[l] = arena.Allocate<uint8_t>(static_cast<size_t>(width));
+    if (arena.planning() || arena.overflowed()) continue;
+    for (int32_t x = 0; x < width; ++x) {
+      const int32_t u = ((2 * x + 1 - (1 << l)) * 128) >> l;
+      tap_[l][x] = static_cast<int16_t>(u >> 8);
+      frac_[l][x] = static_cast<uint8_t>(u & 255);
+    }
+  }
 }
 
 void LayerPlane::Begin(const ApertureShape& shape, int32_t shift) {
@@ -159,19 +199,27 @@ void LayerPlane::BuildPrefix(int32_t k, int32_t level, int32_t h, int32_t jlo, i
         for (int32_t i = q0; i <= q1; ++i) box[i] = 0;
       }
       const int32_t end = Min(height_, (m + 1) << level);
+      int32_t* box_a = box_ + channels_ * static_cast<ptrdiff_t>(pitch_);
       for (int32_t j = m << level; j < end; ++j) {
         if (!(tiles_[Slot(j) * layers_ + k] & run)) continue;
         const int16_t* s = RadiusRow(j);
-        for (int32_t x = x0; x <= x1; ++x) {
-          const uint16_t e = layer_of[s[x] + offset];
-          const int32_t first = e >> 8, frac = e & 255;
-          const int32_t a = first == k ? 256 - frac : (first + 1 == k ? frac : 0);
-          if (a == 0) continue;
-          for (int32_t c = 0; c < channels_; ++c) {
-            box_[c * static_cast<ptrdiff_t>(pitch_) + (x >> level)] +=
-                (ValueRow(j, c)[x] * a) >> shift_;
+        const int16_t* v0 = ValueRow(j, 0);
+        const int16_t* v1 = channels_ > 1 ? ValueRow(j, 1) : v0;
+        // Sum each box's row in registers, then add it once: no store-to-load chain.
+        for (int32_t q = q0; q <= q1; ++q) {
+          int32_t sum0 = 0, sum1 = 0, sum_a = 0;
+          const int32_t xe = Min(x1, ((q + 1) << level) - 1);
+          for (int32_t x = q << level; x <= xe; ++x) {
+            const uint16_t e = layer_of[s[x] + offset];
+            const int32_t first = e >> 8, frac = e & 255;
+            const int32_t a = first == k ? 256 - frac : (first + 1 == k ? frac : 0);
+            sum0 += (v0[x] * a) >> shift_;
+            sum1 += (v1[x] * a) >> shift_;
+            sum_a += a;
           }
-          box_[channels_ * static_cast<ptrdiff_t>(pitch_) + (x >> level)] += a;
+          box_[q] += sum0;
+          if (channels_ > 1) box_[pitch_ + q] += sum1;
+          box_a[q] += sum_a;
         }
       }
       const int32_t round = 1 << (2 * level - 1);
@@ -196,7 +244,7 @@ void LayerPlane::GatherNormalise(int32_t kernel, int32_t m, int32_t jlo, int32_t
   const int32_t h = half_[kernel];
   const KernelRow* rows = kernels_ + kernel * kernel_rows_;
   for (int32_t c = 0; c < planes; ++c) {
-    int64_t* acc = acc_ + c * static_cast<ptrdiff_t>(pitch_);
+    uint32_t* acc = acc_ + c * static_cast<ptrdiff_t>(pitch_);
     for (int32_t x = x0; x <= x1; ++x) acc[x] = 0;
   }
   for (int32_t dy = -h; dy <= h; ++dy) {
@@ -212,17 +260,18 @@ void LayerPlane::GatherNormalise(int32_t kernel, int32_t m, int32_t jlo, int32_t
   }
   // alpha = acc / (total * 256) in Q16 (rec = 2^40 / total); colour likewise, undoing the shift.
   const uint64_t rec = reciprocal_[kernel];
-  const int64_t* acc_a = acc_ + channels_ * static_cast<ptrdiff_t>(pitch_);
+  const uint32_t* acc_a = acc_ + channels_ * static_cast<ptrdiff_t>(pitch_);
   int32_t* alpha = layer + channels_ * stride;
   for (int32_t x = x0; x <= x1; ++x) {
-    const uint64_t a = (static_cast<uint64_t>(acc_a[x]) * rec) >> 32;
+    const uint64_t a = (uint64_t{acc_a[x]} * rec) >> 32;
     alpha[x] = static_cast<int32_t>(a > 65536 ? 65536 : a);
   }
   for (int32_t c = 0; c < channels_; ++c) {
-    const int64_t* acc = acc_ + c * static_cast<ptrdiff_t>(pitch_);
+    const uint32_t* acc = acc_ + c * static_cast<ptrdiff_t>(pitch_);
     int32_t* colour = layer + c * stride;
     for (int32_t x = x0; x <= x1; ++x) {
-      colour[x] = static_cast<int32_t>((acc[x] * static_cast<int64_t>(rec)) >> (32 - shift_));
+      const int64_t sum = static_cast<int32_t>(acc[x]);
+      colour[x] = static_cast<int32_t>((sum * static_cast<int64_t>(rec)) >> (32 - shift_));
     }
   }
 }
@@ -230,18 +279,8 @@ void LayerPlane::GatherNormalise(int32_t kernel, int32_t m, int32_t jlo, int32_t
 void LayerPlane::Composite(const int32_t* layer, ptrdiff_t stride, int32_t x0, int32_t x1,
                            int32_t* out) {
   const int32_t* alpha = layer + channels_ * stride;
-  int32_t* out_a = out + channels_ * static_cast<ptrdiff_t>(width_);
-  for (int32_t c = 0; c < channels_; ++c) {
-    const int32_t* colour = layer + c * stride;
-    int32_t* o = out + c * static_cast<ptrdiff_t>(width_);
-    for (int32_t x = x0; x <= x1; ++x) {
-      const int64_t keep = 65536 - alpha[x];
-      o[x] = static_cast<int32_t>(((o[x] * keep + 32768) >> 16) + colour[x]);
-    }
-  }
-  for (int32_t x = x0; x <= x1; ++x) {
-    const int64_t keep = 65536 - alpha[x];
-    out_a[x] = static_cast<int32_t>(((out_a[x] * keep + 32768) >> 16) + alpha[x]);
+  for (int32_t c = 0; c <= channels_; ++c) {
+    CompositeRow(out + c * static_cast<ptrdiff_t>(width_), layer + c * stride, alpha, x0, x1);
   }
 }
 
@@ -308,18 +347,18 @@ void LayerPlane::RenderRun(int32_t k, int32_t y0, int32_t n, const uint16_t* lay
     const int64_t fy = uy & 255;
     const int32_t* ra = layer_ + (ma - m_first) * low_stride;
     const int32_t* rb = layer_ + (mb - m_first) * low_stride;
+    // Separable: blend the two low-res rows (into box_, edges replicated), then interpolate
+    // each output column between its two taps.
     for (int32_t c = 0; c < planes; ++c) {
       const int32_t* a = ra + c * static_cast<ptrdiff_t>(pitch_);
       const int32_t* b = rb + c * static_cast<ptrdiff_t>(pitch_);
-      int32_t* dst = full_ + c * static_cast<ptrdiff_t>(pitch_);
-      for (int32_t x = x0; x <= x1; ++x) {
-        const int32_t ux = coord_q8(x);
-        const int32_t ta = Clamp(ux >> 8, q_lo, q_hi), tb = Clamp((ux >> 8) + 1, q_lo, q_hi);
-        const int64_t fx = ux & 255;
-        const int64_t top = a[ta] * (256 - fx) + a[tb] * fx;
-        const int64_t bottom = b[ta] * (256 - fx) + b[tb] * fx;
-        dst[x] = static_cast<int32_t>((top * (256 - fy) + bottom * fy + 32768) >> 16);
+      int32_t* col = box_ + c * static_cast<ptrdiff_t>(pitch_) + 1;
+      for (int32_t q = q_lo; q <= q_hi; ++q) {
+        col[q] = static_cast<int32_t>((a[q] * (256 - fy) + b[q] * fy + 128) >> 8);
       }
+      col[q_lo - 1] = col[q_lo];
+      col[q_hi + 1] = col[q_hi];
+      LerpRow(col, tap_[level], frac_[level], full_ + c * static_cast<ptrdiff_t>(pitch_), x0, x1);
     }
     Composite(full_, pitch_, x0, x1, out_ + (y - y0) * row_stride);
   }

@@ -17,8 +17,9 @@
 // largest reach, one layer's prefix sums for one strip's window, and strip-sized accumulators.
 // Fixed point: colour value v (int16, Y * gain or (C - 128) * gain), layer weight a (Q8);
 // prefix of c = (v * a) >> shift in uint32 (wrapping, only differences are used, each below
-// 2^31); a kernel row's term w * span in int32 (shift chosen so it cannot overflow); the
-// per-pixel sum in int64; the layer's colour and alpha normalised to Q16; compositing in Q16.
+// 2^31); the kernel sum per pixel in int32 (kernels stay within 17 x 17 cells at their level,
+// and the shift is chosen so 17^2 x 256 x c cannot overflow); the layer's colour and alpha
+// normalised to Q16 (int64 product with a reciprocal); compositing in Q16.
 #pragma once
 
 #include <cstddef>
@@ -97,18 +98,20 @@ class LayerPlane {
   int32_t level_[kMaxKernels] = {};
   int32_t half_[kMaxKernels] = {};         // at the kernel's level
   uint64_t reciprocal_[kMaxKernels] = {};  // 2^40 / total kernel weight
-  int16_t* ring_s_ = nullptr;     // ring_rows x width: signed radius, Q4 full-resolution px
-  int16_t* ring_v_ = nullptr;     // ring_rows x channels x width
-  uint64_t* tiles_ = nullptr;     // ring_rows x layers: bit t = the layer has a pixel in tile t
-  int32_t tile_shift_ = 6;        // tiles of 2^tile_shift columns, at most 64 of them
-  uint32_t* prefix_ = nullptr;    // window_rows x (channels + 1) x pitch
-  uint8_t* active_ = nullptr;     // per window row: the layer has pixels there
-  int32_t* box_ = nullptr;        // (channels + 1) x pitch: one low-res row's box sums
-  int64_t* acc_ = nullptr;        // (channels + 1) x pitch
-  int32_t* layer_ = nullptr;      // low_rows x (channels + 1) x pitch: normalised layer, Q16
-  int32_t* full_ = nullptr;       // (channels + 1) x pitch: one upsampled row of a layer, Q16
-  int32_t* out_ = nullptr;        // strip_rows x (channels + 1) x width, premultiplied Q16
-  KernelRow* kernels_ = nullptr;  // radii x kernel_rows
+  int16_t* ring_s_ = nullptr;         // ring_rows x width: signed radius, Q4 full-resolution px
+  int16_t* ring_v_ = nullptr;         // ring_rows x channels x width
+  uint64_t* tiles_ = nullptr;         // ring_rows x layers: bit t = the layer has a pixel in tile t
+  int32_t tile_shift_ = 6;            // tiles of 2^tile_shift columns, at most 64 of them
+  uint32_t* prefix_ = nullptr;        // window_rows x (channels + 1) x pitch
+  uint8_t* active_ = nullptr;         // per window row: the layer has pixels there
+  int32_t* box_ = nullptr;            // (channels + 1) x pitch: one low-res row's box sums
+  uint32_t* acc_ = nullptr;           // (channels + 1) x pitch: kernel sums, wrapping
+  int32_t* layer_ = nullptr;          // low_rows x (channels + 1) x pitch: normalised layer, Q16
+  int32_t* full_ = nullptr;           // (channels + 1) x pitch: one upsampled row of a layer, Q16
+  int32_t* out_ = nullptr;            // strip_rows x (channels + 1) x width, premultiplied Q16
+  KernelRow* kernels_ = nullptr;      // radii x kernel_rows
+  int16_t* tap_[kMaxLevel + 1] = {};  // per level and column: the left low-res tap
+  uint8_t* frac_[kMaxLevel + 1] = {};  // and the right tap's weight, Q8
 };
 
 }  // namespace lb

@@ -7,10 +7,10 @@ int32_t Min(int32_t a, int32_t b) { return a < b ? a : b; }
 int32_t Max(int32_t a, int32_t b) { return a > b ? a : b; }
 
 // Largest |value| in a plane after the highlight boost, and the shift of c = (v * a) >> shift
-// that keeps a kernel row's term (2 half + 1 cells x 256 x c) below 2^31.
+// that keeps a whole kernel's sum ((2 half + 1)^2 cells x 256 x c) below 2^31.
 int32_t ShiftFor(int32_t max_value, int32_t half) {
   int32_t shift = 0;
-  const int64_t cells = 2 * int64_t{half} + 1;
+  const int64_t cells = (2 * int64_t{half} + 1) * (2 * int64_t{half} + 1);
   while (cells * 256 * ((int64_t{max_value} * 256) >> shift) >= (int64_t{1} << 31)) ++shift;
   return shift;
 }
