@@ -105,10 +105,20 @@ const uint8_t kPalette[][3] = {{200, 62, 50},  {52, 118, 200}, {232, 188, 62}, {
 constexpr int kPaletteSize = sizeof(kPalette) / sizeof(kPalette[0]);
 
 // Texture cells in design px: colour blotches, then three octaves of detail.
-// Inverse cell sizes (Q16) so the per-pixel path multiplies; the ground's cells are in cm.
-constexpr int32_t kInvCells[2][4] = {{65536 / 56, 65536 / 20, 65536 / 7, 65536 / 3},
-                                     {65536 / 112, 65536 / 40, 65536 / 14, 65536 / 6}};
-constexpr int32_t kDetailWeights[3] = {5, 4, 3};  // sum 12
+// Noise octaves: colour blotches, then detail. Each octave's lattice is turned by its own
+// Pythagorean angle (a/h, b/h) so the octaves' grids do not line up into visible squares.
+// inv_q16 = 65536 / (cell * h), cells in design px (cm on the ground, twice as large).
+struct Octave {
+  int32_t a, b, inv_q16[2];  // [0] objects, [1] ground
+  int32_t weight;
+};
+constexpr Octave kOctaves[5] = {
+    {1, 0, {65536 / 56, 65536 / 112}, 0},  // colour mix
+    {4, 3, {65536 / (20 * 5), 65536 / (40 * 5)}, 5},
+    {12, 5, {65536 / (7 * 13), 65536 / (14 * 13)}, 4},
+    {15, 8, {65536 / (3 * 17), 65536 / (6 * 17)}, 3},
+    {21, 20, {65536 * 4 / (5 * 29), 65536 * 2 / (5 * 29)}, 2},  // 1.25 px: high resolutions only
+};
 
 }  // namespace
 
@@ -264,6 +274,9 @@ void Scene::BuildFixedPoint() {
   half_h_q16_ = int64_t{height_} << 15;
   design_per_px_q24_ = ToFixed(1 / s, 24);
   disp_per_rho_q16_ = ToFixed(intrinsics_.fx * baseline_, 16);
+  // The finest octave only where its cells span 2 px or more: below that a camera's optics
+  // would blur it, and point-sampling it would alias.
+  detail_octaves_ = 1.25 * s >= 2 ? 4 : 3;
   for (int32_t i = 0; i < object_count_; ++i) {
     Object& o = objects_[i];
     o.cx_q16 = ToFixed(0.5 * width_ + o.cx * s, 16);
@@ -455,9 +468,10 @@ int32_t Scene::Winner(const ViewMap* maps, const RowState& row, int32_t x2,
 }
 
 // Inlined: four calls per pixel, and the call overhead was a fifth of the render time.
-[[gnu::always_inline]] inline int32_t Scene::Noise(int64_t u_q8, int64_t v_q8, int32_t inv_cell_q16,
-                                                   int32_t sx, int32_t sy) const {
-  const int64_t lu = (u_q8 * inv_cell_q16) >> 16, lv = (v_q8 * inv_cell_q16) >> 16;  // Q8 cells
+[[gnu::always_inline]] inline int32_t Scene::Noise(int64_t u_q8, int64_t v_q8, int32_t a, int32_t b,
+                                                   int32_t inv_q16, int32_t sx, int32_t sy) const {
+  const int64_t lu = ((u_q8 * a - v_q8 * b) * inv_q16) >> 16;  // Q8 cells
+  const int64_t lv = ((u_q8 * b + v_q8 * a) * inv_q16) >> 16;
   const int32_t iu = static_cast<int32_t>((lu >> 8) + sx) & 255;
   const int32_t iv = static_cast<int32_t>((lv >> 8) + sy) & 255;
   const int32_t wu = fade_[lu & 255], wv = fade_[lv & 255];
@@ -485,13 +499,16 @@ void Scene::Shade(int32_t index, int64_t xr_q16, int64_t yr_q16, int32_t* rgb) c
     u = ((xr_q16 - half_w_q16_) * design_per_px_q24_) >> 32;
     v = ((yr_q16 - half_h_q16_) * design_per_px_q24_) >> 32;
   }
-  const int32_t* inv_cells = kInvCells[ground ? 1 : 0];
-  const int32_t mix = Noise(u, v, inv_cells[0], o.salt_x, o.salt_y) >> 8;
-  int32_t detail = 0;
-  for (int k = 0; k < 3; ++k)
-    detail += kDetailWeights[k] *
-              Noise(u, v, inv_cells[k + 1], o.salt_x + 61 * (k + 1), o.salt_y + 97 * (k + 1));
-  detail = detail / 12 >> 8;              // 0..255, mostly 90..170
+  const int g = ground ? 1 : 0;
+  const int32_t mix = Noise(u, v, 1, 0, kOctaves[0].inv_q16[g], o.salt_x, o.salt_y) >> 8;
+  int32_t detail = 0, weights = 0;
+  for (int k = 1; k < detail_octaves_ + 1; ++k) {
+    const Octave& oct = kOctaves[k];
+    detail += oct.weight *
+              Noise(u, v, oct.a, oct.b, oct.inv_q16[g], o.salt_x + 61 * k, o.salt_y + 97 * k);
+    weights += oct.weight;
+  }
+  detail = detail / weights >> 8;         // 0..255, mostly 90..170
   int32_t gain_q8 = 64 + detail * 3 / 2;  // about 0.75..1.25
   int32_t base[3];
   for (int c = 0; c < 3; ++c)

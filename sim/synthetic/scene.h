@@ -171,7 +171,8 @@ class Scene {
                 int64_t* yr_q16) const;
   bool Inside(const Object& o, int64_t xr_q16, int64_t yr_q16) const;
   void Shade(int32_t object, int64_t xr_q16, int64_t yr_q16, int32_t* rgb) const;
-  int32_t Noise(int64_t u_q8, int64_t v_q8, int32_t cell_shift_q16, int32_t sx, int32_t sy) const;
+  int32_t Noise(int64_t u_q8, int64_t v_q8, int32_t a, int32_t b, int32_t inv_q16, int32_t sx,
+                int32_t sy) const;
   Status CheckTruthArgs(int32_t scale, int32_t y0, int32_t rows, const void* out,
                         ptrdiff_t stride) const;
 
@@ -195,6 +196,7 @@ class Scene {
   int64_t ground_h_q8_ = 0;        // camera height in cm, Q8
   int64_t ground_vmin_q16_ = 0;    // smallest row offset below the centre the ground texture uses
   int64_t disp_per_rho_q16_ = 0;   // full-resolution px per view step per (1/m), Q16
+  int32_t detail_octaves_ = 3;     // texture octaves the resolution can show
   uint8_t noise_[256 * 256] = {};
   uint8_t fade_[256] = {};            // smoothstep, Q8
   std::vector<uint8_t> corner_rows_;  // 2 x (width + 1) object indices
