@@ -22,7 +22,7 @@ namespace lb {
 
 struct DataTermParams {
   int32_t color_trunc = 45;   // truncation of the summed |dR|+|dG|+|dB|, 0..765
-  int32_t census_weight = 6;  // cost per differing census bit (24 bits), 0..10
+  int32_t census_weight = 4;  // cost per differing census bit (24 bits), 0..10
 };
 
 class DataTerm {

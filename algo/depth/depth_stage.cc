@@ -71,6 +71,7 @@ Status DepthStage::Carve(Arena& arena) {
   weight_right_ = arena.Allocate<uint16_t>(n);
   weight_down_ = arena.Allocate<uint16_t>(n);
   state_ = arena.Allocate<uint8_t>(n);
+  reach_ = arena.Allocate<uint16_t>(n);
   stats_.arena_bytes = arena.used() - start;
   if (arena.overflowed()) return Status(Code::kOutOfMemory, "depth: arena too small");
   return Status::Ok();
@@ -107,6 +108,16 @@ void DepthStage::EdgeWeights(const ConstImageU8& ref) {
       const int32_t p = y * w + x;
       weight_right_[p] = x + 1 < w ? weight(row + 3 * x, row + 3 * x + 3) : 0;
       weight_down_[p] = y + 1 < h ? weight(row + 3 * x, below + 3 * x) : 0;
+    }
+  }
+  // Largest change of the pair terms around a pixel when it alone switches label.
+  for (int32_t y = 0; y < h; ++y) {
+    for (int32_t x = 0; x < w; ++x) {
+      const int32_t p = y * w + x;
+      const int32_t sum = weight_right_[p] + (x > 0 ? weight_right_[p - 1] : 0) + weight_down_[p] +
+                          (y > 0 ? weight_down_[p - w] : 0);
+      const int32_t reach = sum * config_.smooth_trunc;  // saturating is safe: D <= 2295
+      reach_[p] = static_cast<uint16_t>(reach > 0xffff ? 0xffff : reach);
     }
   }
 }
@@ -159,26 +170,31 @@ bool DepthStage::Expand(int32_t alpha) {
   // Pass 1: pixels whose choice does not depend on their neighbours are fixed before the cut.
   // Flipping p to alpha changes the energy by u_p plus, per neighbour q, C - A (q keeps its
   // label) or -B (q takes alpha); if that is > 0 whatever the neighbours do, p keeps its label
-  // in every optimal move, and if it is < 0 whatever they do, p takes alpha.
-  bool any_free = false, any_take = false;
+  // in every optimal move, and if it is < 0 whatever they do, p takes alpha. Each pair term
+  // moves the sum by at most w_pq * trunc, which settles most pixels without looking further.
+  int32_t y_lo = h, y_hi = -1;  // rows holding free or switching pixels
   for (int32_t y = 0; y < h; ++y) {
+    const int32_t row = y * w;
+    uint8_t* state = state_ + row;
+    const uint16_t* ca = cost_alpha_ + row;
+    const uint16_t* cc = cost_ + row;
+    const uint16_t* reach = reach_ + row;
+    bool open = false;
     for (int32_t x = 0; x < w; ++x) {
-      const int32_t p = y * w + x;
+      const int32_t u = ca[x] - cc[x];
+      state[x] = u > reach[x] ? kKeep : kFree;
+      open |= u <= reach[x];
+    }
+    if (!open) continue;
+    for (int32_t x = 0; x < w; ++x) {
+      if (state[x] == kKeep) continue;
+      const int32_t p = row + x;
       const int32_t fp = labels_[p];
       if (fp == alpha) {
-        state_[p] = kKeep;
+        state[x] = kKeep;
         continue;
       }
-      const int32_t u = cost_alpha_[p] - cost_[p];
-      // Most pixels: alpha is far worse than any smoothness saving (each pair term moves the
-      // difference by at most w_pq * trunc).
-      const int32_t reach = (weight_right_[p] + (x > 0 ? weight_right_[p - 1] : 0) +
-                             weight_down_[p] + (y > 0 ? weight_down_[p - w] : 0)) *
-                            config_.smooth_trunc;
-      if (u > reach) {
-        state_[p] = kKeep;
-        continue;
-      }
+      const int32_t u = ca[x] - cc[x];
       int32_t lo = u, hi = u;
       auto edge = [&](int32_t q, int32_t wpq) {
         const int32_t fq = labels_[q];
@@ -192,61 +208,98 @@ bool DepthStage::Expand(int32_t alpha) {
       if (y + 1 < h) edge(p + w, weight_down_[p]);
       if (y > 0) edge(p - w, weight_down_[p - w]);
       if (lo > 0) {
-        state_[p] = kKeep;
-      } else if (hi < 0) {
-        state_[p] = kTake;
-        any_take = true;
-      } else {
-        state_[p] = kFree;
-        any_free = true;
+        state[x] = kKeep;
+        continue;
       }
+      state[x] = hi < 0 ? kTake : kFree;
+      y_lo = y < y_lo ? y : y_lo;
+      y_hi = y;
     }
   }
-  if (!any_free && !any_take) return false;
-  // Pass 2: the cut over the free pixels; a fixed neighbour turns a pair term into a unary one.
-  if (any_free) {
-    maxflow_.Reset(w, h);
-    for (int32_t y = 0; y < h; ++y) {
-      for (int32_t x = 0; x < w; ++x) {
-        const int32_t p = y * w + x;
-        const int32_t fp = labels_[p];
-        const uint8_t sp = state_[p];
-        int32_t balance = sp == kFree ? cost_alpha_[p] - cost_[p] : 0;
-        auto pair = [&](int32_t q, int32_t wpq, GridMaxflow::Dir dir) {
-          const uint8_t sq = state_[q];
-          if (sp != kFree && sq != kFree) return;
-          const int32_t fq = labels_[q];
-          // A pixel fixed to alpha behaves as alpha on both sides of its pair terms.
-          const int32_t lp = sp == kTake ? alpha : fp, lq = sq == kTake ? alpha : fq;
-          const int32_t a = wpq * Smooth(lp, lq), b = wpq * Smooth(lp, alpha);
-          const int32_t c = wpq * Smooth(alpha, lq);
-          if (sp == kFree && sq == kFree) {
-            balance += c - a;
-            maxflow_.AddTerminalBalance(q, -c);
-            maxflow_.AddEdge(p, dir, b + c - a, 0);
-          } else if (sp == kFree) {
-            balance += c - a;  // q fixed: E(x_p, q) = a + (c - a) x_p
-          } else {
-            maxflow_.AddTerminalBalance(q, b - a);  // p fixed: E(p, x_q) = a + (b - a) x_q
-          }
-        };
-        if (x + 1 < w) pair(p + 1, weight_right_[p], GridMaxflow::kRight);
-        if (y + 1 < h) pair(p + w, weight_down_[p], GridMaxflow::kDown);
-        if (sp == kFree) maxflow_.AddTerminalBalance(p, balance);
+  if (y_hi < 0) return false;
+
+  // Pass 2: the cut over the free pixels of rows y_lo..y_hi (node = p - y_lo * w). A fixed
+  // neighbour turns a pair term into a unary one: E(x_p) = a + (c - a) x_p with a = V(fp, lq),
+  // c = V(alpha, lq), lq the label the neighbour is fixed to.
+  const int32_t base = y_lo * w;
+  maxflow_.Reset(w, y_hi - y_lo + 1);
+  bool any_free = false;
+  for (int32_t y = y_lo; y <= y_hi; ++y) {
+    for (int32_t x = 0; x < w; ++x) {
+      const int32_t p = y * w + x;
+      if (state_[p] != kFree) continue;
+      any_free = true;
+      ++stats_.cut_pixels;
+      const int32_t fp = labels_[p];
+      const int32_t node = p - base;
+      int32_t balance = cost_alpha_[p] - cost_[p];
+      auto fixed = [&](int32_t q, int32_t wpq) {
+        const int32_t lq = state_[q] == kTake ? alpha : labels_[q];
+        balance += wpq * (Smooth(alpha, lq) - Smooth(fp, lq));
+      };
+      auto pair = [&](int32_t q, int32_t wpq, GridMaxflow::Dir dir) {
+        if (state_[q] != kFree) return fixed(q, wpq);
+        const int32_t fq = labels_[q];
+        const int32_t a = wpq * Smooth(fp, fq), b = wpq * Smooth(fp, alpha);
+        const int32_t c = wpq * Smooth(alpha, fq);
+        balance += c - a;
+        maxflow_.AddTerminalBalance(node + (q - p), -c);
+        maxflow_.AddEdge(node, dir, b + c - a, 0);
+      };
+      if (x + 1 < w) pair(p + 1, weight_right_[p], GridMaxflow::kRight);
+      if (y + 1 < h) {
+        if (y + 1 <= y_hi) {
+          pair(p + w, weight_down_[p], GridMaxflow::kDown);
+        } else {
+          fixed(p + w, weight_down_[p]);
+        }
       }
+      // Left and upper pairs with a free neighbour were added from that neighbour.
+      if (x > 0 && state_[p - 1] != kFree) fixed(p - 1, weight_right_[p - 1]);
+      if (y > 0 && state_[p - w] != kFree) fixed(p - w, weight_down_[p - w]);
+      maxflow_.AddTerminalBalance(node, balance);
     }
-    (void)maxflow_.Solve();
   }
-  for (int32_t p = 0; p < w * h; ++p) {
-    const uint8_t sp = state_[p];
-    if (sp == kTake || (sp == kFree && !maxflow_.InSource(p))) {
+  if (any_free) (void)maxflow_.Solve();
+
+  // Apply, and update the energy from the pixels that changed and their pair terms.
+  for (int32_t y = y_lo; y <= y_hi; ++y) {
+    for (int32_t x = 0; x < w; ++x) {
+      const int32_t p = y * w + x;
+      if (state_[p] == kFree) state_[p] = maxflow_.InSource(p - base) ? kKeep : kTake;
+    }
+  }
+  int64_t delta = 0;
+  for (int32_t y = y_lo; y <= y_hi; ++y) {
+    for (int32_t x = 0; x < w; ++x) {
+      const int32_t p = y * w + x;
+      if (state_[p] != kTake) continue;
+      const int32_t fp = labels_[p];
+      delta += cost_alpha_[p] - cost_[p];
+      // Pairs with an unchanged neighbour; a pair of two switching pixels goes from
+      // V(fp, fq) to 0 and is counted once, from its left or upper pixel.
+      auto pair = [&](int32_t q, int32_t wpq, bool first) {
+        if (state_[q] == kTake && !(first && q > p)) return;
+        const int32_t fq = labels_[q];
+        const int32_t after = state_[q] == kTake ? 0 : Smooth(alpha, fq);
+        delta += int64_t{wpq} * (after - Smooth(fp, fq));
+      };
+      if (x + 1 < w) pair(p + 1, weight_right_[p], true);
+      if (x > 0) pair(p - 1, weight_right_[p - 1], false);
+      if (y + 1 < h) pair(p + w, weight_down_[p], true);
+      if (y > 0) pair(p - w, weight_down_[p - w], false);
+    }
+  }
+  for (int32_t y = y_lo; y <= y_hi; ++y) {
+    for (int32_t x = 0; x < w; ++x) {
+      const int32_t p = y * w + x;
+      if (state_[p] != kTake) continue;
       labels_[p] = static_cast<uint8_t>(alpha);
       cost_[p] = cost_alpha_[p];
     }
   }
-  const int64_t before = energy_;
-  energy_ = LabelEnergy(labels_, cost_, weight_right_, weight_down_, w, h, config_.smooth_trunc);
-  return energy_ < before;
+  energy_ += delta;
+  return delta < 0;
 }
 
 int64_t DepthStage::Energy(const uint8_t* labels) {
@@ -323,6 +376,7 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
   stats_.initial_energy = energy_;
   stats_.cycles = 0;
   stats_.moves = 0;
+  stats_.cut_pixels = 0;
   for (int32_t cycle = 0; cycle < c.max_cycles; ++cycle) {
     bool lowered = false;
     for (int32_t alpha = 0; alpha < c.labels; ++alpha) {

@@ -29,16 +29,16 @@ struct DepthConfig {
 
   // Data term (see data_term.h).
   int32_t color_trunc = 45;   // truncation of |dR|+|dG|+|dB|, 1..765
-  int32_t census_weight = 6;  // cost per differing census bit, 0..10
+  int32_t census_weight = 4;  // cost per differing census bit, 0..10
   // Smoothness V(a, b) = w_pq * min(|a - b|, smooth_trunc) over label indices: truncated linear,
   // Potts when smooth_trunc is 1. w_pq is smooth_weight where the reference is flat and
   // smooth_weight * edge_weight_q8 / 256 across a colour edge (largest channel step above
   // edge_threshold), so label changes prefer image edges.
-  int32_t smooth_weight = 16;   // 0..4096
+  int32_t smooth_weight = 96;   // 0..4096
   int32_t smooth_trunc = 8;     // 1..64
   int32_t edge_threshold = 16;  // 0..255
-  int32_t edge_weight_q8 = 96;  // 0..256
-  int32_t max_cycles = 2;       // expansion cycles after the winner-take-all start, 0..32
+  int32_t edge_weight_q8 = 64;  // 0..256
+  int32_t max_cycles = 1;       // expansion cycles after the winner-take-all start, 0..32
   bool subpixel = true;         // parabola fit between labels for the output
 };
 
@@ -46,6 +46,7 @@ struct DepthStats {
   int32_t labels = 0;
   int32_t cycles = 0;          // expansion cycles run
   int32_t moves = 0;           // expansion moves that lowered the energy
+  int64_t cut_pixels = 0;      // pixels left free for the cuts, summed over the moves
   int64_t initial_energy = 0;  // energy of the winner-take-all labels
   int64_t energy = 0;          // final energy
   size_t arena_bytes = 0;      // bytes this stage carved from the arena
@@ -99,7 +100,8 @@ class DepthStage {
   uint16_t* weight_right_ = nullptr;  // w_pq to the right neighbour; D_p(f_p + 1) when refining
   uint16_t* weight_down_ = nullptr;
   enum : uint8_t { kFree = 0, kKeep = 1, kTake = 2 };
-  uint8_t* state_ = nullptr;  // per pixel in a move: free for the cut, or fixed
+  uint8_t* state_ = nullptr;   // per pixel in a move: free for the cut, or fixed
+  uint16_t* reach_ = nullptr;  // per pixel: sum of its pair weights times smooth_trunc
   int64_t energy_ = 0;
 };
 

@@ -22,17 +22,10 @@ void GridMaxflow::Reset(int32_t width, int32_t height) {
   flow_ = 0;
 }
 
-bool GridMaxflow::HasNeighbour(int32_t p, int dir) const {
-  switch (dir) {
-    case kRight:
-      return (p % width_) != width_ - 1;
-    case kLeft:
-      return (p % width_) != 0;
-    case kDown:
-      return p + width_ < count_;
-    default:
-      return p >= width_;
-  }
+uint32_t GridMaxflow::NeighbourMask(int32_t p) const {
+  const int32_t x = p % width_;  // one division per visit, not one per direction
+  return (x != width_ - 1 ? 1u << kRight : 0u) | (x != 0 ? 1u << kLeft : 0u) |
+         (p + width_ < count_ ? 1u << kDown : 0u) | (p >= width_ ? 1u << kUp : 0u);
 }
 
 void GridMaxflow::Activate(int32_t p) {
@@ -133,8 +126,9 @@ void GridMaxflow::Adopt(int32_t p) {
   const bool source = n.tree == kSourceTree;
   int best_dir = -1;
   uint32_t best_dist = UINT32_MAX;
+  const uint32_t mask = NeighbourMask(p);
   for (int dir = 0; dir < 4; ++dir) {
-    if (!HasNeighbour(p, dir)) continue;
+    if (!(mask & (1u << dir))) continue;
     const int32_t q = Neighbour(p, dir);
     if (nodes_[q].tree != n.tree) continue;
     // The arc that would carry flow from the new parent: q->p in the source tree, p->q in the sink.
@@ -183,7 +177,7 @@ void GridMaxflow::Adopt(int32_t p) {
   // No parent: p leaves its tree. Neighbours that could feed it become active again, and its
   // children become orphans.
   for (int dir = 0; dir < 4; ++dir) {
-    if (!HasNeighbour(p, dir)) continue;
+    if (!(mask & (1u << dir))) continue;
     const int32_t q = Neighbour(p, dir);
     Node& m = nodes_[q];
     if (m.tree != n.tree) continue;
@@ -226,8 +220,9 @@ int64_t GridMaxflow::Solve() {
     const bool source = n.tree == kSourceTree;
     int32_t touch_s = -1;
     int touch_dir = 0;
+    const uint32_t mask = NeighbourMask(p);
     for (int dir = 0; dir < 4 && touch_s < 0; ++dir) {
-      if (!HasNeighbour(p, dir)) continue;
+      if (!(mask & (1u << dir))) continue;
       const int32_t q = Neighbour(p, dir);
       const int32_t c = source ? n.cap[dir] : nodes_[q].cap[dir ^ 1];
       if (c <= 0) continue;

@@ -77,8 +77,8 @@ class GridMaxflow {
         return p - width_;
     }
   }
-  // The set of directions whose neighbour exists, for node p at (x, y).
-  bool HasNeighbour(int32_t p, int dir) const;
+  // Bit d set when node p has a neighbour in direction d.
+  uint32_t NeighbourMask(int32_t p) const;
 
   void Activate(int32_t p);
   int32_t NextActive();

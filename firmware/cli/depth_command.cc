@@ -1,0 +1,170 @@
+// refocus depth: rectified, equally spaced views (left to right) -> the reference view's
+// disparity in px per view step as a PFM, and optionally a colour-mapped PNG preview.
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "algo/core/color.h"
+#include "algo/depth/depth_stage.h"
+#include "firmware/cli/commands.h"
+#include "firmware/cli/options.h"
+#include "firmware/depth_out/depth_out.h"
+#include "sim/files/image_file.h"
+
+namespace lb::cli {
+namespace {
+
+const char kUsage[] =
+    "usage: refocus depth --views F1 F2 ... --disparity-out D.pfm [options]\n"
+    "\n"
+    "  --views F1 F2 ...      the views, left to right, rectified and equally spaced\n"
+    "                         (PPM, PGM, PNG or JPEG, all the same size)\n"
+    "  --ref K                reference view, 0-based (default: the middle one)\n"
+    "  --disparity-out D.pfm  disparity of the reference view, px per view step (PFM)\n"
+    "  --preview P.png        colour-mapped preview (blue far .. red near)\n"
+    "  --labels N             disparity labels, 2..256 (default 64)\n"
+    "  --disparity MIN,MAX    label range in px per view step (default 0 and (N-1)/4:\n"
+    "                         quarter-pixel labels)\n"
+    "  --smoothness W         smoothness weight, 0..4096 (default %d)\n"
+    "  --cycles N             expansion cycle cap, 0..32 (default %d)\n";
+
+int Usage(const char* problem) {
+  if (problem) fprintf(stderr, "refocus depth: %s\n", problem);
+  const DepthConfig defaults;
+  fprintf(stderr, kUsage, defaults.smooth_weight, defaults.max_cycles);
+  return 2;
+}
+
+// Reads an image file of any supported format as tightly packed RGB8.
+Status ReadRgb(const char* path, int32_t* width, int32_t* height, std::vector<uint8_t>* rgb) {
+  ImageFileInfo info;
+  std::vector<uint8_t> pixels;
+  LB_RETURN_IF_ERROR(ReadImageFile(path, &info, &pixels));
+  const int bpp = BytesPerPixel(info.format);
+  *width = info.width;
+  *height = info.height;
+  rgb->resize(static_cast<size_t>(info.width) * info.height * 3);
+  for (int32_t y = 0; y < info.height; ++y) {
+    RowToRgb8(info.format, pixels.data() + static_cast<size_t>(y) * info.width * bpp, nullptr,
+              info.width, rgb->data() + static_cast<size_t>(y) * info.width * 3);
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+int DepthCommand(int argc, char** argv) {
+  std::vector<const char*> files;
+  const char* pfm = nullptr;
+  const char* preview = nullptr;
+  int32_t ref = -1;
+  DepthConfig c;
+  c.labels = 64;
+  float disp_min = 0, disp_max = -1;
+  std::string error;
+  for (int i = 0; i < argc; ++i) {
+    const char* a = argv[i];
+    const char* value = i + 1 < argc ? argv[i + 1] : nullptr;
+    auto need = [&]() {
+      if (!value) error = std::string(a) + " needs a value";
+      return value != nullptr;
+    };
+    bool ok = true;
+    if (!strcmp(a, "--views")) {
+      while (i + 1 < argc && strncmp(argv[i + 1], "--", 2) != 0) files.push_back(argv[++i]);
+      continue;
+    } else if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+      return Usage(nullptr);
+    } else if (!strcmp(a, "--disparity-out")) {
+      ok = need() && (pfm = argv[++i]);
+    } else if (!strcmp(a, "--preview")) {
+      ok = need() && (preview = argv[++i]);
+    } else if (!strcmp(a, "--ref")) {
+      ok = need() && ParseInt(argv[++i], 0, DepthConfig::kMaxViews - 1, &ref, &error);
+    } else if (!strcmp(a, "--labels")) {
+      ok = need() && ParseInt(argv[++i], 2, DepthConfig::kMaxLabels, &c.labels, &error);
+    } else if (!strcmp(a, "--smoothness")) {
+      ok = need() && ParseInt(argv[++i], 0, 4096, &c.smooth_weight, &error);
+    } else if (!strcmp(a, "--cycles")) {
+      ok = need() && ParseInt(argv[++i], 0, 32, &c.max_cycles, &error);
+    } else if (!strcmp(a, "--disparity")) {
+      ok = need();
+      if (ok) {
+        const char* text = argv[++i];
+        const char* comma = strchr(text, ',');
+        if (!comma) {
+          error = std::string("--disparity wants MIN,MAX, got \"") + text + "\"";
+          ok = false;
+        } else {
+          const std::string lo(text, comma);
+          ok = ParseFloat(lo.c_str(), 0, 255, &disp_min, &error) &&
+               ParseFloat(comma + 1, 0, 255, &disp_max, &error);
+        }
+      }
+    } else {
+      error = std::string("unknown option \"") + a + "\"";
+      ok = false;
+    }
+    if (!ok) return Usage(error.c_str());
+  }
+  if (files.size() < 2) return Usage("--views needs at least two files");
+  if (files.size() > static_cast<size_t>(DepthConfig::kMaxViews)) {
+    return Usage("--views takes at most 16 files");
+  }
+  if (!pfm) return Usage("--disparity-out is required");
+  c.views = static_cast<int32_t>(files.size());
+  c.reference = ref < 0 ? c.views / 2 : ref;
+  if (c.reference >= c.views) return Usage("--ref is past the last view");
+  if (disp_max < 0) disp_max = static_cast<float>(c.labels - 1) / 4.0f;
+  c.disp_min_q8 = static_cast<int32_t>(disp_min * 256.0f + 0.5f);
+  c.disp_max_q8 = static_cast<int32_t>(disp_max * 256.0f + 0.5f);
+
+  std::vector<std::vector<uint8_t>> pixels(files.size());
+  for (size_t v = 0; v < files.size(); ++v) {
+    int32_t w = 0, h = 0;
+    const Status read = ReadRgb(files[v], &w, &h, &pixels[v]);
+    if (!read.ok()) return Fail(read.message());
+    if (v == 0) {
+      c.width = w;
+      c.height = h;
+    } else if (w != c.width || h != c.height) {
+      char msg[512];
+      snprintf(msg, sizeof(msg), "%s is %dx%d, but %s is %dx%d: the views must match", files[v], w,
+               h, files[0], c.width, c.height);
+      return Fail(msg);
+    }
+  }
+  const Status valid = DepthStage::Validate(c);
+  if (!valid.ok()) return Fail(valid.message());
+
+  const size_t bytes = DepthStage::RequiredBytes(c);
+  std::vector<uint8_t> memory(bytes + Arena::kAlign);
+  const uintptr_t base = (reinterpret_cast<uintptr_t>(memory.data()) + Arena::kAlign - 1) &
+                         ~uintptr_t{Arena::kAlign - 1};
+  Arena arena(reinterpret_cast<void*>(base), bytes);
+  DepthStage stage;
+  Status s = stage.Configure(c, arena);
+  if (!s.ok()) return Fail(s.message());
+  std::vector<ConstImageU8> views;
+  for (const auto& p : pixels) views.push_back(MakeView(p.data(), c.width, c.height, 3));
+  std::vector<uint16_t> disp(static_cast<size_t>(c.width) * c.height);
+  const ImageU16 out = MakeView(disp.data(), c.width, c.height);
+  s = stage.Compute(views.data(), out);
+  if (!s.ok()) return Fail(s.message());
+  s = WriteDisparityPfm(pfm, out);
+  if (!s.ok()) return Fail(s.message());
+  if (preview) {
+    s = WriteDisparityPreview(preview, out, c.disp_min_q8, c.disp_max_q8);
+    if (!s.ok()) return Fail(s.message());
+  }
+  const DepthStats& st = stage.stats();
+  printf(
+      "%s: %dx%d, %d views (reference %d), %d labels %.2f..%.2f px/step, %d cycles, %zu arena "
+      "bytes\n",
+      pfm, c.width, c.height, c.views, c.reference, c.labels, c.disp_min_q8 / 256.0,
+      c.disp_max_q8 / 256.0, st.cycles, st.arena_bytes);
+  return 0;
+}
+
+}  // namespace lb::cli

@@ -1,0 +1,117 @@
+#include "firmware/depth_out/depth_out.h"
+
+#include <png.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace lb {
+namespace {
+
+// Writes through a temporary file and renames it over `path` only when everything succeeded.
+class TempFile {
+ public:
+  explicit TempFile(const char* path) : path_(path), temp_(std::string(path) + ".tmp") {}
+  ~TempFile() {
+    if (file_) fclose(file_);
+    if (!committed_) remove(temp_.c_str());
+  }
+  Status Open() {
+    file_ = fopen(temp_.c_str(), "wb");
+    if (!file_)
+      return Status(Code::kIoError, "%s: cannot create: %s", temp_.c_str(), strerror(errno));
+    return Status::Ok();
+  }
+  FILE* file() { return file_; }
+  Status Commit() {
+    const bool write_error = ferror(file_) != 0;
+    const int closed = fclose(file_);
+    file_ = nullptr;
+    if (write_error || closed != 0) {
+      return Status(Code::kIoError, "%s: write failed: %s", path_.c_str(), strerror(errno));
+    }
+    if (rename(temp_.c_str(), path_.c_str()) != 0) {
+      return Status(Code::kIoError, "%s: cannot rename into place: %s", path_.c_str(),
+                    strerror(errno));
+    }
+    committed_ = true;
+    return Status::Ok();
+  }
+
+ private:
+  std::string path_, temp_;
+  FILE* file_ = nullptr;
+  bool committed_ = false;
+};
+
+Status CheckMap(const char* path, ConstImageU16 disp_q8) {
+  if (disp_q8.empty() || disp_q8.channels != 1) {
+    return Status(Code::kInvalidArgument, "%s: no single-channel disparity map to write", path);
+  }
+  return Status::Ok();
+}
+
+}  // namespace
+
+Status WriteDisparityPfm(const char* path, ConstImageU16 disp_q8) {
+  LB_RETURN_IF_ERROR(CheckMap(path, disp_q8));
+  TempFile out(path);
+  LB_RETURN_IF_ERROR(out.Open());
+  fprintf(out.file(), "Pf\n%d %d\n-1.0\n", disp_q8.width, disp_q8.height);
+  std::vector<uint8_t> row(static_cast<size_t>(disp_q8.width) * 4);
+  for (int32_t y = disp_q8.height - 1; y >= 0; --y) {
+    const uint16_t* src = disp_q8.Row(y);
+    for (int32_t x = 0; x < disp_q8.width; ++x) {
+      const float v = static_cast<float>(src[x]) / 256.0f;
+      uint32_t bits;
+      memcpy(&bits, &v, 4);
+      for (int b = 0; b < 4; ++b) row[4 * x + b] = static_cast<uint8_t>(bits >> (8 * b));
+    }
+    fwrite(row.data(), 1, row.size(), out.file());
+  }
+  return out.Commit();
+}
+
+void DisparityColour(int32_t disp_q8, int32_t min_q8, int32_t max_q8, uint8_t rgb[3]) {
+  const int32_t span = max_q8 > min_q8 ? max_q8 - min_q8 : 1;
+  int32_t v = disp_q8 < min_q8 ? min_q8 : (disp_q8 > max_q8 ? max_q8 : disp_q8);
+  // Position on the ramp, 0..1023: four segments of 256.
+  const int32_t t = static_cast<int32_t>((int64_t{v - min_q8} * 1023) / span);
+  const int32_t seg = t >> 8, f = t & 255;
+  static constexpr uint8_t kStops[5][3] = {
+      {0, 0, 255}, {0, 255, 255}, {0, 255, 0}, {255, 255, 0}, {255, 0, 0}};
+  for (int c = 0; c < 3; ++c) {
+    const int32_t a = kStops[seg][c], b = kStops[seg + 1][c];
+    rgb[c] = static_cast<uint8_t>(a + ((b - a) * f + 128) / 256);
+  }
+}
+
+Status WriteDisparityPreview(const char* path, ConstImageU16 disp_q8, int32_t min_q8,
+                             int32_t max_q8) {
+  LB_RETURN_IF_ERROR(CheckMap(path, disp_q8));
+  TempFile out(path);
+  LB_RETURN_IF_ERROR(out.Open());
+  std::vector<uint8_t> pixels(static_cast<size_t>(disp_q8.width) * disp_q8.height * 3);
+  for (int32_t y = 0; y < disp_q8.height; ++y) {
+    for (int32_t x = 0; x < disp_q8.width; ++x) {
+      DisparityColour(disp_q8.Row(y)[x], min_q8, max_q8,
+                      &pixels[(static_cast<size_t>(y) * disp_q8.width + x) * 3]);
+    }
+  }
+  // libpng's simplified API reports errors through image.message instead of longjmp.
+  png_image image;
+  memset(&image, 0, sizeof(image));
+  image.version = PNG_IMAGE_VERSION;
+  image.width = static_cast<png_uint_32>(disp_q8.width);
+  image.height = static_cast<png_uint_32>(disp_q8.height);
+  image.format = PNG_FORMAT_RGB;
+  if (!png_image_write_to_stdio(&image, out.file(), 0, pixels.data(), 0, nullptr)) {
+    return Status(Code::kIoError, "%s: PNG encoder: %s", path, image.message);
+  }
+  return out.Commit();
+}
+
+}  // namespace lb

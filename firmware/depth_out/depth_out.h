@@ -1,0 +1,24 @@
+// Writing a disparity map out of the product: a PFM (Middlebury's float format, px per view step
+// for the reference view) and a colour-mapped PNG preview. Both write a temporary file next to
+// the target and rename it into place, so a failure never leaves a half-written output.
+#pragma once
+
+#include <cstdint>
+
+#include "algo/core/image.h"
+#include "algo/core/status.h"
+
+namespace lb {
+
+// Single-channel PFM ("Pf"), little-endian (scale -1), rows bottom to top, values dispQ8 / 256.
+Status WriteDisparityPfm(const char* path, ConstImageU16 disp_q8);
+
+// RGB8 colour of a disparity on a blue (far) - cyan - green - yellow - red (near) ramp over
+// [min_q8, max_q8]; values outside are clamped.
+void DisparityColour(int32_t disp_q8, int32_t min_q8, int32_t max_q8, uint8_t rgb[3]);
+
+// The preview PNG: one DisparityColour per pixel. Allocates one row.
+Status WriteDisparityPreview(const char* path, ConstImageU16 disp_q8, int32_t min_q8,
+                             int32_t max_q8);
+
+}  // namespace lb

@@ -1,0 +1,161 @@
+// The depth stage on Middlebury teddy (9 views, 450x375, 64 quarter-pixel labels), one thread,
+// and - when OpenCV is installed - OpenCV's StereoSGBM on the same set's im2/im6 pair, so the
+// ratio is measured side by side on the same machine.
+//   build/host/tests/bench/depth/depth_bench --benchmark_counters_tabular=true
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <vector>
+
+#include "algo/depth/depth_stage.h"
+#include "tests/algo/depth/middlebury.h"
+
+#ifdef LB_HAVE_OPENCV
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/core/utility.hpp>
+#endif
+
+namespace lb {
+namespace {
+
+const middlebury::Set* Teddy() {
+  static middlebury::Set set;
+  static bool loaded = false;
+  if (!loaded) {
+    const std::string dir = middlebury::DataDir();
+    if (dir.empty() || !middlebury::Load(dir, "teddy", &set).ok()) return nullptr;
+    loaded = true;
+  }
+  return &set;
+}
+
+void BM_DepthStageTeddy(benchmark::State& state) {
+  const middlebury::Set* set = Teddy();
+  if (!set) {
+    state.SkipWithError("../shared/data/middlebury/teddy is absent");
+    return;
+  }
+  DepthConfig c;
+  c.width = set->width;
+  c.height = set->height;
+  c.views = static_cast<int32_t>(set->views.size());
+  c.reference = set->reference;
+  c.labels = 64;
+  c.disp_max_q8 = 63 * 64;
+  const size_t bytes = DepthStage::RequiredBytes(c);
+  std::vector<uint8_t> memory(bytes + Arena::kAlign);
+  const uintptr_t base = (reinterpret_cast<uintptr_t>(memory.data()) + Arena::kAlign - 1) &
+                         ~uintptr_t{Arena::kAlign - 1};
+  Arena arena(reinterpret_cast<void*>(base), bytes);
+  DepthStage stage;
+  if (!stage.Configure(c, arena).ok()) {
+    state.SkipWithError("configure failed");
+    return;
+  }
+  const std::vector<ConstImageU8> views = set->Views();
+  std::vector<uint16_t> disp(static_cast<size_t>(c.width) * c.height);
+  const ImageU16 out = MakeView(disp.data(), c.width, c.height);
+  for (auto _ : state) {
+    if (!stage.Compute(views.data(), out).ok()) state.SkipWithError("compute failed");
+    benchmark::DoNotOptimize(disp.data());
+  }
+  state.counters["labels"] = c.labels;
+  state.counters["cycles"] = stage.stats().cycles;
+  state.counters["arena_MiB"] = static_cast<double>(stage.stats().arena_bytes) / (1 << 20);
+  state.counters["cut_px_per_move"] =
+      static_cast<double>(stage.stats().cut_pixels) / (c.labels * stage.stats().cycles + 1e-9);
+  state.counters["bad_pct"] = middlebury::BadPixelPercent(*set, out.AsConst());
+}
+BENCHMARK(BM_DepthStageTeddy)->Unit(benchmark::kMillisecond)->MinTime(3.0);
+
+// The 640x480, 7 views, 64 labels configuration the memory bound is stated for, on teddy's
+// views cropped/tiled to that size (time only; there is no ground truth at this size).
+void BM_DepthStage640x480(benchmark::State& state) {
+  const middlebury::Set* set = Teddy();
+  if (!set) {
+    state.SkipWithError("../shared/data/middlebury/teddy is absent");
+    return;
+  }
+  DepthConfig c;
+  c.width = 640;
+  c.height = 480;
+  c.views = 7;
+  c.reference = 3;
+  c.labels = 64;
+  c.disp_max_q8 = 63 * 64;
+  std::vector<std::vector<uint8_t>> pixels(7, std::vector<uint8_t>(640 * 480 * 3));
+  for (int32_t v = 0; v < 7; ++v) {
+    for (int32_t y = 0; y < 480; ++y) {
+      for (int32_t x = 0; x < 640; ++x) {
+        // Mirror-tile the set's view v+1 so the scene stays continuous.
+        const int32_t sx = (x / set->width) % 2 ? set->width - 1 - x % set->width : x % set->width;
+        const int32_t sy =
+            (y / set->height) % 2 ? set->height - 1 - y % set->height : y % set->height;
+        for (int c3 = 0; c3 < 3; ++c3)
+          pixels[v][(y * 640 + x) * 3 + c3] = set->views[v + 1][(sy * set->width + sx) * 3 + c3];
+      }
+    }
+  }
+  const size_t bytes = DepthStage::RequiredBytes(c);
+  std::vector<uint8_t> memory(bytes + Arena::kAlign);
+  const uintptr_t base = (reinterpret_cast<uintptr_t>(memory.data()) + Arena::kAlign - 1) &
+                         ~uintptr_t{Arena::kAlign - 1};
+  Arena arena(reinterpret_cast<void*>(base), bytes);
+  DepthStage stage;
+  if (!stage.Configure(c, arena).ok()) {
+    state.SkipWithError("configure failed");
+    return;
+  }
+  std::vector<ConstImageU8> views;
+  for (const auto& p : pixels) views.push_back(MakeView(p.data(), 640, 480, 3));
+  std::vector<uint16_t> disp(640 * 480);
+  for (auto _ : state) {
+    if (!stage.Compute(views.data(), MakeView(disp.data(), 640, 480)).ok())
+      state.SkipWithError("compute failed");
+  }
+  state.counters["labels"] = c.labels;
+  state.counters["cycles"] = stage.stats().cycles;
+  state.counters["arena_MiB"] = static_cast<double>(bytes) / (1 << 20);
+}
+BENCHMARK(BM_DepthStage640x480)->Unit(benchmark::kMillisecond)->MinTime(3.0);
+
+#ifdef LB_HAVE_OPENCV
+// Two-view SGBM on im2/im6 (disparities 0..63 px over 4 view steps, the same depth range as the
+// 64 quarter-pixel labels above), single thread.
+void BM_OpenCvSgbmTeddy(benchmark::State& state) {
+  const middlebury::Set* set = Teddy();
+  if (!set) {
+    state.SkipWithError("../shared/data/middlebury/teddy is absent");
+    return;
+  }
+  cv::setNumThreads(1);
+  // OpenCV wants BGR; the cost is colour-order independent, so the RGB bytes are used as they are.
+  const cv::Mat left(set->height, set->width, CV_8UC3, const_cast<uint8_t*>(set->views[2].data()));
+  const cv::Mat right(set->height, set->width, CV_8UC3, const_cast<uint8_t*>(set->views[6].data()));
+  const int block = 5;
+  auto sgbm = cv::StereoSGBM::create(0, 64, block, 8 * 3 * block * block, 32 * 3 * block * block, 1,
+                                     63, 10, 100, 32, cv::StereoSGBM::MODE_SGBM);
+  cv::Mat disp;
+  for (auto _ : state) {
+    sgbm->compute(left, right, disp);
+    benchmark::DoNotOptimize(disp.data);
+  }
+  // SGBM gives 1/16 px over im2-im6; the score wants px per view step in Q8.
+  std::vector<uint16_t> q8(static_cast<size_t>(set->width) * set->height);
+  for (int32_t y = 0; y < set->height; ++y)
+    for (int32_t x = 0; x < set->width; ++x) {
+      const int16_t d = disp.at<int16_t>(y, x);
+      q8[y * set->width + x] = static_cast<uint16_t>(d < 0 ? 0 : d * 4);  // /16 px, /4 steps, *256
+    }
+  state.counters["labels"] = 64;
+  state.counters["bad_pct"] =
+      middlebury::BadPixelPercent(*set, MakeView(q8.data(), set->width, set->height).AsConst());
+}
+BENCHMARK(BM_OpenCvSgbmTeddy)->Unit(benchmark::kMillisecond)->MinTime(3.0);
+#endif
+
+}  // namespace
+}  // namespace lb
+
+BENCHMARK_MAIN();
