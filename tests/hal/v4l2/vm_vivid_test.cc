@@ -197,6 +197,26 @@ TEST_F(VividTest, BufferFlaggedBadIsDetected) {
   ASSERT_TRUE(s.ok()) << s.message();
 }
 
+TEST_F(VividTest, UnpluggedCameraIsReportedAndComesBack) {
+  V4l2Sensor sensor(Options());
+  SensorMode mode;
+  ASSERT_TRUE(sensor.Configure(Burst(3), &mode).ok());
+  // vivid's Disconnect acts like a USB unplug until every open handle is closed.
+  ASSERT_TRUE(SetControl(device_, "Disconnect", 1));
+  FrameCheck sink;
+  Status s = sensor.CaptureBurst(sink);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(std::string(s.message()).find("No such device"), std::string::npos) << s.message();
+  printf("unplugged camera: %s\n", s.message());
+  sensor.Stop();
+  s = sensor.Configure(Burst(3), &mode);
+  ASSERT_TRUE(s.ok()) << s.message();
+  FrameCheck again;
+  s = sensor.CaptureBurst(again);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(again.frames.size(), 3u);
+}
+
 TEST_F(VividTest, SecondOpenerFindsTheDeviceBusy) {
   V4l2Sensor first(Options());
   SensorMode mode;
