@@ -112,6 +112,7 @@ void LayerPlane::Carve(Arena& arena, int32_t width, int32_t height, int32_t chan
   tile_shift_ = 6;
   while ((width + (1 << tile_shift_) - 1) >> tile_shift_ > 64) ++tile_shift_;
   tiles_ = arena.Allocate<uint64_t>(static_cast<size_t>(ring_rows_) * layers);
+  pure_ = arena.Allocate<uint64_t>(static_cast<size_t>(ring_rows_) * layers);
   prefix_ = arena.Allocate<uint32_t>(static_cast<size_t>(window_rows_) * planes * pitch_);
   active_ = arena.Allocate<uint8_t>(static_cast<size_t>(window_rows_));
   box_ = arena.Allocate<int32_t>(planes * pitch_);
@@ -147,13 +148,21 @@ void LayerPlane::Begin(const ApertureShape& shape, int32_t shift) {
 
 void LayerPlane::CommitRow(int32_t y, const uint16_t* layer_of, int32_t offset) {
   uint64_t* tiles = tiles_ + Slot(y) * layers_;
-  for (int32_t k = 0; k < layers_; ++k) tiles[k] = 0;
+  uint64_t* pure = pure_ + Slot(y) * layers_;
+  for (int32_t k = 0; k < layers_; ++k) tiles[k] = 0, pure[k] = 0;
   const int16_t* s = RadiusRow(y);
-  for (int32_t x = 0; x < width_; ++x) {
-    const uint16_t e = layer_of[s[x] + offset];
-    const uint64_t bit = uint64_t{1} << (x >> tile_shift_);
-    tiles[e >> 8] |= bit;
-    if (e & 255) tiles[(e >> 8) + 1] |= bit;
+  for (int32_t x0 = 0, t = 0; x0 < width_; x0 += 1 << tile_shift_, ++t) {
+    const int32_t x1 = Min(width_, x0 + (1 << tile_shift_));
+    const uint64_t bit = uint64_t{1} << t;
+    const uint16_t e0 = layer_of[s[x0] + offset];
+    bool same = (e0 & 255) == 0;
+    for (int32_t x = x0; x < x1; ++x) {
+      const uint16_t e = layer_of[s[x] + offset];
+      same = same && e == e0;
+      tiles[e >> 8] |= bit;
+      if (e & 255) tiles[(e >> 8) + 1] |= bit;
+    }
+    if (same) pure[e0 >> 8] |= bit;  // every pixel of the tile wholly in one layer
   }
   next_row_ = y + 1;
 }
@@ -167,71 +176,106 @@ uint64_t LayerPlane::Tiles(int32_t k, int32_t y0, int32_t y1) const {
 void LayerPlane::BuildPrefix(int32_t k, int32_t level, int32_t h, int32_t jlo, int32_t jhi,
                              int32_t x0, int32_t x1, uint64_t run, int32_t base,
                              const uint16_t* layer_of, int32_t offset) {
-  const int32_t planes = channels_ + 1;
+  if (channels_ == 1) {
+    BuildPrefixT<1>(k, level, h, jlo, jhi, x0, x1, run, base, layer_of, offset);
+  } else {
+    BuildPrefixT<2>(k, level, h, jlo, jhi, x0, x1, run, base, layer_of, offset);
+  }
+}
+
+template <int C>
+void LayerPlane::BuildPrefixT(int32_t k, int32_t level, int32_t h, int32_t jlo, int32_t jhi,
+                              int32_t x0, int32_t x1, uint64_t run, int32_t base,
+                              const uint16_t* layer_of, int32_t offset) {
   const int32_t pad = pitch_ - width_ - (pitch_ - width_) / 2;  // room for indices below 0
   const int32_t q0 = x0 >> level, q1 = x1 >> level;             // the run's columns at this level
+  const int32_t shift = shift_;
+  const int32_t tile = 1 << tile_shift_;
+  // Weight (Q8) of layer k in a pixel whose layer entry is e.
+  auto weight = [k](uint16_t e) {
+    const int32_t first = e >> 8, frac = e & 255;
+    return first == k ? 256 - frac : (first + 1 == k ? frac : 0);
+  };
   for (int32_t m = jlo; m < jhi; ++m) {
     uint8_t& active = active_[m - base];
     active = (Tiles(k, m << level, (m + 1) << level) & run) != 0;
     if (!active) continue;
-    uint32_t* p[kMaxChannels + 1];
-    for (int32_t c = 0; c < planes; ++c) {
-      p[c] = prefix_ + ((m - base) * planes + c) * static_cast<ptrdiff_t>(pitch_) + pad;
+    uint32_t* p[C + 1];
+    for (int32_t c = 0; c <= C; ++c) {
+      p[c] = prefix_ + ((m - base) * (C + 1) + c) * static_cast<ptrdiff_t>(pitch_) + pad;
       for (int32_t x = q0 - h; x <= q0; ++x) p[c][x] = 0;
     }
     if (level == 0) {
       const int16_t* s = RadiusRow(m);
-      const int16_t* v[kMaxChannels];
-      for (int32_t c = 0; c < channels_; ++c) v[c] = ValueRow(m, c);
-      for (int32_t x = x0; x <= x1; ++x) {
-        const uint16_t e = layer_of[s[x] + offset];
-        const int32_t first = e >> 8, frac = e & 255;
-        const int32_t a = first == k ? 256 - frac : (first + 1 == k ? frac : 0);
-        for (int32_t c = 0; c < channels_; ++c) {
-          p[c][x + 1] = p[c][x] + static_cast<uint32_t>((v[c][x] * a) >> shift_);
+      const int16_t* v[C];
+      for (int32_t c = 0; c < C; ++c) v[c] = ValueRow(m, c);
+      const uint64_t any = tiles_[Slot(m) * layers_ + k], pure = pure_[Slot(m) * layers_ + k];
+      for (int32_t t0 = x0; t0 <= x1; t0 += tile) {
+        const int32_t t1 = Min(x1, t0 + tile - 1);
+        const uint64_t bit = uint64_t{1} << (t0 >> tile_shift_);
+        if (!(any & bit)) {  // the layer is absent from this tile: the prefix stays flat
+          for (int32_t c = 0; c <= C; ++c) {
+            for (int32_t x = t0; x <= t1; ++x) p[c][x + 1] = p[c][x];
+          }
+        } else if (pure & bit) {  // wholly in the layer: weight 256 everywhere
+          for (int32_t c = 0; c < C; ++c) {
+            for (int32_t x = t0; x <= t1; ++x) {
+              p[c][x + 1] = p[c][x] + static_cast<uint32_t>((v[c][x] * 256) >> shift);
+            }
+          }
+          for (int32_t x = t0; x <= t1; ++x) p[C][x + 1] = p[C][x] + 256;
+        } else {
+          for (int32_t x = t0; x <= t1; ++x) {
+            const int32_t a = weight(layer_of[s[x] + offset]);
+            for (int32_t c = 0; c < C; ++c) {
+              p[c][x + 1] = p[c][x] + static_cast<uint32_t>((v[c][x] * a) >> shift);
+            }
+            p[C][x + 1] = p[C][x] + static_cast<uint32_t>(a);
+          }
         }
-        p[channels_][x + 1] = p[channels_][x] + static_cast<uint32_t>(a);
       }
     } else {
-      // Box means over 2^level x 2^level pixels of the layer's values and weights.
-      for (int32_t c = 0; c < planes; ++c) {
-        int32_t* box = box_ + c * static_cast<ptrdiff_t>(pitch_);
-        for (int32_t i = q0; i <= q1; ++i) box[i] = 0;
+      // Box means over 2^level x 2^level pixels of the layer's values and weights; each box's
+      // row is summed in registers and added once.
+      int32_t* box[C + 1];
+      for (int32_t c = 0; c <= C; ++c) {
+        box[c] = box_ + c * static_cast<ptrdiff_t>(pitch_);
+        for (int32_t i = q0; i <= q1; ++i) box[c][i] = 0;
       }
       const int32_t end = Min(height_, (m + 1) << level);
-      int32_t* box_a = box_ + channels_ * static_cast<ptrdiff_t>(pitch_);
       for (int32_t j = m << level; j < end; ++j) {
-        if (!(tiles_[Slot(j) * layers_ + k] & run)) continue;
+        const uint64_t any = tiles_[Slot(j) * layers_ + k] & run;
+        if (!any) continue;
+        const uint64_t pure = pure_[Slot(j) * layers_ + k];
         const int16_t* s = RadiusRow(j);
-        const int16_t* v0 = ValueRow(j, 0);
-        const int16_t* v1 = channels_ > 1 ? ValueRow(j, 1) : v0;
-        // Sum each box's row in registers, then add it once: no store-to-load chain.
-        for (int32_t q = q0; q <= q1; ++q) {
-          int32_t sum0 = 0, sum1 = 0, sum_a = 0;
-          const int32_t xe = Min(x1, ((q + 1) << level) - 1);
-          for (int32_t x = q << level; x <= xe; ++x) {
-            const uint16_t e = layer_of[s[x] + offset];
-            const int32_t first = e >> 8, frac = e & 255;
-            const int32_t a = first == k ? 256 - frac : (first + 1 == k ? frac : 0);
-            sum0 += (v0[x] * a) >> shift_;
-            sum1 += (v1[x] * a) >> shift_;
-            sum_a += a;
+        const int16_t* v[C];
+        for (int32_t c = 0; c < C; ++c) v[c] = ValueRow(j, c);
+        for (int32_t t0 = x0; t0 <= x1; t0 += tile) {
+          const uint64_t bit = uint64_t{1} << (t0 >> tile_shift_);
+          if (!(any & bit)) continue;
+          const int32_t t1 = Min(x1, t0 + tile - 1);
+          const bool whole = (pure & bit) != 0;
+          for (int32_t q = t0 >> level; q <= t1 >> level; ++q) {
+            int32_t sum[C + 1] = {};
+            const int32_t xe = Min(t1, ((q + 1) << level) - 1);
+            for (int32_t x = q << level; x <= xe; ++x) {
+              const int32_t a = whole ? 256 : weight(layer_of[s[x] + offset]);
+              for (int32_t c = 0; c < C; ++c) sum[c] += (v[c][x] * a) >> shift;
+              sum[C] += a;
+            }
+            for (int32_t c = 0; c <= C; ++c) box[c][q] += sum[c];
           }
-          box_[q] += sum0;
-          if (channels_ > 1) box_[pitch_ + q] += sum1;
-          box_a[q] += sum_a;
         }
       }
       const int32_t round = 1 << (2 * level - 1);
-      for (int32_t c = 0; c < planes; ++c) {
-        const int32_t* box = box_ + c * static_cast<ptrdiff_t>(pitch_);
+      for (int32_t c = 0; c <= C; ++c) {
         for (int32_t i = q0; i <= q1; ++i) {
-          p[c][i + 1] = p[c][i] + static_cast<uint32_t>((box[i] + round) >> (2 * level));
+          p[c][i + 1] = p[c][i] + static_cast<uint32_t>((box[c][i] + round) >> (2 * level));
         }
       }
     }
     // Beyond the run the prefix stays flat: the kernel reads up to `h` + 1 columns outside.
-    for (int32_t c = 0; c < planes; ++c) {
+    for (int32_t c = 0; c <= C; ++c) {
       for (int32_t x = q1 + 2; x <= q1 + h + 1; ++x) p[c][x] = p[c][q1 + 1];
     }
   }

@@ -81,6 +81,10 @@ class LayerPlane {
   void BuildPrefix(int32_t k, int32_t level, int32_t half, int32_t jlo, int32_t jhi, int32_t x0,
                    int32_t x1, uint64_t run, int32_t window_base, const uint16_t* layer_of,
                    int32_t offset);
+  template <int C>
+  void BuildPrefixT(int32_t k, int32_t level, int32_t half, int32_t jlo, int32_t jhi, int32_t x0,
+                    int32_t x1, uint64_t run, int32_t window_base, const uint16_t* layer_of,
+                    int32_t offset);
   void RenderRun(int32_t k, int32_t y0, int32_t n, const uint16_t* layer_of, int32_t offset,
                  int32_t kernel, int32_t x0, int32_t x1, uint64_t run);
   // Tiles of layer k in plane rows [y0, y1).
@@ -101,6 +105,8 @@ class LayerPlane {
   int16_t* ring_s_ = nullptr;         // ring_rows x width: signed radius, Q4 full-resolution px
   int16_t* ring_v_ = nullptr;         // ring_rows x channels x width
   uint64_t* tiles_ = nullptr;         // ring_rows x layers: bit t = the layer has a pixel in tile t
+  uint64_t* pure_ = nullptr;          // ring_rows x layers: bit t = every pixel of tile t is wholly
+                                      // in the layer
   int32_t tile_shift_ = 6;            // tiles of 2^tile_shift columns, at most 64 of them
   uint32_t* prefix_ = nullptr;        // window_rows x (channels + 1) x pitch
   uint8_t* active_ = nullptr;         // per window row: the layer has pixels there
