@@ -55,11 +55,14 @@ cache=$(cd "$cache" && pwd)
 work=$(cd "$work" && pwd)
 
 # The kernel: the one linux-image-amd64 points at, unless LB_VM_KERNEL names a version.
-version=${LB_VM_KERNEL:-$(apt-cache depends linux-image-amd64 2>/dev/null |
-  sed -n 's/.*Depends: linux-image-\([0-9].*-amd64\)$/\1/p' | head -n1)}
+version=${LB_VM_KERNEL:-}
+if [[ -z $version ]]; then
+  version=$({ apt-cache depends linux-image-amd64 2>/dev/null || true; } |
+    sed -n 's/.*Depends: linux-image-\([0-9].*-amd64\)$/\1/p' | head -n1)
+fi
 if [[ -z $version ]]; then
   # No package lists: fall back to a kernel already unpacked in the cache.
-  version=$(ls "$cache" 2>/dev/null | sed -n 's/^kernel-//p' | sort -V | tail -n1)
+  version=$(ls "$cache" | sed -n 's/^kernel-//p' | sort -V | tail -n1)
 fi
 [[ -n $version ]] || skip "cannot tell the Debian kernel version (run apt-get update)"
 kroot=$cache/kernel-$version
