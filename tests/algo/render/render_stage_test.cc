@@ -2,23 +2,12 @@
 
 #include <gtest/gtest.h>
 
-#include <atomic>
 #include <cmath>
 #include <cstdlib>
-#include <new>
 #include <vector>
 
+#include "tests/algo/render/alloc_counter.h"
 #include "tests/algo/render/render_util.h"
-
-// Counts heap allocations so a test can prove the render allocates nothing after Configure.
-static std::atomic<int64_t> g_allocations{0};
-void* operator new(size_t n) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(n ? n : 1)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, size_t) noexcept { std::free(p); }
 
 namespace lb {
 namespace {
@@ -223,7 +212,7 @@ TEST(RenderStage, NothingIsAllocatedAfterConfigure) {
   params.aperture = {7, 10.0f, 0.3f};
   params.highlight_gain = 3.0f;
   params.highlight_threshold = 220;
-  const int64_t before = g_allocations.load();
+  const int64_t before = test::AllocationCount();
   bool ok = stage.Begin(scene.Planar(), scene.WorkingDisp(), params).ok();
   int32_t total = 0;
   for (int32_t rows = 1; ok && rows > 0;) {
@@ -232,7 +221,7 @@ TEST(RenderStage, NothingIsAllocatedAfterConfigure) {
     ok = stage.NextStrip(&strip, &y0, &rows).ok();
     total += rows;
   }
-  const int64_t after = g_allocations.load();
+  const int64_t after = test::AllocationCount();
   EXPECT_TRUE(ok);
   EXPECT_EQ(total, 64);
   EXPECT_EQ(after - before, 0);
