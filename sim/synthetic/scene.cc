@@ -103,6 +103,7 @@ const uint8_t kPalette[][3] = {{200, 62, 50},  {52, 118, 200}, {232, 188, 62}, {
                                {176, 88, 168}, {230, 132, 52}, {88, 188, 200}, {222, 218, 206},
                                {120, 80, 60},  {40, 60, 90}};
 constexpr int kPaletteSize = sizeof(kPalette) / sizeof(kPalette[0]);
+static_assert(kPaletteSize >= Scene::kMaxObjects, "every object needs a colour of its own");
 
 // Texture cells in design px: colour blotches, then three octaves of detail.
 // Noise octaves: colour blotches, then detail. Each octave's lattice is turned by its own
@@ -110,14 +111,13 @@ constexpr int kPaletteSize = sizeof(kPalette) / sizeof(kPalette[0]);
 // inv_q16 = 65536 / (cell * h), cells in design px (cm on the ground, twice as large).
 struct Octave {
   int32_t a, b, inv_q16[2];  // [0] objects, [1] ground
-  int32_t weight;
 };
 constexpr Octave kOctaves[5] = {
-    {1, 0, {65536 / 56, 65536 / 112}, 0},  // colour mix
-    {4, 3, {65536 / (20 * 5), 65536 / (40 * 5)}, 5},
-    {12, 5, {65536 / (7 * 13), 65536 / (14 * 13)}, 4},
-    {15, 8, {65536 / (3 * 17), 65536 / (6 * 17)}, 3},
-    {21, 20, {65536 * 4 / (5 * 29), 65536 * 2 / (5 * 29)}, 2},  // 1.25 px: high resolutions only
+    {1, 0, {65536 / 56, 65536 / 112}},  // colour mix
+    {4, 3, {65536 / (20 * 5), 65536 / (40 * 5)}},
+    {12, 5, {65536 / (7 * 13), 65536 / (14 * 13)}},
+    {15, 8, {65536 / (3 * 17), 65536 / (6 * 17)}},
+    {21, 20, {65536 * 4 / (5 * 29), 65536 * 2 / (5 * 29)}},  // 1.25 px: high resolutions only
 };
 
 }  // namespace
@@ -166,11 +166,13 @@ void Scene::BuildLayout(const SceneParams& params) {
   baseline_ = base_baseline * params.disparity_scale;
   const auto depth_of = [&](double disp) { return focal_design_ * base_baseline / disp; };
 
-  for (int i = 0; i < 256 * 256; ++i) noise_[i] = static_cast<uint8_t>(rng.Next() >> 56);
+  for (int i = 0; i < kNoiseSize * kNoiseSize; ++i)
+    noise_[i] = static_cast<uint8_t>(rng.Next() >> 56);
   for (int t = 0; t < 256; ++t)
     fade_[t] = static_cast<uint8_t>((3 * t * t * 256 - 2 * t * t * t) >> 16);
 
   object_count_ = 0;
+  uint32_t used_colors = 0;
   auto add = [&](Shape shape, double depth, double x, double y, double r0, double r1, double angle,
                  uint8_t pattern) -> Object& {
     Object& o = objects_[object_count_++];
@@ -185,7 +187,18 @@ void Scene::BuildLayout(const SceneParams& params) {
     o.pattern = pattern;
     o.salt_x = rng.Int(256);
     o.salt_y = rng.Int(256);
-    const uint8_t* a = kPalette[rng.Int(kPaletteSize)];
+    // A main colour no other object has, so neighbours differ at their shared edges.
+    int32_t pick = rng.Int(kPaletteSize - (object_count_ - 1));
+    int32_t index = 0;
+    for (int32_t c = 0; c < kPaletteSize; ++c) {
+      if (used_colors & (1u << c)) continue;
+      if (pick-- == 0) {
+        index = c;
+        break;
+      }
+    }
+    used_colors |= 1u << index;
+    const uint8_t* a = kPalette[index];
     const uint8_t* b = kPalette[rng.Int(kPaletteSize)];
     for (int k = 0; k < 3; ++k) {
       o.color_a[k] = a[k];
@@ -248,10 +261,10 @@ void Scene::BuildLayout(const SceneParams& params) {
 
   light_count_ = 0;
   if (params.point_lights) {
-    const int32_t count = 5 + rng.Int(3);
+    const int32_t count = 6 + rng.Int(3);
     for (int32_t i = 0; i < count; ++i) {
       const int64_t x = ToFixed(rng.Range(-300, 300), 8);
-      const int64_t y = ToFixed(rng.Range(-225, -5), 8);
+      const int64_t y = ToFixed(rng.Range(-230, -60), 8);
       lights_[light_count_++] = {x, y};
     }
   }
@@ -277,6 +290,8 @@ void Scene::BuildFixedPoint() {
   // The finest octave only where its cells span 2 px or more: below that a camera's optics
   // would blur it, and point-sampling it would alias.
   detail_octaves_ = 1.25 * s >= 2 ? 4 : 3;
+  const int32_t weights[2][4] = {{7, 5, 4, 0}, {6, 5, 3, 2}};  // each sums to 16
+  for (int k = 0; k < 4; ++k) detail_weights_[k] = weights[detail_octaves_ - 3][k];
   for (int32_t i = 0; i < object_count_; ++i) {
     Object& o = objects_[i];
     o.cx_q16 = ToFixed(0.5 * width_ + o.cx * s, 16);
@@ -472,12 +487,13 @@ int32_t Scene::Winner(const ViewMap* maps, const RowState& row, int32_t x2,
                                                    int32_t inv_q16, int32_t sx, int32_t sy) const {
   const int64_t lu = ((u_q8 * a - v_q8 * b) * inv_q16) >> 16;  // Q8 cells
   const int64_t lv = ((u_q8 * b + v_q8 * a) * inv_q16) >> 16;
-  const int32_t iu = static_cast<int32_t>((lu >> 8) + sx) & 255;
-  const int32_t iv = static_cast<int32_t>((lv >> 8) + sy) & 255;
+  constexpr int32_t kMask = kNoiseSize - 1;
+  const int32_t iu = static_cast<int32_t>((lu >> 8) + sx) & kMask;
+  const int32_t iv = static_cast<int32_t>((lv >> 8) + sy) & kMask;
   const int32_t wu = fade_[lu & 255], wv = fade_[lv & 255];
-  const uint8_t* r0 = noise_ + iv * 256;
-  const uint8_t* r1 = noise_ + ((iv + 1) & 255) * 256;
-  const int32_t iu1 = (iu + 1) & 255;
+  const uint8_t* r0 = noise_ + iv * kNoiseSize;
+  const uint8_t* r1 = noise_ + ((iv + 1) & kMask) * kNoiseSize;
+  const int32_t iu1 = (iu + 1) & kMask;
   const int32_t top = r0[iu] * (256 - wu) + r0[iu1] * wu;  // Q8
   const int32_t bot = r1[iu] * (256 - wu) + r1[iu1] * wu;
   return (top * (256 - wv) + bot * wv) >> 8;  // 0..65280, Q8
@@ -501,14 +517,13 @@ void Scene::Shade(int32_t index, int64_t xr_q16, int64_t yr_q16, int32_t* rgb) c
   }
   const int g = ground ? 1 : 0;
   const int32_t mix = Noise(u, v, 1, 0, kOctaves[0].inv_q16[g], o.salt_x, o.salt_y) >> 8;
-  int32_t detail = 0, weights = 0;
+  int32_t detail = 0;
   for (int k = 1; k < detail_octaves_ + 1; ++k) {
     const Octave& oct = kOctaves[k];
-    detail += oct.weight *
+    detail += detail_weights_[k - 1] *
               Noise(u, v, oct.a, oct.b, oct.inv_q16[g], o.salt_x + 61 * k, o.salt_y + 97 * k);
-    weights += oct.weight;
   }
-  detail = detail / weights >> 8;         // 0..255, mostly 90..170
+  detail >>= 12;                          // weights sum to 16: 0..255, mostly 90..170
   int32_t gain_q8 = 64 + detail * 3 / 2;  // about 0.75..1.25
   int32_t base[3];
   for (int c = 0; c < 3; ++c)

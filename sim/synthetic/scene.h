@@ -191,13 +191,16 @@ class Scene {
   ViewMap maps_[kMaxViews][kMaxObjects];
   // Fixed-point resolution constants.
   int64_t half_w_q16_ = 0, half_h_q16_ = 0;
-  int64_t design_per_px_q24_ = 0;  // design px per pixel, Q24
-  int64_t ground_fh_q8_ = 0;       // focal * camera height in px * cm, Q8
-  int64_t ground_h_q8_ = 0;        // camera height in cm, Q8
-  int64_t ground_vmin_q16_ = 0;    // smallest row offset below the centre the ground texture uses
-  int64_t disp_per_rho_q16_ = 0;   // full-resolution px per view step per (1/m), Q16
-  int32_t detail_octaves_ = 3;     // texture octaves the resolution can show
-  uint8_t noise_[256 * 256] = {};
+  int64_t design_per_px_q24_ = 0;   // design px per pixel, Q24
+  int64_t ground_fh_q8_ = 0;        // focal * camera height in px * cm, Q8
+  int64_t ground_h_q8_ = 0;         // camera height in cm, Q8
+  int64_t ground_vmin_q16_ = 0;     // smallest row offset below the centre the ground texture uses
+  int64_t disp_per_rho_q16_ = 0;    // full-resolution px per view step per (1/m), Q16
+  int32_t detail_octaves_ = 3;      // texture octaves the resolution can show
+  int32_t detail_weights_[4] = {};  // sum to 16
+  // Value-noise lattice: small enough to stay in the L1 cache.
+  static constexpr int32_t kNoiseSize = 128;
+  uint8_t noise_[kNoiseSize * kNoiseSize] = {};
   uint8_t fade_[256] = {};            // smoothstep, Q8
   std::vector<uint8_t> corner_rows_;  // 2 x (width + 1) object indices
 };
