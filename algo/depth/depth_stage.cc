@@ -41,7 +41,8 @@ Status DepthStage::Validate(const DepthConfig& c) {
   if (c.color_trunc < 1 || c.color_trunc > 765 || c.census_weight < 0 || c.census_weight > 10 ||
       c.smooth_weight < 0 || c.smooth_weight > 4096 || c.smooth_trunc < 1 || c.smooth_trunc > 64 ||
       c.edge_threshold < 0 || c.edge_threshold > 255 || c.edge_weight_q8 < 0 ||
-      c.edge_weight_q8 > 256 || c.max_cycles < 0 || c.max_cycles > 32) {
+      c.edge_weight_q8 > 256 || c.max_cycles < 0 || c.max_cycles > 32 || c.move_margin < 0 ||
+      c.move_margin > 65535) {
     return Status(Code::kInvalidArgument,
                   "depth: cost parameters out of range (colour %d, census %d, smoothness %d "
                   "trunc %d edge %d/%d, cycles %d)",
@@ -172,6 +173,10 @@ bool DepthStage::Expand(int32_t alpha) {
   // label) or -B (q takes alpha); if that is > 0 whatever the neighbours do, p keeps its label
   // in every optimal move, and if it is < 0 whatever they do, p takes alpha. Each pair term
   // moves the sum by at most w_pq * trunc, which settles most pixels without looking further.
+  // With a move margin, pixels for which alpha costs more than that above their label also keep
+  // it: a restricted move, still an exact cut over the pixels it frees, so the energy still
+  // never rises, over a much smaller graph.
+  const int32_t margin = config_.move_margin > 0 ? config_.move_margin : INT32_MAX;
   int32_t y_lo = h, y_hi = -1;  // rows holding free or switching pixels
   for (int32_t y = 0; y < h; ++y) {
     const int32_t row = y * w;
@@ -182,8 +187,9 @@ bool DepthStage::Expand(int32_t alpha) {
     bool open = false;
     for (int32_t x = 0; x < w; ++x) {
       const int32_t u = ca[x] - cc[x];
-      state[x] = u > reach[x] ? kKeep : kFree;
-      open |= u <= reach[x];
+      const int32_t limit = reach[x] < margin ? reach[x] : margin;
+      state[x] = u > limit ? kKeep : kFree;
+      open |= u <= limit;
     }
     if (!open) continue;
     for (int32_t x = 0; x < w; ++x) {

@@ -39,7 +39,10 @@ struct DepthConfig {
   int32_t edge_threshold = 16;  // 0..255
   int32_t edge_weight_q8 = 64;  // 0..256
   int32_t max_cycles = 1;       // expansion cycles after the winner-take-all start, 0..32
-  bool subpixel = true;         // parabola fit between labels for the output
+  // A move frees only pixels whose D(alpha) is at most this above D(f_p); 0 frees every pixel
+  // that could gain (the full expansion move). 0..65535.
+  int32_t move_margin = 0;
+  bool subpixel = true;  // parabola fit between labels for the output
 };
 
 struct DepthStats {
