@@ -63,7 +63,7 @@ int DepthCommand(int argc, char** argv) {
   c.labels = 64;
   float disp_min = 0, disp_max = -1;
   std::string error;
-  for (int i = 0; i < argc; ++i) {
+  for (int i = 1; i < argc; ++i) {  // argv[0] is the subcommand's name
     const char* a = argv[i];
     const char* value = i + 1 < argc ? argv[i + 1] : nullptr;
     auto need = [&]() {
