@@ -1,5 +1,7 @@
 #include "algo/render/depth_upsample.h"
 
+#include <initializer_list>
+
 namespace lb {
 namespace {
 
@@ -77,11 +79,11 @@ const uint8_t* DepthUpsampler::UniformRow(int32_t wy) {
                              disp_.Row(Min(wy + 1, wh_ - 1))};
   for (int32_t wx = 0; wx < ww_; ++wx) {
     const int32_t l = Max(wx - 1, 0), r = Min(wx + 1, ww_ - 1);
-    const uint16_t v = rows[1][wx];
-    bool same = true;
-    for (int32_t i = 0; i < 3; ++i)
-      same = same && rows[i][l] == v && rows[i][wx] == v && rows[i][r] == v;
-    uniform_[wx] = same ? 1 : 0;
+    int32_t lo = 65535, hi = 0;
+    for (int32_t i = 0; i < 3; ++i) {
+      for (int32_t q : {l, wx, r}) lo = Min(lo, rows[i][q]), hi = Max(hi, rows[i][q]);
+    }
+    uniform_[wx] = hi == lo ? kFlat : (hi - lo <= kSmoothQ8 ? kSmooth : kEdge);
   }
   return uniform_;
 }
@@ -98,27 +100,48 @@ void DepthUpsampler::Row(int32_t y, uint16_t* out) {
   const uint8_t* cb = ref_.planes[1].Row(y / 2);
   const uint8_t* cr = ref_.planes[2].Row(y / 2);
   const uint16_t* wsy = spatial_q8_ + fy * 3;
-  for (int32_t x = 0; x < width_; ++x) {
-    const int32_t wx = Min(x / s, ww_ - 1);
-    if (uniform[wx]) {
-      out[x] = disp[1][wx];
+  // Block by block: a block whose 3x3 neighbourhood agrees is a plain fill.
+  for (int32_t wx = 0; wx < ww_; ++wx) {
+    const int32_t x0 = wx * s, x1 = wx + 1 == ww_ ? width_ : x0 + s;
+    if (uniform[wx] == kFlat) {
+      for (int32_t x = x0; x < x1; ++x) out[x] = disp[1][wx];
       continue;
     }
-    const uint16_t* wsx = spatial_q8_ + Min(x - wx * s, s - 1) * 3;
     const int32_t qx[3] = {Max(wx - 1, 0), wx, Min(wx + 1, ww_ - 1)};
-    const int32_t py = luma[x], pb = cb[x / 2], pr = cr[x / 2];
-    uint32_t sum_w = 0, sum_wd = 0;  // weights Q8 <= 256: at most 9 * 256 * 65535 < 2^32
-    for (int32_t oy = 0; oy < 3; ++oy) {
-      const uint8_t* g = guide[oy];
-      for (int32_t ox = 0; ox < 3; ++ox) {
-        const int32_t q = qx[ox];
-        const int32_t dist = Abs(py - g[q]) + Abs(pb - g[ww_ + q]) + Abs(pr - g[2 * ww_ + q]);
-        const uint32_t w = ((wsy[oy] * wsx[ox]) >> 8) * range_q8_[dist] >> 8;
-        sum_w += w;
-        sum_wd += w * disp[oy][q];
+    if (uniform[wx] == kSmooth) {
+      // A smooth surface (a slanted plane): spatial weights only, so image texture cannot
+      // ripple its depth. Rows are combined once per block.
+      uint32_t col[3] = {0, 0, 0}, wy_sum = 0;
+      for (int32_t oy = 0; oy < 3; ++oy) {
+        wy_sum += wsy[oy];
+        for (int32_t ox = 0; ox < 3; ++ox) col[ox] += wsy[oy] * disp[oy][qx[ox]];
       }
+      for (int32_t x = x0; x < x1; ++x) {
+        const uint16_t* wsx = spatial_q8_ + Min(x - x0, s - 1) * 3;
+        // col < 3 * 256 * 65535; times a Q8 weight it needs 64 bits.
+        const uint64_t num =
+            uint64_t{wsx[0]} * col[0] + uint64_t{wsx[1]} * col[1] + uint64_t{wsx[2]} * col[2];
+        const uint64_t den = uint64_t{wy_sum} * (wsx[0] + wsx[1] + wsx[2]);
+        out[x] = static_cast<uint16_t>((num + den / 2) / den);
+      }
+      continue;
     }
-    out[x] = sum_w ? static_cast<uint16_t>((sum_wd + sum_w / 2) / sum_w) : disp[1][wx];
+    for (int32_t x = x0; x < x1; ++x) {
+      const uint16_t* wsx = spatial_q8_ + Min(x - x0, s - 1) * 3;
+      const int32_t py = luma[x], pb = cb[x / 2], pr = cr[x / 2];
+      uint32_t sum_w = 0, sum_wd = 0;  // weights Q8 <= 256: at most 9 * 256 * 65535 < 2^32
+      for (int32_t oy = 0; oy < 3; ++oy) {
+        const uint8_t* g = guide[oy];
+        for (int32_t ox = 0; ox < 3; ++ox) {
+          const int32_t q = qx[ox];
+          const int32_t dist = Abs(py - g[q]) + Abs(pb - g[ww_ + q]) + Abs(pr - g[2 * ww_ + q]);
+          const uint32_t w = ((wsy[oy] * wsx[ox]) >> 8) * range_q8_[dist] >> 8;
+          sum_w += w;
+          sum_wd += w * disp[oy][q];
+        }
+      }
+      out[x] = sum_w ? static_cast<uint16_t>((sum_wd + sum_w / 2) / sum_w) : disp[1][wx];
+    }
   }
 }
 

@@ -4,7 +4,8 @@
 // (distance to that working pixel's centre) times a range term (how close the pixel's colour is
 // to the mean colour of that working pixel's block), so a depth edge snaps to the image edge it
 // belongs to: hair and thin objects keep their depth. Blocks whose 3x3 disparities agree are
-// copied without weighing. Fixed point: weights Q8, the mean by integer division (exact).
+// copied, and smooth ones (a slanted surface) use the spatial term alone. Fixed point: weights
+// Q8, the mean by integer division (exact).
 #pragma once
 
 #include <cstdint>
@@ -24,6 +25,9 @@ class DepthUpsampler {
   void Row(int32_t y, uint16_t* disp_q8);
 
   static constexpr int32_t kRangeSigma = 16;  // colour distance (|dY|+|dCb|+|dCr|) of weight 1/4
+  // Blocks whose 3x3 disparities span at most this (Q8, a quarter px) are a smooth surface: the
+  // colour term is skipped there.
+  static constexpr int32_t kSmoothQ8 = 64;
 
  private:
   struct Guide {
@@ -37,7 +41,8 @@ class DepthUpsampler {
   ConstPlanarU8 ref_;
   ConstImageU16 disp_;
   Guide guide_[4];
-  uint8_t* uniform_ = nullptr;  // per working pixel of row uniform_tag_: 3x3 disparities agree
+  enum : uint8_t { kEdge = 0, kSmooth = 1, kFlat = 2 };
+  uint8_t* uniform_ = nullptr;  // per working pixel of row uniform_tag_: how its 3x3 agree
   int32_t uniform_tag_ = -1;
   uint16_t* spatial_q8_ = nullptr;  // [f * 3 + o]: offset o-1 seen from sub-position f
   uint16_t* range_q8_ = nullptr;    // [colour distance 0..765]

@@ -7,9 +7,14 @@ int32_t Min(int32_t a, int32_t b) { return a < b ? a : b; }
 int32_t Max(int32_t a, int32_t b) { return a > b ? a : b; }
 int32_t Clamp(int32_t v, int32_t lo, int32_t hi) { return v < lo ? lo : (v > hi ? hi : v); }
 
-// Rounded signed division, den > 0 (half away from zero; the same on every platform).
-int64_t RoundDiv(int64_t num, int64_t den) {
+// Rounded signed division, den > 0 (half away from zero; the same on every platform). The
+// operands fit int32 (|num| < 2^31 - 2^16), so a 32-bit division suffices.
+int32_t RoundDiv(int32_t num, int32_t den) {
   return num >= 0 ? (num + den / 2) / den : -((-num + den / 2) / den);
+}
+// RoundDiv(num, 65536).
+int32_t RoundShift16(int32_t num) {
+  return num >= 0 ? (num + 32768) >> 16 : -((-num + 32768) >> 16);
 }
 
 // Adds one kernel row's weighted sums to acc[x0..x1]. p[i] is the row prefix up to column i.
@@ -423,9 +428,12 @@ void LayerPlane::RenderStrip(int32_t y0, int32_t n, const uint16_t* layer_of, in
       const int16_t* v = ValueRow(y, c);
       uint8_t* d = dst[c].Row(y - y0);
       for (int32_t x = 0; x < width_; ++x) {
-        // A pixel always covers itself, so alpha is positive; the fallback is for safety.
-        const int64_t value = out_a[x] > 0 ? RoundDiv(o[x], out_a[x]) : v[x];
-        const int64_t b = value + bias;
+        // A pixel always covers itself, so alpha is positive; the fallback is for safety. Most
+        // pixels are fully covered (alpha 1.0): a shift instead of a division.
+        const int32_t value = out_a[x] == 65536 ? RoundShift16(o[x])
+                              : out_a[x] > 0    ? RoundDiv(o[x], out_a[x])
+                                                : v[x];
+        const int32_t b = value + bias;
         d[x] = static_cast<uint8_t>(b < 0 ? 0 : (b > 255 ? 255 : b));
       }
     }
