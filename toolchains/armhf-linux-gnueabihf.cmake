@@ -15,3 +15,6 @@ set(ENV{PKG_CONFIG_LIBDIR} "${LB_SYSROOT}/usr/lib/arm-linux-gnueabihf/pkgconfig:
 set(CMAKE_CROSSCOMPILING_EMULATOR
     qemu-arm-static;-L;/usr/arm-linux-gnueabihf;-E;LD_LIBRARY_PATH=${LB_SYSROOT}/usr/lib/arm-linux-gnueabihf)
 set(CMAKE_EXE_LINKER_FLAGS_INIT "-Wl,-rpath-link,${LB_SYSROOT}/usr/lib/arm-linux-gnueabihf")
+# Debian puts architecture-specific headers (jconfig.h) under include/<triple>.
+set(CMAKE_C_STANDARD_INCLUDE_DIRECTORIES ${LB_SYSROOT}/usr/include/arm-linux-gnueabihf)
+set(CMAKE_CXX_STANDARD_INCLUDE_DIRECTORIES ${LB_SYSROOT}/usr/include/arm-linux-gnueabihf)

@@ -1,0 +1,100 @@
+#include "firmware/app/job.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <ctime>
+
+#include "firmware/jpeg/jpeg_writer.h"
+#include "firmware/storage/atomic_file.h"
+
+namespace lb {
+namespace {
+
+double Now() {
+  timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<double>(ts.tv_sec) + static_cast<double>(ts.tv_nsec) * 1e-9;
+}
+
+void FormatExifTime(char* out, size_t size) {
+  const time_t t = time(nullptr);
+  tm local;
+  localtime_r(&t, &local);
+  strftime(out, size, "%Y:%m:%d %H:%M:%S", &local);
+}
+
+}  // namespace
+
+void Job::FreeDeleter::operator()(void* p) const { free(p); }
+
+Job::Job() : pipeline_(std::make_unique<Pipeline>()) {}
+Job::~Job() = default;
+
+Status Job::Configure(Sensor* sensor, const JobOptions& options) {
+  sensor_ = sensor;
+  options_ = options;
+  LB_RETURN_IF_ERROR(sensor_->Configure(options.sensor, &mode_));
+  PipelineConfig& pc = options_.pipeline;
+  pc.width = mode_.width;
+  pc.height = mode_.height;
+  pc.frames = mode_.frames;
+  if (pc.reference < 0 || pc.reference >= pc.frames) pc.reference = pc.frames / 2;
+  size_t bytes = 0;
+  LB_RETURN_IF_ERROR(Pipeline::RequiredBytes(pc, &bytes));
+  if (bytes != arena_bytes_) {
+    arena_.reset(static_cast<uint8_t*>(aligned_alloc(Arena::kAlign, Arena::RoundUp(bytes))));
+    if (!arena_) return Status(Code::kOutOfMemory, "cannot allocate the %zu-byte arena", bytes);
+    arena_bytes_ = bytes;
+  }
+  return pipeline_->Configure(pc, arena_.get(), arena_bytes_);
+}
+
+Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer) {
+  if (!sensor_) return Status(Code::kInvalidArgument, "job run before configure");
+  JobReport r;
+  r.arena_bytes = arena_bytes_;
+  r.width = mode_.width;
+  r.height = mode_.height;
+  Pipeline& p = *pipeline_;
+  p.ResetBurst();
+
+  // Opened first so an unwritable destination fails before the capture; any later failure
+  // removes the temporary, so nothing is left on storage.
+  AtomicFile file;
+  LB_RETURN_IF_ERROR(file.Open(out_path));
+  double t0 = Now();
+  LB_RETURN_IF_ERROR(sensor_->CaptureBurst(p));
+  double t1 = Now();
+  r.capture_s = t1 - t0;
+  LB_RETURN_IF_ERROR(p.ComputeDepth());
+  double t2 = Now();
+  r.depth_s = t2 - t1;
+
+  JpegMetadata meta;
+  meta.make = options_.make;
+  meta.model = options_.model;
+  meta.software = options_.software;
+  char when[32];
+  FormatExifTime(when, sizeof(when));
+  meta.datetime_original = when;
+  meta.f_number = options_.render.f_number;
+  JpegWriter writer;
+  LB_RETURN_IF_ERROR(writer.Begin(&file, mode_.width, mode_.height, options_.quality, meta));
+  LB_RETURN_IF_ERROR(p.BeginRender(options_.render));
+  r.focus_disp_q8 = p.render().focus_disp_q8();
+  for (;;) {
+    ConstPlanarU8 strip;
+    int32_t y0 = 0, rows = 0;
+    LB_RETURN_IF_ERROR(p.NextStrip(&strip, &y0, &rows));
+    if (rows == 0) break;
+    if (observer) observer->OnStrip(strip, y0, rows);
+    LB_RETURN_IF_ERROR(writer.WriteStrip(strip, rows));
+  }
+  LB_RETURN_IF_ERROR(writer.Finish());
+  LB_RETURN_IF_ERROR(file.Commit());
+  r.render_s = Now() - t2;
+  if (report) *report = r;
+  return Status::Ok();
+}
+
+}  // namespace lb

@@ -1,0 +1,67 @@
+// A refocus job: one burst from a sensor through the pipeline into a refocused JPEG on storage.
+// Configure sizes everything once (the arena is allocated there and reused for every burst);
+// Run captures, computes depth, renders strip by strip into the encoder and commits the file
+// atomically. The host command line and the device daemon are thin wrappers around it.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+
+#include "algo/pipeline/pipeline.h"
+#include "hal/sensor.h"
+
+namespace lb {
+
+struct JobOptions {
+  SensorConfig sensor;      // requested size and burst length
+  PipelineConfig pipeline;  // width/height/frames are taken from the sensor's mode
+  RenderParams render;
+  int quality = 92;
+  const char* make = "LensBlur";
+  const char* model = "Simulated camera";
+  const char* software = "refocus";
+};
+
+struct JobReport {
+  double capture_s = 0, depth_s = 0, render_s = 0;  // wall time of each stage
+  size_t arena_bytes = 0;
+  int32_t focus_disp_q8 = 0;
+  int32_t width = 0, height = 0;
+};
+
+// Receives each rendered strip as the encoder does (tests use it to checksum the output).
+class StripObserver {
+ public:
+  virtual ~StripObserver() = default;
+  virtual void OnStrip(const ConstPlanarU8& strip, int32_t y0, int32_t rows) = 0;
+};
+
+class Job {
+ public:
+  Job();
+  ~Job();
+  Job(const Job&) = delete;
+  Job& operator=(const Job&) = delete;
+
+  // Configures `sensor` (borrowed for the Job's lifetime) and allocates the pipeline arena.
+  Status Configure(Sensor* sensor, const JobOptions& options);
+  // One burst -> `out_path`. On failure nothing is left under `out_path`.
+  Status Run(const char* out_path, JobReport* report, StripObserver* observer = nullptr);
+
+  Pipeline& pipeline() { return *pipeline_; }
+  const SensorMode& mode() const { return mode_; }
+
+ private:
+  struct FreeDeleter {
+    void operator()(void* p) const;
+  };
+  Sensor* sensor_ = nullptr;
+  JobOptions options_;
+  SensorMode mode_;
+  std::unique_ptr<Pipeline> pipeline_;
+  std::unique_ptr<uint8_t, FreeDeleter> arena_;
+  size_t arena_bytes_ = 0;
+};
+
+}  // namespace lb

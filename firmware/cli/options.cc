@@ -1,0 +1,126 @@
+#include "firmware/cli/options.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+
+namespace lb::cli {
+namespace {
+
+std::string Printf(const char* format, ...) __attribute__((format(printf, 1, 2)));
+std::string Printf(const char* format, ...) {
+  char buf[256];
+  va_list args;
+  va_start(args, format);
+  vsnprintf(buf, sizeof(buf), format, args);
+  va_end(args);
+  return buf;
+}
+
+// Half the side of the square a focus *point* stands for, as a fraction of the image: small
+// enough to pick one object, large enough that the median of its depths is stable.
+constexpr int32_t kPointHalfSide = 8;
+
+}  // namespace
+
+bool ParseInt(const char* text, int32_t lo, int32_t hi, int32_t* out, std::string* error) {
+  char* end = nullptr;
+  errno = 0;
+  const long v = strtol(text, &end, 10);
+  if (errno || end == text || *end != '\0' || v < lo || v > hi) {
+    *error = Printf("'%s' is not a whole number from %d to %d", text, lo, hi);
+    return false;
+  }
+  *out = static_cast<int32_t>(v);
+  return true;
+}
+
+bool ParseFloat(const char* text, float lo, float hi, float* out, std::string* error) {
+  char* end = nullptr;
+  errno = 0;
+  const float v = strtof(text, &end);
+  if (errno || end == text || *end != '\0' || !std::isfinite(v) || v < lo || v > hi) {
+    *error = Printf("'%s' is not a number from %g to %g", text, static_cast<double>(lo),
+                    static_cast<double>(hi));
+    return false;
+  }
+  *out = v;
+  return true;
+}
+
+bool ParseFocus(const char* text, FocusRegion* out, std::string* error) {
+  int32_t v[4] = {0, 0, 0, 0};
+  int n = 0;
+  const char* p = text;
+  while (n < 4) {
+    char* end = nullptr;
+    errno = 0;
+    const long x = strtol(p, &end, 10);
+    if (errno || end == p || x < 0 || x > 65535) break;
+    v[n++] = static_cast<int32_t>(x);
+    if (*end == '\0') {
+      p = end;
+      break;
+    }
+    if (*end != ',') {
+      n = -1;
+      break;
+    }
+    p = end + 1;
+  }
+  if ((n != 2 && n != 4) || *p != '\0' || (n == 4 && (v[2] == 0 || v[3] == 0))) {
+    *error = Printf("focus '%s' is neither X,Y nor X,Y,W,H (pixels of the reference image)", text);
+    return false;
+  }
+  if (n == 2) {
+    *out = {v[0] - kPointHalfSide, v[1] - kPointHalfSide, 2 * kPointHalfSide, 2 * kPointHalfSide};
+    if (out->x < 0) out->x = 0;
+    if (out->y < 0) out->y = 0;
+  } else {
+    *out = {v[0], v[1], v[2], v[3]};
+  }
+  return true;
+}
+
+bool ParseAperture(const char* text, Aperture* out, std::string* error) {
+  int32_t blades = 0;
+  if (strcmp(text, "disc") == 0) {
+    out->blades = 0;
+    return true;
+  }
+  const char* num = nullptr;
+  std::string t(text);
+  if (t.rfind("polygon:", 0) == 0) num = text + 8;
+  const size_t dash = t.find("-blade");
+  std::string head = dash == std::string::npos ? "" : t.substr(0, dash);
+  if (!num && !head.empty() && t.substr(dash) == "-blade") num = head.c_str();
+  if (!num || !ParseInt(num, 3, 12, &blades, error)) {
+    *error =
+        Printf("aperture '%s' is neither 'disc' nor N-blade / polygon:N with N from 3 to 12", text);
+    return false;
+  }
+  out->blades = blades;
+  return true;
+}
+
+bool ParseSize(const char* text, int32_t* width, int32_t* height, std::string* error) {
+  int w = 0, h = 0;
+  char tail = 0;
+  if (sscanf(text, "%dx%d%c", &w, &h, &tail) != 2 || w < 16 || h < 16 || w > 8192 || h > 8192) {
+    *error = Printf("size '%s' is not WxH between 16x16 and 8192x8192", text);
+    return false;
+  }
+  *width = w;
+  *height = h;
+  return true;
+}
+
+int Fail(const char* message) {
+  fprintf(stderr, "refocus: %s\n", message);
+  return 1;
+}
+
+}  // namespace lb::cli

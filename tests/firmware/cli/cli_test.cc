@@ -1,0 +1,207 @@
+// `refocus run` as a user meets it: every bad input gives one line on stderr that names the file
+// and the problem, a non-zero exit, and nothing under the output name (nor a stray temporary).
+#include <dirent.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "tests/sim/files/test_images.h"
+
+namespace lb {
+namespace {
+
+using test::Bytes;
+
+struct Result {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string Slurp(const std::string& path) {
+  std::string s;
+  if (FILE* f = fopen(path.c_str(), "rb")) {
+    char buf[4096];
+    for (size_t n; (n = fread(buf, 1, sizeof(buf), f)) > 0;) s.append(buf, n);
+    fclose(f);
+  }
+  return s;
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    char tmpl[] = "/tmp/refocus-cli-XXXXXX";
+    ASSERT_NE(mkdtemp(tmpl), nullptr);
+    dir_ = tmpl;
+    out_dir_ = dir_ + "/out";
+    ASSERT_EQ(mkdir(out_dir_.c_str(), 0755), 0);
+  }
+  void TearDown() override { (void)system(("rm -rf " + dir_).c_str()); }
+
+  Result Run(const std::vector<std::string>& args) {
+    std::string cmd = REFOCUS_BIN;
+    for (const auto& a : args) cmd += " '" + a + "'";
+    cmd += " >" + dir_ + "/stdout 2>" + dir_ + "/stderr";
+    Result r;
+    const int status = system(cmd.c_str());
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.out = Slurp(dir_ + "/stdout");
+    r.err = Slurp(dir_ + "/stderr");
+    return r;
+  }
+
+  // A valid W x H RGB burst of `n` PPM files; returns their paths.
+  std::vector<std::string> PpmBurst(int n, int w, int h) {
+    std::vector<std::string> paths;
+    for (int i = 0; i < n; ++i) {
+      std::vector<uint16_t> samples(static_cast<size_t>(w) * h * 3);
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+          for (int c = 0; c < 3; ++c) samples[(y * w + x) * 3 + c] = test::Smooth(x + 2 * i, y, c);
+      paths.push_back(dir_ + "/f" + std::to_string(i) + ".ppm");
+      EXPECT_TRUE(test::WriteFile(paths.back(), test::EncodePnm("P6", w, h, 255, samples)));
+    }
+    return paths;
+  }
+
+  // The bad-input contract: exit 1, one line naming `names` and `problem`, no output file.
+  void ExpectCleanFailure(const Result& r, const std::string& names, const std::string& problem) {
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(names), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(problem), std::string::npos) << r.err;
+    EXPECT_TRUE(OutDirEmpty()) << "a file was left in " << out_dir_;
+  }
+
+  bool OutDirEmpty() {
+    DIR* d = opendir(out_dir_.c_str());
+    if (!d) return true;
+    int entries = 0;
+    while (dirent* e = readdir(d)) entries += e->d_name[0] != '.' || e->d_name[1] > '.';
+    closedir(d);
+    return entries == 0;
+  }
+
+  std::string Out() const { return out_dir_ + "/photo.jpg"; }
+
+  std::string dir_, out_dir_;
+};
+
+TEST_F(Cli, SyntheticRunWritesAJpegOfTheConfiguredSize) {
+  Result r = Run({"run", "--synthetic", "--size", "200x150", "--labels", "16", "--out", Out()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find(Out()), std::string::npos) << r.out;
+  const std::string jpeg = Slurp(Out());
+  ASSERT_GT(jpeg.size(), 1000u);
+  EXPECT_EQ(static_cast<uint8_t>(jpeg[0]), 0xFF);
+  EXPECT_EQ(static_cast<uint8_t>(jpeg[1]), 0xD8);
+  // SOF0 carries the size: height then width, big-endian.
+  const size_t sof = jpeg.find("\xFF\xC0");
+  ASSERT_NE(sof, std::string::npos);
+  EXPECT_EQ((static_cast<uint8_t>(jpeg[sof + 5]) << 8) | static_cast<uint8_t>(jpeg[sof + 6]), 150);
+  EXPECT_EQ((static_cast<uint8_t>(jpeg[sof + 7]) << 8) | static_cast<uint8_t>(jpeg[sof + 8]), 200);
+}
+
+TEST_F(Cli, FileBurstRuns) {
+  std::vector<std::string> args = {"run", "--labels", "8", "--disparity", "0,4", "--out", Out()};
+  for (const auto& p : PpmBurst(3, 64, 48)) args.push_back(p);
+  Result r = Run(args);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_GT(Slurp(Out()).size(), 100u);
+}
+
+TEST_F(Cli, TruncatedPpm) {
+  auto paths = PpmBurst(3, 64, 48);
+  ASSERT_EQ(truncate(paths[1].c_str(), 500), 0);
+  ExpectCleanFailure(Run({"run", paths[0], paths[1], paths[2], "--out", Out()}), "f1.ppm",
+                     "truncated");
+}
+
+TEST_F(Cli, PngWithBrokenCrc) {
+  auto paths = PpmBurst(2, 64, 48);
+  test::PngSpec spec;
+  spec.width = 64;
+  spec.height = 48;
+  spec.rows.resize(64 * 48 * 3, 90);
+  Bytes png;
+  ASSERT_TRUE(test::EncodePng(spec, &png));
+  const long idat = test::FindPngChunk(png, "IDAT");
+  ASSERT_GT(idat, 0);
+  const size_t at = static_cast<size_t>(idat);
+  const size_t length = (size_t{png[at]} << 24) | (size_t{png[at + 1]} << 16) |
+                        (size_t{png[at + 2]} << 8) | png[at + 3];
+  png[at + 8 + length] ^= 0x5A;  // the stored CRC: the data still inflates, the check must fail
+  const std::string bad = dir_ + "/bad.png";
+  ASSERT_TRUE(test::WriteFile(bad, png));
+  ExpectCleanFailure(Run({"run", paths[0], bad, paths[1], "--out", Out()}), "bad.png", "CRC");
+}
+
+TEST_F(Cli, TruncatedJpeg) {
+  auto paths = PpmBurst(2, 64, 48);
+  std::vector<uint8_t> rgb(64 * 48 * 3);
+  for (size_t i = 0; i < rgb.size(); ++i)
+    rgb[i] = test::Smooth(static_cast<int>(i / 3) % 64, static_cast<int>(i / 192),
+                          static_cast<int>(i % 3));
+  Bytes jpeg;
+  ASSERT_TRUE(test::EncodeJpeg(64, 48, 3, rgb.data(), 90, false, &jpeg));
+  jpeg.resize(jpeg.size() / 2);
+  const std::string bad = dir_ + "/cut.jpg";
+  ASSERT_TRUE(test::WriteFile(bad, jpeg));
+  Result r = Run({"run", paths[0], bad, paths[1], "--out", Out()});
+  ExpectCleanFailure(r, "cut.jpg", "cut.jpg");
+  EXPECT_TRUE(r.err.find("truncated") != std::string::npos ||
+              r.err.find("Premature end") != std::string::npos)
+      << r.err;
+}
+
+TEST_F(Cli, FramesOfDifferentSizes) {
+  auto a = PpmBurst(2, 64, 48);
+  const std::string big = dir_ + "/big.ppm";
+  ASSERT_TRUE(test::WriteFile(
+      big, test::EncodePnm("P6", 80, 48, 255, std::vector<uint16_t>(80 * 48 * 3, 7))));
+  ExpectCleanFailure(Run({"run", a[0], a[1], big, "--out", Out()}), "big.ppm", "80x48");
+}
+
+TEST_F(Cli, EmptyDirectory) {
+  const std::string empty = dir_ + "/empty";
+  ASSERT_EQ(mkdir(empty.c_str(), 0755), 0);
+  ExpectCleanFailure(Run({"run", "--input", empty, "--out", Out()}), empty, "no image files");
+}
+
+TEST_F(Cli, OneFrameBurst) {
+  auto a = PpmBurst(1, 64, 48);
+  ExpectCleanFailure(Run({"run", a[0], "--out", Out()}), "1 frame", "at least 2");
+}
+
+TEST_F(Cli, MissingPath) {
+  const std::string missing = dir_ + "/no/such/burst";
+  ExpectCleanFailure(Run({"run", "--input", missing, "--out", Out()}), missing,
+                     "no such file or directory");
+}
+
+TEST_F(Cli, UnwritableOutputDirectory) {
+  // Running as root ignores permission bits, so the "directory" is a regular file.
+  const std::string not_dir = dir_ + "/file";
+  ASSERT_TRUE(test::WriteFile(not_dir, Bytes{1, 2, 3}));
+  Result r = Run({"run", "--synthetic", "--size", "64x48", "--out", not_dir + "/photo.jpg"});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find(not_dir), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_EQ(Slurp(not_dir).size(), 3u);
+}
+
+TEST_F(Cli, UsageErrorsExitWithTwo) {
+  EXPECT_EQ(Run({"run", "--synthetic"}).exit_code, 2);  // no --out
+  EXPECT_EQ(Run({"run", "--f-number", "fast", "--out", Out()}).exit_code, 2);
+  EXPECT_EQ(Run({"frobnicate"}).exit_code, 2);
+  EXPECT_TRUE(OutDirEmpty());
+}
+
+}  // namespace
+}  // namespace lb
