@@ -2,27 +2,10 @@
 
 #include <gtest/gtest.h>
 
-#include <atomic>
-#include <cstdlib>
-#include <new>
 #include <string>
 #include <vector>
 
-// Counts every allocation of the process, so the test can prove a capture allocates nothing.
-namespace {
-std::atomic<int64_t> g_allocations{0};
-}  // namespace
-
-void* operator new(size_t size) {
-  g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void* operator new[](size_t size) { return operator new(size); }
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete[](void* p) noexcept { std::free(p); }
-void operator delete(void* p, size_t) noexcept { std::free(p); }
-void operator delete[](void* p, size_t) noexcept { std::free(p); }
+#include "tests/sim/synthetic/alloc_counter.h"
 
 namespace lb {
 namespace {
@@ -88,11 +71,11 @@ TEST(SyntheticSensorTest, DeliversTheSceneInStripsWithoutAllocating) {
   SensorMode mode;
   ASSERT_TRUE(sensor.Configure(SensorConfig{200, 150, 4, 2000}, &mode).ok());
   RecordingSink sink(200, 150, 4);
-  const int64_t before = g_allocations.load();
+  const size_t before = testing::AllocationCount();
   const Status s = sensor.CaptureBurst(sink);
-  const int64_t during = g_allocations.load() - before;
+  const size_t during = testing::AllocationCount() - before;
   ASSERT_TRUE(s.ok()) << s.message();
-  EXPECT_EQ(during, 0) << "allocations inside CaptureBurst";
+  EXPECT_EQ(during, 0u) << "allocations inside CaptureBurst";
   EXPECT_EQ(sink.begun_, 4);
   EXPECT_EQ(sink.short_strips_, 4);  // 150 = 9 x 16 + 6
   for (int32_t i = 0; i < 4; ++i) {
