@@ -14,6 +14,9 @@ host_pkgs=(
   clang-14 libclang-rt-14-dev clang-format clang-tidy
   libjpeg-turbo-progs libimage-exiftool-perl time
   g++-aarch64-linux-gnu g++-arm-linux-gnueabihf qemu-user-static
+  libcamera-dev libcamera-ipa
+  # The throw-away VM that tests the real kernel drivers (tests/vm/run_vm.sh).
+  qemu-system-x86 busybox-static kmod cpio linux-headers-amd64
 )
 
 missing() {
