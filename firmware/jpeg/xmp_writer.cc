@@ -101,8 +101,9 @@ void PutBigEndian32(uint32_t v, std::vector<uint8_t>* out) {
 
 JpegSegment MainSegment(const std::string& packet) {
   JpegSegment seg;
-  seg.payload.assign(kXmpSignature, kXmpSignature + sizeof(kXmpSignature));  // with its NUL
-  seg.payload.insert(seg.payload.end(), packet.begin(), packet.end());
+  seg.payload.resize(sizeof(kXmpSignature) + packet.size());
+  memcpy(seg.payload.data(), kXmpSignature, sizeof(kXmpSignature));  // with its NUL
+  memcpy(seg.payload.data() + sizeof(kXmpSignature), packet.data(), packet.size());
   return seg;
 }
 
@@ -175,10 +176,9 @@ Status BuildXmpSegments(const RefocusableXmp& xmp, std::vector<JpegSegment>* seg
     const size_t n =
         extended.size() - offset < kExtendedXmpChunk ? extended.size() - offset : kExtendedXmpChunk;
     JpegSegment seg;
-    seg.payload.reserve(sizeof(kExtendedXmpSignature) + 40 + n);
-    seg.payload.assign(kExtendedXmpSignature,
-                       kExtendedXmpSignature + sizeof(kExtendedXmpSignature));  // with its NUL
-    seg.payload.insert(seg.payload.end(), md5, md5 + 32);  // the GUID is the packet's MD5
+    seg.payload.resize(sizeof(kExtendedXmpSignature) + 32);
+    memcpy(seg.payload.data(), kExtendedXmpSignature, sizeof(kExtendedXmpSignature));  // + NUL
+    memcpy(seg.payload.data() + sizeof(kExtendedXmpSignature), md5, 32);  // GUID = the MD5
     PutBigEndian32(static_cast<uint32_t>(extended.size()), &seg.payload);
     PutBigEndian32(static_cast<uint32_t>(offset), &seg.payload);
     seg.payload.insert(seg.payload.end(), extended.begin() + static_cast<ptrdiff_t>(offset),

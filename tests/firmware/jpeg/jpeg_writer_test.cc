@@ -10,6 +10,7 @@
 #include <cstring>
 #include <string>
 
+#include "firmware/jpeg/base64.h"
 #include "tests/firmware/jpeg/jpeg_test_util.h"
 
 namespace lb {
@@ -88,6 +89,34 @@ TEST(JpegWriterTest, SameInputGivesTheSameBytes) {
   ASSERT_TRUE(EncodeYCbCr420(img.View(), 90, &a).ok());
   ASSERT_TRUE(EncodeYCbCr420(img.View(), 90, &b).ok());
   EXPECT_EQ(a, b);
+}
+
+// The product promises the same bytes on x86-64 and ARM: an integer-only input (no libm) and a
+// digest of the whole file, EXIF included. A libjpeg-turbo or libexif upgrade may change it;
+// then check the new file with djpeg and exiftool and update the digest.
+TEST(JpegWriterTest, BytesAreTheSameOnEveryPlatform) {
+  Ycc420 img;
+  img.width = 75;
+  img.height = 41;
+  img.y.resize(75 * 41);
+  img.cb.resize(38 * 21);
+  img.cr.resize(38 * 21);
+  for (size_t i = 0; i < img.y.size(); ++i) img.y[i] = static_cast<uint8_t>((i * 7) ^ (i >> 5));
+  for (size_t i = 0; i < img.cb.size(); ++i) {
+    img.cb[i] = static_cast<uint8_t>(96 + i % 64);
+    img.cr[i] = static_cast<uint8_t>(160 - i % 48);
+  }
+  JpegWriter writer;
+  std::vector<uint8_t> jpeg;
+  ASSERT_TRUE(writer.BeginMemory(&jpeg, img.width, img.height, 90, CameraMetadata()).ok());
+  for (int32_t y = 0; y < img.height; y += 16) {
+    const int32_t rows = img.height - y < 16 ? img.height - y : 16;
+    ASSERT_TRUE(writer.WriteStrip(img.Strip(y, rows), rows).ok());
+  }
+  ASSERT_TRUE(writer.Finish().ok());
+  char md5[33];
+  Md5Hex(jpeg.data(), jpeg.size(), md5);
+  EXPECT_STREQ(md5, "D121B7C576FE25D50C04EE2B6F3ED204") << jpeg.size() << " bytes";
 }
 
 TEST(JpegWriterTest, InMemoryEncodeHasJfifAndDecodes) {
