@@ -46,6 +46,8 @@ Status DisparityRangeFromNearFar(double near_depth, double far_depth, DisparityR
   return Status::Ok();
 }
 
+double DepthForDisparity(int32_t disp_q8) { return 256.0 / (disp_q8 > 0 ? disp_q8 : 1); }
+
 uint16_t EncodeRangeInverse(int32_t disp_q8, const DisparityRange& range, int bits) {
   const int64_t top = bits == 8 ? 255 : 65535;
   const int32_t far_q8 = FarQ8(range);

@@ -25,6 +25,10 @@ Status DepthNearFar(const DisparityRange& range, double* near_depth, double* far
 // The disparity range that a file's Near and Far describe (inverse of DepthNearFar).
 Status DisparityRangeFromNearFar(double near_depth, double far_depth, DisparityRange* range);
 
+// The depth (in Near/Far units) of a disparity, e.g. the focal plane for GFocus:FocalDistance.
+// Disparity 0 (infinity) is taken as 1/256 px, like the far plane.
+double DepthForDisparity(int32_t disp_q8);
+
 // dispQ8 -> RangeInverse value of `bits` (8 or 16) bits, rounded to nearest; disparities outside
 // the range clamp to its ends. The range must have passed DepthNearFar.
 uint16_t EncodeRangeInverse(int32_t disp_q8, const DisparityRange& range, int bits);

@@ -79,6 +79,15 @@ TEST(DepthEncodingTest, NearFarSurviveTheXmpTextAndComeBack) {
   }
 }
 
+TEST(DepthEncodingTest, FocalDepthUsesTheSameUnitsAsNearAndFar) {
+  double near_depth, far_depth;
+  ASSERT_TRUE(DepthNearFar({64, 2048}, &near_depth, &far_depth).ok());
+  EXPECT_DOUBLE_EQ(DepthForDisparity(2048), near_depth);
+  EXPECT_DOUBLE_EQ(DepthForDisparity(64), far_depth);
+  EXPECT_DOUBLE_EQ(DepthForDisparity(512), 0.5);  // 2 px per view step
+  EXPECT_DOUBLE_EQ(DepthForDisparity(0), 256.0);
+}
+
 TEST(DepthEncodingTest, BadRangesAndMapsAreRejected) {
   double n, f;
   EXPECT_FALSE(DepthNearFar({10, 10}, &n, &f).ok());
