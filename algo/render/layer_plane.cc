@@ -51,12 +51,18 @@ void CompositeRow(int32_t* out, const int32_t* colour, const int32_t* alpha, int
   }
 }
 
-// Linear interpolation of a low-res row at each output column's tap (col[-1] .. col[n] valid).
-void LerpRow(const int32_t* col, const int16_t* tap, const uint8_t* frac, int32_t* dst, int32_t x0,
+// Linear interpolation of a low-res row (col[-1] .. col[n] valid) at output columns [x0, x1]
+// of level `level`: column x lies between low-res columns q = (x - f/2) >> level and q + 1, at
+// the fixed weight frac[x] (Q8) of q + 1; each interval's f columns share a and b - a.
+void LerpRow(const int32_t* col, const uint8_t* frac, int32_t level, int32_t* dst, int32_t x0,
              int32_t x1) {
-  for (int32_t x = x0; x <= x1; ++x) {
-    const int32_t a = col[tap[x]], b = col[tap[x] + 1];
-    dst[x] = a + static_cast<int32_t>((int64_t{b - a} * frac[x] + 128) >> 8);
+  const int32_t f = 1 << level;
+  for (int32_t x = x0; x <= x1;) {
+    const int32_t q = (x - f / 2) >> level;
+    const int32_t end = Min(x1, ((q + 1) << level) + f / 2 - 1);
+    const int32_t a = col[q];
+    const int64_t d = col[q + 1] - a;
+    for (; x <= end; ++x) dst[x] = a + static_cast<int32_t>((d * frac[x] + 128) >> 8);
   }
 }
 
@@ -130,12 +136,10 @@ void LayerPlane::Carve(Arena& arena, int32_t width, int32_t height, int32_t chan
   int32_t max_level = 0;
   for (int32_t i = 0; i < radii; ++i) max_level = Max(max_level, level_[i]);
   for (int32_t l = 1; l <= max_level; ++l) {
-    tap_[l] = arena.Allocate<int16_t>(static_cast<size_t>(width));
     frac_[l] = arena.Allocate<uint8_t>(static_cast<size_t>(width));
     if (arena.planning() || arena.overflowed()) continue;
     for (int32_t x = 0; x < width; ++x) {
       const int32_t u = ((2 * x + 1 - (1 << l)) * 128) >> l;
-      tap_[l][x] = static_cast<int16_t>(u >> 8);
       frac_[l][x] = static_cast<uint8_t>(u & 255);
     }
   }
@@ -365,6 +369,28 @@ void LayerPlane::RenderRun(int32_t k, int32_t y0, int32_t n, const uint16_t* lay
   const int32_t level = level_[i], h = half_[i];
   const int32_t planes = channels_ + 1;
   const ptrdiff_t row_stride = planes * static_cast<ptrdiff_t>(width_);
+  if (h == 0 && reciprocal_[i] == uint64_t{1} << 32) {
+    // The in-focus layer (the identity kernel): its weight and value are the layer itself;
+    // the same numbers the general path gives for a kernel of one cell of weight 256.
+    for (int32_t y = y0; y < y0 + n; ++y) {
+      const int16_t* s = RadiusRow(y);
+      int32_t* alpha = layer_ + channels_ * static_cast<ptrdiff_t>(pitch_);
+      for (int32_t x = x0; x <= x1; ++x) {
+        const uint16_t e = layer_of[s[x] + offset];
+        const int32_t first = e >> 8, frac = e & 255;
+        alpha[x] = (first == k ? 256 - frac : (first + 1 == k ? frac : 0)) << 8;
+      }
+      for (int32_t c = 0; c < channels_; ++c) {
+        const int16_t* v = ValueRow(y, c);
+        int32_t* colour = layer_ + c * static_cast<ptrdiff_t>(pitch_);
+        for (int32_t x = x0; x <= x1; ++x) {
+          colour[x] = ((v[x] * (alpha[x] >> 8)) >> shift_) * (1 << (8 + shift_));
+        }
+      }
+      Composite(layer_, pitch_, x0, x1, out_ + (y - y0) * row_stride);
+    }
+    return;
+  }
   if (level == 0) {
     const int32_t jlo = Max(0, y0 - h), jhi = Min(height_, y0 + n + h);
     const int32_t base = y0 - h;
@@ -407,7 +433,7 @@ void LayerPlane::RenderRun(int32_t k, int32_t y0, int32_t n, const uint16_t* lay
       }
       col[q_lo - 1] = col[q_lo];
       col[q_hi + 1] = col[q_hi];
-      LerpRow(col, tap_[level], frac_[level], full_ + c * static_cast<ptrdiff_t>(pitch_), x0, x1);
+      LerpRow(col, frac_[level], level, full_ + c * static_cast<ptrdiff_t>(pitch_), x0, x1);
     }
     Composite(full_, pitch_, x0, x1, out_ + (y - y0) * row_stride);
   }

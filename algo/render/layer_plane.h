@@ -102,22 +102,21 @@ class LayerPlane {
   int32_t level_[kMaxKernels] = {};
   int32_t half_[kMaxKernels] = {};         // at the kernel's level
   uint64_t reciprocal_[kMaxKernels] = {};  // 2^40 / total kernel weight
-  int16_t* ring_s_ = nullptr;         // ring_rows x width: signed radius, Q4 full-resolution px
-  int16_t* ring_v_ = nullptr;         // ring_rows x channels x width
-  uint64_t* tiles_ = nullptr;         // ring_rows x layers: bit t = the layer has a pixel in tile t
-  uint64_t* pure_ = nullptr;          // ring_rows x layers: bit t = every pixel of tile t is wholly
-                                      // in the layer
-  int32_t tile_shift_ = 6;            // tiles of 2^tile_shift columns, at most 64 of them
-  uint32_t* prefix_ = nullptr;        // window_rows x (channels + 1) x pitch
-  uint8_t* active_ = nullptr;         // per window row: the layer has pixels there
-  int32_t* box_ = nullptr;            // (channels + 1) x pitch: one low-res row's box sums
-  uint32_t* acc_ = nullptr;           // (channels + 1) x pitch: kernel sums, wrapping
-  int32_t* layer_ = nullptr;          // low_rows x (channels + 1) x pitch: normalised layer, Q16
-  int32_t* full_ = nullptr;           // (channels + 1) x pitch: one upsampled row of a layer, Q16
-  int32_t* out_ = nullptr;            // strip_rows x (channels + 1) x width, premultiplied Q16
-  KernelRow* kernels_ = nullptr;      // radii x kernel_rows
-  int16_t* tap_[kMaxLevel + 1] = {};  // per level and column: the left low-res tap
-  uint8_t* frac_[kMaxLevel + 1] = {};  // and the right tap's weight, Q8
+  int16_t* ring_s_ = nullptr;     // ring_rows x width: signed radius, Q4 full-resolution px
+  int16_t* ring_v_ = nullptr;     // ring_rows x channels x width
+  uint64_t* tiles_ = nullptr;     // ring_rows x layers: bit t = the layer has a pixel in tile t
+  uint64_t* pure_ = nullptr;      // ring_rows x layers: bit t = every pixel of tile t is wholly
+                                  // in the layer
+  int32_t tile_shift_ = 6;        // tiles of 2^tile_shift columns, at most 64 of them
+  uint32_t* prefix_ = nullptr;    // window_rows x (channels + 1) x pitch
+  uint8_t* active_ = nullptr;     // per window row: the layer has pixels there
+  int32_t* box_ = nullptr;        // (channels + 1) x pitch: one low-res row's box sums
+  uint32_t* acc_ = nullptr;       // (channels + 1) x pitch: kernel sums, wrapping
+  int32_t* layer_ = nullptr;      // low_rows x (channels + 1) x pitch: normalised layer, Q16
+  int32_t* full_ = nullptr;       // (channels + 1) x pitch: one upsampled row of a layer, Q16
+  int32_t* out_ = nullptr;        // strip_rows x (channels + 1) x width, premultiplied Q16
+  KernelRow* kernels_ = nullptr;  // radii x kernel_rows
+  uint8_t* frac_[kMaxLevel + 1] = {};  // per level and column: the right low-res tap's weight
 };
 
 }  // namespace lb
