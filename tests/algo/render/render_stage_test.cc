@@ -83,6 +83,34 @@ Image TwoHalves(int32_t left_y, uint16_t left_disp, int32_t right_y, uint16_t ri
   return im;
 }
 
+// Every size, scale and largest radius (kernels larger than the image, odd sizes, reduced
+// levels down to 1/16): a flat colour stays flat under any depth and iris, so borders, tiles and
+// levels neither lose nor invent light.
+TEST(RenderStage, FlatColourStaysFlatForExtremeConfigurations) {
+  struct Size {
+    int32_t w, h, scale;
+  };
+  uint32_t seed = 7;
+  auto next = [&seed] { return seed = seed * 1664525u + 1013904223u; };
+  for (const Size& size : {Size{16, 16, 1}, Size{33, 17, 2}, Size{97, 75, 3}, Size{200, 40, 8}}) {
+    for (int32_t radius : {0, 1, 7, 33, 128}) {
+      Image im(size.w, size.h, size.scale);
+      for (uint8_t& v : im.y) v = 77;
+      for (uint8_t& v : im.cb) v = 200;
+      for (uint8_t& v : im.cr) v = 30;
+      for (uint16_t& d : im.disp) d = static_cast<uint16_t>(next() >> 16);
+      test::RenderSetup setup;
+      setup.max_radius = radius;
+      setup.params.f_number = 1.4f;
+      setup.params.aperture = {static_cast<int32_t>(next() % 2 ? 0 : 3 + next() % 10), 33.0f, 0.2f};
+      const test::Rendered out = Render(im, setup);
+      for (uint8_t v : out.y) ASSERT_NEAR(v, 77, 1) << size.w << "x" << size.h << " r" << radius;
+      for (uint8_t v : out.cb) ASSERT_NEAR(v, 200, 1) << size.w << "x" << size.h << " r" << radius;
+      for (uint8_t v : out.cr) ASSERT_NEAR(v, 30, 1) << size.w << "x" << size.h << " r" << radius;
+    }
+  }
+}
+
 TEST(RenderStage, SharpForegroundDoesNotBleedIntoBlurredBackground) {
   // Left: far background (disparity 1), dark. Right: near foreground (disparity 3), bright, in
   // focus. At f/2.8 and scale 4 the background blurs by 16 px.
