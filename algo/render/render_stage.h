@@ -8,6 +8,12 @@
 // 1/f-number, capped at max_radius), each pixel is split between two neighbouring depth layers,
 // and the layers are blurred by the aperture's shape (aperture.h) and composited back to front
 // (layer_plane.h). Everything is fixed point after Begin; the output is the same on every CPU.
+//
+// Lens model (lens_model.h): radius_px = 2 * (2.8 / f_number) * working_scale * |d - d_focus|,
+// d in working px per view step (at f/2.8 the synthetic lens spans the 4 view steps of a 5-frame
+// burst), capped at max_radius; d_focus is the median disparity of the focus region.
+// Memory: rings of rows and one strip's accumulators, sized by the width and max_radius (about
+// 5.3 MiB at 4056 px wide and max_radius 32); nothing is allocated after Configure.
 #pragma once
 
 #include <cstddef>
@@ -23,8 +29,10 @@
 namespace lb {
 
 struct FocusRegion {
-  int32_t x = 0, y = 0;           // top-left, full-resolution pixels
-  int32_t width = 0, height = 0;  // 0 x 0 means "the default region" (the image centre)
+  int32_t x = 0, y = 0;  // top-left, full-resolution pixels
+  // 0 x 0 means the default region (the central ninth of the image); a region under 3x3
+  // working px (e.g. a tapped point, 1 x 1) is grown to 3x3 around its centre.
+  int32_t width = 0, height = 0;
 };
 
 struct Aperture {
