@@ -100,6 +100,9 @@ Status Scene::Configure(const SceneParams& params, int32_t width, int32_t height
   if (width < kMinSize || width > kMaxSize || height < kMinSize || height > kMaxSize)
     return Status(Code::kInvalidArgument, "synthetic scene: size %dx%d outside %d..%d", width,
                   height, kMinSize, kMaxSize);
+  if (width > kMaxAspect * height || height > kMaxAspect * width)
+    return Status(Code::kInvalidArgument, "synthetic scene: size %dx%d wider than %d:1", width,
+                  height, kMaxAspect);
   if (views < kMinViews || views > kMaxViews)
     return Status(Code::kInvalidArgument, "synthetic scene: %d views outside %d..%d", views,
                   kMinViews, kMaxViews);
@@ -270,6 +273,7 @@ void Scene::BuildFixedPoint() {
     Object& o = objects_[i];
     o.cx_q16 = ToFixed(0.5 * width_ + o.cx * s, 16);
     o.cy_q16 = ToFixed(0.5 * height_ + o.cy * s, 16);
+    o.r0_q16 = ToFixed(o.r0 * s, 16);
     o.r0sq_q32 = ToFixed(o.r0 * s * o.r0 * s, 32);
     o.r1sq_q32 = ToFixed(o.r1 * s * o.r1 * s, 32);
     double sn, cs;

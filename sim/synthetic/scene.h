@@ -69,6 +69,7 @@ class Scene {
  public:
   static constexpr int32_t kMinSize = 16;
   static constexpr int32_t kMaxSize = 8192;
+  static constexpr int32_t kMaxAspect = 4;  // width:height or height:width
   static constexpr int32_t kMinViews = 2;
   static constexpr int32_t kMaxViews = 16;
   static constexpr int32_t kMaxObjects = 8;
@@ -132,7 +133,7 @@ class Scene {
     uint8_t pattern = 0;             // 0 plain, 1 checker, 2 stripes, 3 bricks, 4 tiles
     int32_t salt_x = 0, salt_y = 0;  // noise table offsets, so objects look different
     // Fixed-point outline in reference px (Q16): centre, squared radii (Q32) or box axes.
-    int64_t cx_q16 = 0, cy_q16 = 0, r0sq_q32 = 0, r1sq_q32 = 0;
+    int64_t cx_q16 = 0, cy_q16 = 0, r0_q16 = 0, r0sq_q32 = 0, r1sq_q32 = 0;
     int64_t cos_q15 = 0, sin_q15 = 0, half_len_q31 = 0, half_wid_q31 = 0;
   };
   // One object as seen from one view. Inputs are view coordinates in half pixels (X2 = 2x).

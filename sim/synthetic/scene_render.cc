@@ -72,6 +72,8 @@ bool Scene::Inside(const Object& o, int64_t xr_q16, int64_t yr_q16) const {
     return along <= o.half_len_q31 && along >= -o.half_len_q31 && across <= o.half_wid_q31 &&
            across >= -o.half_wid_q31;
   }
+  // A point far outside (a steep view can map there) must not overflow the squares.
+  if (dx > o.r0_q16 || dx < -o.r0_q16 || dy > o.r0_q16 || dy < -o.r0_q16) return false;
   const int64_t d2 = dx * dx + dy * dy;  // Q32
   if (d2 > o.r0sq_q32) return false;
   return o.shape != Shape::kRing || d2 >= o.r1sq_q32;
@@ -126,7 +128,11 @@ void Scene::Shade(int32_t index, int64_t xr_q16, int64_t yr_q16, int32_t* rgb) c
     int64_t dy_q16 = yr_q16 - half_h_q16_;
     if (dy_q16 < ground_vmin_q16_) dy_q16 = ground_vmin_q16_;
     const int64_t inv_q32 = (int64_t{1} << 48) / dy_q16;  // 1 / dy px
-    const int64_t ratio_q24 = ((xr_q16 - half_w_q16_) * inv_q32) >> 24;
+    // |dx / dy| <= 64 keeps the product in range; only a steep view's edge reaches the limit.
+    int64_t dx_q16 = xr_q16 - half_w_q16_;
+    if (dx_q16 > (dy_q16 << 6)) dx_q16 = dy_q16 << 6;
+    if (dx_q16 < -(dy_q16 << 6)) dx_q16 = -(dy_q16 << 6);
+    const int64_t ratio_q24 = (dx_q16 * inv_q32) >> 24;
     u = (ratio_q24 * ground_h_q8_) >> 24;
     v = (ground_fh_q8_ * inv_q32) >> 32;
   } else {
