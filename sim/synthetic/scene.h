@@ -2,13 +2,13 @@
 // rendering and motion tests.
 //
 // The scene is a brick wall 12 m away with 6-8 bright point lights, an optional tiled ground
-// plane and 5-6 planar objects in front (discs, a ring, boards, a thin pole) between about 0.5
-// and 5 m, at distinct depths, some overlapping. It is designed at 640x480 ("design px",
+// plane and 5-6 planar objects in front (discs, a ring, boards, a thin pole) between about 0.45
+// and 2.6 m, at distinct depths, some overlapping. It is designed at 640x480 ("design px",
 // centred on the image centre; sizes up to 4:1 either way) and scaled to any size, so the same
 // seed gives the same picture at every resolution (a finest texture octave joins where it spans
 // 2 px or more). Distances are in metres; the reference camera sits at the origin looking down
 // +Z, image y pointing down. At disparity_scale 1 a 640x480 frame's disparity runs from 0.5
-// (wall) to about 12-13 px per view step (the nearest disc).
+// (wall) to 11-13 px per view step (the nearest disc).
 //
 // Every view is exactly a per-object plane-induced homography of the reference: objects are
 // planes whose outline and texture are fixed in reference-image coordinates (the ground is
