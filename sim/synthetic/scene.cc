@@ -267,8 +267,6 @@ void Scene::BuildFixedPoint() {
   // The finest octave only where its cells span 2 px or more: below that a camera's optics
   // would blur it, and point-sampling it would alias.
   detail_octaves_ = 1.25 * s >= 2 ? 4 : 3;
-  const int32_t weights[2][4] = {{7, 5, 4, 0}, {6, 5, 3, 2}};  // each sums to 16
-  for (int k = 0; k < 4; ++k) detail_weights_[k] = weights[detail_octaves_ - 3][k];
   for (int32_t i = 0; i < object_count_; ++i) {
     Object& o = objects_[i];
     o.cx_q16 = ToFixed(0.5 * width_ + o.cx * s, 16);

@@ -175,8 +175,6 @@ class Scene {
                 int64_t* yr_q16) const;
   bool Inside(const Object& o, int64_t xr_q16, int64_t yr_q16) const;
   void Shade(int32_t object, int64_t xr_q16, int64_t yr_q16, int32_t* rgb) const;
-  int32_t Noise(int64_t u_q8, int64_t v_q8, int32_t a, int32_t b, int32_t inv_q16, int32_t sx,
-                int32_t sy) const;
   Status CheckTruthArgs(int32_t scale, int32_t y0, int32_t rows, const void* out,
                         ptrdiff_t stride) const;
 
@@ -195,13 +193,12 @@ class Scene {
   ViewMap maps_[kMaxViews][kMaxObjects];
   // Fixed-point resolution constants.
   int64_t half_w_q16_ = 0, half_h_q16_ = 0;
-  int64_t design_per_px_q24_ = 0;   // design px per pixel, Q24
-  int64_t ground_fh_q8_ = 0;        // focal * camera height in px * cm, Q8
-  int64_t ground_h_q8_ = 0;         // camera height in cm, Q8
-  int64_t ground_vmin_q16_ = 0;     // smallest row offset below the centre the ground texture uses
-  int64_t disp_per_rho_q16_ = 0;    // full-resolution px per view step per (1/m), Q16
-  int32_t detail_octaves_ = 3;      // texture octaves the resolution can show
-  int32_t detail_weights_[4] = {};  // sum to 16
+  int64_t design_per_px_q24_ = 0;  // design px per pixel, Q24
+  int64_t ground_fh_q8_ = 0;       // focal * camera height in px * cm, Q8
+  int64_t ground_h_q8_ = 0;        // camera height in cm, Q8
+  int64_t ground_vmin_q16_ = 0;    // smallest row offset below the centre the ground texture uses
+  int64_t disp_per_rho_q16_ = 0;   // full-resolution px per view step per (1/m), Q16
+  int32_t detail_octaves_ = 3;     // texture octaves the resolution can show
   // Value-noise lattice: small enough to stay in the L1 cache.
   static constexpr int32_t kNoiseSize = 128;
   uint8_t noise_[kNoiseSize * kNoiseSize] = {};

@@ -20,18 +20,55 @@ uint32_t Hash2(int64_t a, int64_t b) {
 }
 
 // Noise octaves: colour blotches, then detail. Each octave's lattice is turned by its own
-// Pythagorean angle (a/h, b/h) so the octaves' grids do not line up into visible squares.
-// inv_q16 = 65536 / (cell * h), cells in design px (cm on the ground, twice as large).
+// Pythagorean angle (a/h, b/h) so the octaves' grids do not line up into visible squares, and
+// scaled by 1 / (cell * h), cells in design px (cm on the ground, twice as large). The turn
+// and the scale are folded into two Q16 factors: ca = a * inv, cb = b * inv.
 struct Octave {
-  int32_t a, b, inv_q16[2];  // [0] objects, [1] ground
+  int32_t ca, cb;
 };
-constexpr Octave kOctaves[5] = {
-    {1, 0, {65536 / 56, 65536 / 112}},  // colour mix
-    {4, 3, {65536 / (20 * 5), 65536 / (40 * 5)}},
-    {12, 5, {65536 / (7 * 13), 65536 / (14 * 13)}},
-    {15, 8, {65536 / (3 * 17), 65536 / (6 * 17)}},
-    {21, 20, {65536 * 4 / (5 * 29), 65536 * 2 / (5 * 29)}},  // 1.25 px: high resolutions only
+constexpr Octave MakeOctave(int32_t a, int32_t b, int32_t inv_q16) {
+  return {a * inv_q16, b * inv_q16};
+}
+// [0] objects, [1] ground; octave 0 is the colour mix, 4 the 1.25 px octave of high resolutions.
+constexpr Octave kOctaves[2][5] = {
+    {MakeOctave(1, 0, 65536 / 56), MakeOctave(4, 3, 65536 / (20 * 5)),
+     MakeOctave(12, 5, 65536 / (7 * 13)), MakeOctave(15, 8, 65536 / (3 * 17)),
+     MakeOctave(21, 20, 65536 * 4 / (5 * 29))},
+    {MakeOctave(1, 0, 65536 / 112), MakeOctave(4, 3, 65536 / (40 * 5)),
+     MakeOctave(12, 5, 65536 / (14 * 13)), MakeOctave(15, 8, 65536 / (6 * 17)),
+     MakeOctave(21, 20, 65536 * 2 / (5 * 29))},
 };
+// Detail weights with three and with four octaves; each set sums to 16.
+constexpr int32_t kDetailWeights[2][4] = {{7, 5, 4, 0}, {6, 5, 3, 2}};
+
+// Value noise: smoothstep-weighted bilinear lattice values, 0..65280 (Q8 of 0..255).
+[[gnu::always_inline]] inline int32_t Noise(const uint8_t* lattice, const uint8_t* fade,
+                                            int32_t size, int64_t u_q8, int64_t v_q8,
+                                            const Octave& oct, int32_t sx, int32_t sy) {
+  const int64_t lu = (u_q8 * oct.ca - v_q8 * oct.cb) >> 16;  // Q8 cells
+  const int64_t lv = (u_q8 * oct.cb + v_q8 * oct.ca) >> 16;
+  const int32_t mask = size - 1;
+  const int32_t iu = static_cast<int32_t>((lu >> 8) + sx) & mask;
+  const int32_t iv = static_cast<int32_t>((lv >> 8) + sy) & mask;
+  const int32_t wu = fade[lu & 255], wv = fade[lv & 255];
+  const uint8_t* r0 = lattice + iv * size;
+  const uint8_t* r1 = lattice + ((iv + 1) & mask) * size;
+  const int32_t iu1 = (iu + 1) & mask;
+  const int32_t top = r0[iu] * (256 - wu) + r0[iu1] * wu;  // Q8
+  const int32_t bot = r1[iu] * (256 - wu) + r1[iu1] * wu;
+  return (top * (256 - wv) + bot * wv) >> 8;
+}
+
+// The detail octaves with compile-time constants, so the factors fold into the code.
+template <int kCount, int kGround>
+int32_t Detail(const uint8_t* lattice, const uint8_t* fade, int32_t size, int64_t u_q8,
+               int64_t v_q8, int32_t sx, int32_t sy) {
+  int32_t sum = 0;
+  for (int k = 1; k <= kCount; ++k)
+    sum += kDetailWeights[kCount - 3][k - 1] *
+           Noise(lattice, fade, size, u_q8, v_q8, kOctaves[kGround][k], sx + 61 * k, sy + 97 * k);
+  return sum >> 12;  // 0..255, mostly 90..170
+}
 
 }  // namespace
 
@@ -102,23 +139,6 @@ int32_t Scene::Winner(const ViewMap* maps, const RowState& row, int32_t x2,
   return best;
 }
 
-// Inlined: up to five calls per pixel, and the call overhead was a fifth of the render time.
-[[gnu::always_inline]] inline int32_t Scene::Noise(int64_t u_q8, int64_t v_q8, int32_t a, int32_t b,
-                                                   int32_t inv_q16, int32_t sx, int32_t sy) const {
-  const int64_t lu = ((u_q8 * a - v_q8 * b) * inv_q16) >> 16;  // Q8 cells
-  const int64_t lv = ((u_q8 * b + v_q8 * a) * inv_q16) >> 16;
-  constexpr int32_t kMask = kNoiseSize - 1;
-  const int32_t iu = static_cast<int32_t>((lu >> 8) + sx) & kMask;
-  const int32_t iv = static_cast<int32_t>((lv >> 8) + sy) & kMask;
-  const int32_t wu = fade_[lu & 255], wv = fade_[lv & 255];
-  const uint8_t* r0 = noise_ + iv * kNoiseSize;
-  const uint8_t* r1 = noise_ + ((iv + 1) & kMask) * kNoiseSize;
-  const int32_t iu1 = (iu + 1) & kMask;
-  const int32_t top = r0[iu] * (256 - wu) + r0[iu1] * wu;  // Q8
-  const int32_t bot = r1[iu] * (256 - wu) + r1[iu1] * wu;
-  return (top * (256 - wv) + bot * wv) >> 8;  // 0..65280, Q8
-}
-
 void Scene::Shade(int32_t index, int64_t xr_q16, int64_t yr_q16, int32_t* rgb) const {
   const Object& o = objects_[index];
   int64_t u, v;  // texture coordinates, Q8: design px, or cm on the ground
@@ -140,14 +160,15 @@ void Scene::Shade(int32_t index, int64_t xr_q16, int64_t yr_q16, int32_t* rgb) c
     v = ((yr_q16 - half_h_q16_) * design_per_px_q24_) >> 32;
   }
   const int g = ground ? 1 : 0;
-  const int32_t mix = Noise(u, v, 1, 0, kOctaves[0].inv_q16[g], o.salt_x, o.salt_y) >> 8;
-  int32_t detail = 0;
-  for (int k = 1; k < detail_octaves_ + 1; ++k) {
-    const Octave& oct = kOctaves[k];
-    detail += detail_weights_[k - 1] *
-              Noise(u, v, oct.a, oct.b, oct.inv_q16[g], o.salt_x + 61 * k, o.salt_y + 97 * k);
-  }
-  detail >>= 12;                          // weights sum to 16: 0..255, mostly 90..170
+  const int32_t mix =
+      Noise(noise_, fade_, kNoiseSize, u, v, kOctaves[g][0], o.salt_x, o.salt_y) >> 8;
+  int32_t detail;
+  if (detail_octaves_ == 4)
+    detail = ground ? Detail<4, 1>(noise_, fade_, kNoiseSize, u, v, o.salt_x, o.salt_y)
+                    : Detail<4, 0>(noise_, fade_, kNoiseSize, u, v, o.salt_x, o.salt_y);
+  else
+    detail = ground ? Detail<3, 1>(noise_, fade_, kNoiseSize, u, v, o.salt_x, o.salt_y)
+                    : Detail<3, 0>(noise_, fade_, kNoiseSize, u, v, o.salt_x, o.salt_y);
   int32_t gain_q8 = 64 + detail * 3 / 2;  // about 0.75..1.25
   int32_t base[3];
   for (int c = 0; c < 3; ++c)
