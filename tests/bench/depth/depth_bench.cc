@@ -134,8 +134,10 @@ void BM_OpenCvSgbmTeddy(benchmark::State& state) {
   const cv::Mat left(set->height, set->width, CV_8UC3, const_cast<uint8_t*>(set->views[2].data()));
   const cv::Mat right(set->height, set->width, CV_8UC3, const_cast<uint8_t*>(set->views[6].data()));
   const int block = 5;
-  auto sgbm = cv::StereoSGBM::create(0, 64, block, 8 * 3 * block * block, 32 * 3 * block * block, 1,
-                                     63, 10, 100, 32, cv::StereoSGBM::MODE_SGBM);
+  // Dense output (no uniqueness, left-right or speckle rejection), so bad_pct scores every
+  // pixel as ours does; P1/P2 are OpenCV's usual 8/32 x channels x block area.
+  auto sgbm = cv::StereoSGBM::create(0, 64, block, 8 * 3 * block * block, 32 * 3 * block * block,
+                                     -1, 63, 0, 0, 0, cv::StereoSGBM::MODE_SGBM);
   cv::Mat disp;
   for (auto _ : state) {
     sgbm->compute(left, right, disp);
