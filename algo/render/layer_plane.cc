@@ -123,6 +123,7 @@ void LayerPlane::Carve(Arena& arena, int32_t width, int32_t height, int32_t chan
   tile_shift_ = 6;
   while ((width + (1 << tile_shift_) - 1) >> tile_shift_ > 64) ++tile_shift_;
   tiles_ = arena.Allocate<uint64_t>(static_cast<size_t>(ring_rows_) * layers);
+  ring_tag_ = arena.Allocate<int32_t>(static_cast<size_t>(ring_rows_));
   pure_ = arena.Allocate<uint64_t>(static_cast<size_t>(ring_rows_) * layers);
   prefix_ = arena.Allocate<uint32_t>(static_cast<size_t>(window_rows_) * planes * pitch_);
   active_ = arena.Allocate<uint8_t>(static_cast<size_t>(window_rows_));
@@ -153,9 +154,14 @@ void LayerPlane::Begin(const ApertureShape& shape, int32_t shift) {
   }
   shift_ = shift;
   next_row_ = 0;
+  stale_ = false;
+  for (int32_t i = 0; i < ring_rows_; ++i) ring_tag_[i] = -1;
 }
 
+bool LayerPlane::Holds(int32_t y) const { return ring_tag_[Slot(y)] == y; }
+
 void LayerPlane::CommitRow(int32_t y, const uint16_t* layer_of, int32_t offset) {
+  ring_tag_[Slot(y)] = y;
   uint64_t* tiles = tiles_ + Slot(y) * layers_;
   uint64_t* pure = pure_ + Slot(y) * layers_;
   for (int32_t k = 0; k < layers_; ++k) tiles[k] = 0, pure[k] = 0;
@@ -176,9 +182,12 @@ void LayerPlane::CommitRow(int32_t y, const uint16_t* layer_of, int32_t offset) 
   next_row_ = y + 1;
 }
 
-uint64_t LayerPlane::Tiles(int32_t k, int32_t y0, int32_t y1) const {
+uint64_t LayerPlane::Tiles(int32_t k, int32_t y0, int32_t y1) {
   uint64_t t = 0;
-  for (int32_t j = Max(0, y0); j < Min(height_, y1); ++j) t |= tiles_[Slot(j) * layers_ + k];
+  for (int32_t j = Max(0, y0); j < Min(height_, y1); ++j) {
+    t |= tiles_[Slot(j) * layers_ + k];
+    stale_ = stale_ || ring_tag_[Slot(j)] != j;
+  }
   return t;
 }
 

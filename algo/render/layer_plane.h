@@ -65,6 +65,10 @@ class LayerPlane {
   // (Q4 + offset) to (first layer << 8 | weight of the next layer Q8).
   void CommitRow(int32_t y, const uint16_t* layer_of, int32_t offset);
   int32_t next_row() const { return next_row_; }
+  // Whether ring row y still holds plane row y, and whether a strip ever read a row that the
+  // ring had already recycled (a sizing bug; checked once per row, reported by the stage).
+  bool Holds(int32_t y) const;
+  bool stale() const { return stale_; }
   int32_t ring_rows() const { return ring_rows_; }
 
   // Renders plane rows [y0, y0 + n) of every layer (back to front), `radius_of_layer[k]` being
@@ -88,7 +92,7 @@ class LayerPlane {
   void RenderRun(int32_t k, int32_t y0, int32_t n, const uint16_t* layer_of, int32_t offset,
                  int32_t kernel, int32_t x0, int32_t x1, uint64_t run);
   // Tiles of layer k in plane rows [y0, y1).
-  uint64_t Tiles(int32_t k, int32_t y0, int32_t y1) const;
+  uint64_t Tiles(int32_t k, int32_t y0, int32_t y1);
   // Gathers low-res row m of the layer into layer_ (normalised Q16) over columns [x0, x1].
   void GatherNormalise(int32_t kernel, int32_t m, int32_t jlo, int32_t jhi, int32_t window_base,
                        int32_t x0, int32_t x1, int32_t* layer, ptrdiff_t layer_stride);
@@ -102,8 +106,10 @@ class LayerPlane {
   int32_t level_[kMaxKernels] = {};
   int32_t half_[kMaxKernels] = {};         // at the kernel's level
   uint64_t reciprocal_[kMaxKernels] = {};  // 2^40 / total kernel weight
-  int16_t* ring_s_ = nullptr;     // ring_rows x width: signed radius, Q4 full-resolution px
-  int16_t* ring_v_ = nullptr;     // ring_rows x channels x width
+  int16_t* ring_s_ = nullptr;    // ring_rows x width: signed radius, Q4 full-resolution px
+  int16_t* ring_v_ = nullptr;    // ring_rows x channels x width
+  int32_t* ring_tag_ = nullptr;  // ring_rows: the plane row each slot holds
+  bool stale_ = false;
   uint64_t* tiles_ = nullptr;     // ring_rows x layers: bit t = the layer has a pixel in tile t
   uint64_t* pure_ = nullptr;      // ring_rows x layers: bit t = every pixel of tile t is wholly
                                   // in the layer

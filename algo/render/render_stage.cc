@@ -190,6 +190,7 @@ Status RenderStage::Begin(const ConstPlanarU8& ref, ConstImageU16 disp_q8,
   luma_.Begin(shape, ShiftFor(max_luma, luma_.max_half()));
   chroma_.Begin(shape, ShiftFor((128 * max_gain + 128) >> 8, chroma_.max_half()));
   upsampler_.Begin(ref, disp_q8);
+  luma_stale_ = false;
   begun_ = true;
   return Status::Ok();
 }
@@ -210,6 +211,7 @@ void RenderStage::FillChromaRow(int32_t cy) {
   // The chroma sample's radius is the mean of its 2x2 luma block's; its boost follows the
   // block's mean luma, applied to the chroma's distance from grey.
   const int32_t y0 = 2 * cy, y1 = Min(2 * cy + 1, config_.height - 1);
+  if (!luma_.Holds(y0) || !luma_.Holds(y1)) luma_stale_ = true;
   const int16_t* s0 = luma_.RadiusRow(y0);
   const int16_t* s1 = luma_.RadiusRow(y1);
   const uint8_t* l0 = ref_.planes[0].Row(y0);
@@ -247,6 +249,9 @@ Status RenderStage::NextStrip(ConstPlanarU8* strip, int32_t* y0, int32_t* rows) 
   const int32_t offset = config_.max_radius * 16;
   luma_.RenderStrip(*y0, *rows, layer_of_, offset, radius_of_layer_, 0, &strip_.planes[0]);
   chroma_.RenderStrip(cy0, cn, layer_of_, offset, radius_of_layer_, 128, &strip_.planes[1]);
+  if (luma_stale_ || luma_.stale() || chroma_.stale()) {
+    return Status(Code::kInternal, "render: strip at row %d read a recycled ring row", *y0);
+  }
   next_row_ += *rows;
   *strip = strip_.AsConst();
   return Status::Ok();

@@ -106,6 +106,7 @@ class RenderStage {
   PlanarU8 strip_;
   int32_t next_row_ = 0;
   bool begun_ = false;
+  bool luma_stale_ = false;  // a chroma row was made from a recycled luma row (a bug)
   LensModel lens_;
   DepthUpsampler upsampler_;
   LayerPlane luma_, chroma_;

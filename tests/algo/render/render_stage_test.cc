@@ -111,6 +111,46 @@ TEST(RenderStage, FlatColourStaysFlatForExtremeConfigurations) {
   }
 }
 
+// An image that repeats every 64 rows renders to one that repeats too, away from the top and
+// bottom: the ring of rows (far shorter than the image) never hands a strip a wrong row.
+TEST(RenderStage, StreamingIsShiftInvariant) {
+  Image im(72, 640, 2);
+  uint32_t seed = 11;
+  auto next = [&seed] { return seed = seed * 1664525u + 1013904223u; };
+  std::vector<uint8_t> tile_y(72 * 64), tile_c(36 * 32 * 2);
+  std::vector<uint16_t> tile_d(36 * 32);
+  for (uint8_t& v : tile_y) v = static_cast<uint8_t>(next() >> 24);
+  for (uint8_t& v : tile_c) v = static_cast<uint8_t>(next() >> 24);
+  for (uint16_t& d : tile_d) d = static_cast<uint16_t>((next() >> 24) * 6);  // 0 .. 6 px
+  for (int32_t y = 0; y < im.h; ++y) {
+    for (int32_t x = 0; x < im.w; ++x) im.Y(x, y) = tile_y[(y % 64) * 72 + x];
+  }
+  for (int32_t y = 0; y < im.h / 2; ++y) {
+    for (int32_t x = 0; x < 36; ++x) {
+      im.cb[y * 36 + x] = tile_c[(y % 32) * 36 + x];
+      im.cr[y * 36 + x] = tile_c[36 * 32 + (y % 32) * 36 + x];
+      im.D(x, y) = tile_d[(y % 32) * 36 + x];
+    }
+  }
+  test::RenderSetup setup;
+  setup.max_radius = 32;
+  setup.params.f_number = 1.4f;
+  setup.params.focus = {10, 10, 4, 4};
+  setup.params.aperture = {5, 12.0f, 0.3f};
+  const test::Rendered out = Render(im, setup);
+  for (int32_t y = 128; y < im.h - 128 - 64; ++y) {
+    for (int32_t x = 0; x < im.w; ++x) {
+      ASSERT_EQ(out.y[y * im.w + x], out.y[(y + 64) * im.w + x]) << x << "," << y;
+    }
+  }
+  for (int32_t y = 64; y < im.h / 2 - 64 - 32; ++y) {
+    for (int32_t x = 0; x < 36; ++x) {
+      ASSERT_EQ(out.cb[y * 36 + x], out.cb[(y + 32) * 36 + x]) << x << "," << y;
+      ASSERT_EQ(out.cr[y * 36 + x], out.cr[(y + 32) * 36 + x]) << x << "," << y;
+    }
+  }
+}
+
 TEST(RenderStage, SharpForegroundDoesNotBleedIntoBlurredBackground) {
   // Left: far background (disparity 1), dark. Right: near foreground (disparity 3), bright, in
   // focus. At f/2.8 and scale 4 the background blurs by 16 px.
