@@ -27,7 +27,9 @@ const char kUsage[] =
     "  --disparity MIN,MAX    label range in px per view step (default 0 and (N-1)/4:\n"
     "                         quarter-pixel labels)\n"
     "  --smoothness W         smoothness weight, 0..4096 (default %d)\n"
-    "  --cycles N             expansion cycle cap, 0..32 (default %d)\n";
+    "  --cycles N             expansion cycle cap, 0..32 (default %d)\n"
+    "  --subpixel             write the sub-label refinement the renderer uses (default: the\n"
+    "                         labels' disparities, which score best against whole-pixel truth)\n";
 
 int Usage(const char* problem) {
   if (problem) fprintf(stderr, "refocus depth: %s\n", problem);
@@ -61,6 +63,7 @@ int DepthCommand(int argc, char** argv) {
   int32_t ref = -1;
   DepthConfig c;
   c.labels = 64;
+  c.subpixel = false;
   float disp_min = 0, disp_max = -1;
   std::string error;
   for (int i = 1; i < argc; ++i) {  // argv[0] is the subcommand's name
@@ -73,6 +76,9 @@ int DepthCommand(int argc, char** argv) {
     bool ok = true;
     if (!strcmp(a, "--views")) {
       while (i + 1 < argc && strncmp(argv[i + 1], "--", 2) != 0) files.push_back(argv[++i]);
+      continue;
+    } else if (!strcmp(a, "--subpixel")) {
+      c.subpixel = true;
       continue;
     } else if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
       return Usage(nullptr);
