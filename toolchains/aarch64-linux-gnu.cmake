@@ -13,8 +13,10 @@ set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE ONLY)
 set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE ONLY)
 set(ENV{PKG_CONFIG_LIBDIR} "${LB_SYSROOT}/usr/lib/aarch64-linux-gnu/pkgconfig:${LB_SYSROOT}/usr/share/pkgconfig")
 set(CMAKE_CROSSCOMPILING_EMULATOR
-    qemu-aarch64-static;-L;/usr/aarch64-linux-gnu;-E;LD_LIBRARY_PATH=${LB_SYSROOT}/usr/lib/aarch64-linux-gnu)
-set(CMAKE_EXE_LINKER_FLAGS_INIT "-Wl,-rpath-link,${LB_SYSROOT}/usr/lib/aarch64-linux-gnu")
+    qemu-aarch64-static;-L;/usr/aarch64-linux-gnu;-E;LD_LIBRARY_PATH=${LB_SYSROOT}/usr/lib/aarch64-linux-gnu:${LB_SYSROOT}/lib/aarch64-linux-gnu)
+# zlib lives in /lib/<triple>, the rest in /usr/lib/<triple>.
+set(CMAKE_EXE_LINKER_FLAGS_INIT
+    "-Wl,-rpath-link,${LB_SYSROOT}/usr/lib/aarch64-linux-gnu -Wl,-rpath-link,${LB_SYSROOT}/lib/aarch64-linux-gnu")
 # Debian puts architecture-specific headers (jconfig.h) under include/<triple>.
 set(CMAKE_C_STANDARD_INCLUDE_DIRECTORIES ${LB_SYSROOT}/usr/include/aarch64-linux-gnu)
 set(CMAKE_CXX_STANDARD_INCLUDE_DIRECTORIES ${LB_SYSROOT}/usr/include/aarch64-linux-gnu)

@@ -13,8 +13,10 @@ set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE ONLY)
 set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE ONLY)
 set(ENV{PKG_CONFIG_LIBDIR} "${LB_SYSROOT}/usr/lib/arm-linux-gnueabihf/pkgconfig:${LB_SYSROOT}/usr/share/pkgconfig")
 set(CMAKE_CROSSCOMPILING_EMULATOR
-    qemu-arm-static;-L;/usr/arm-linux-gnueabihf;-E;LD_LIBRARY_PATH=${LB_SYSROOT}/usr/lib/arm-linux-gnueabihf)
-set(CMAKE_EXE_LINKER_FLAGS_INIT "-Wl,-rpath-link,${LB_SYSROOT}/usr/lib/arm-linux-gnueabihf")
+    qemu-arm-static;-L;/usr/arm-linux-gnueabihf;-E;LD_LIBRARY_PATH=${LB_SYSROOT}/usr/lib/arm-linux-gnueabihf:${LB_SYSROOT}/lib/arm-linux-gnueabihf)
+# zlib lives in /lib/<triple>, the rest in /usr/lib/<triple>.
+set(CMAKE_EXE_LINKER_FLAGS_INIT
+    "-Wl,-rpath-link,${LB_SYSROOT}/usr/lib/arm-linux-gnueabihf -Wl,-rpath-link,${LB_SYSROOT}/lib/arm-linux-gnueabihf")
 # Debian puts architecture-specific headers (jconfig.h) under include/<triple>.
 set(CMAKE_C_STANDARD_INCLUDE_DIRECTORIES ${LB_SYSROOT}/usr/include/arm-linux-gnueabihf)
 set(CMAKE_CXX_STANDARD_INCLUDE_DIRECTORIES ${LB_SYSROOT}/usr/include/arm-linux-gnueabihf)
