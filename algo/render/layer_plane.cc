@@ -51,18 +51,34 @@ void CompositeRow(int32_t* out, const int32_t* colour, const int32_t* alpha, int
   }
 }
 
-// Linear interpolation of a low-res row (col[-1] .. col[n] valid) at output columns [x0, x1]
-// of level `level`: column x lies between low-res columns q = (x - f/2) >> level and q + 1, at
-// the fixed weight frac[x] (Q8) of q + 1; each interval's f columns share a and b - a.
-void LerpRow(const int32_t* col, const uint8_t* frac, int32_t level, int32_t* dst, int32_t x0,
-             int32_t x1) {
+// Interpolates a reduced layer's blended rows (C colour planes then alpha, `stride` apart,
+// col[-1] .. col[n] valid) at output columns [x0, x1] and lays it over `out` in the same pass:
+// column x lies between low-res columns q = (x - f/2) >> level and q + 1 at the weight frac[x]
+// (Q8) of q + 1, and each interval's f columns share the endpoints.
+template <int C>
+void LerpComposite(const int32_t* col, ptrdiff_t stride, const uint8_t* frac, int32_t level,
+                   int32_t x0, int32_t x1, int32_t* out, ptrdiff_t out_stride) {
   const int32_t f = 1 << level;
   for (int32_t x = x0; x <= x1;) {
     const int32_t q = (x - f / 2) >> level;
     const int32_t end = Min(x1, ((q + 1) << level) + f / 2 - 1);
-    const int32_t a = col[q];
-    const int64_t d = col[q + 1] - a;
-    for (; x <= end; ++x) dst[x] = a + static_cast<int32_t>((d * frac[x] + 128) >> 8);
+    int32_t a[C + 1];
+    int64_t d[C + 1];
+    for (int32_t c = 0; c <= C; ++c) {
+      a[c] = col[c * stride + q];
+      d[c] = col[c * stride + q + 1] - a[c];
+    }
+    for (; x <= end; ++x) {
+      const int32_t alpha = a[C] + static_cast<int32_t>((d[C] * frac[x] + 128) >> 8);
+      const int64_t keep = 65536 - alpha;
+      for (int32_t c = 0; c < C; ++c) {
+        const int32_t colour = a[c] + static_cast<int32_t>((d[c] * frac[x] + 128) >> 8);
+        int32_t& o = out[c * out_stride + x];
+        o = static_cast<int32_t>(((o * keep + 32768) >> 16) + colour);
+      }
+      int32_t& o = out[C * out_stride + x];
+      o = static_cast<int32_t>(((o * keep + 32768) >> 16) + alpha);
+    }
   }
 }
 
@@ -442,9 +458,13 @@ void LayerPlane::RenderRun(int32_t k, int32_t y0, int32_t n, const uint16_t* lay
       }
       col[q_lo - 1] = col[q_lo];
       col[q_hi + 1] = col[q_hi];
-      LerpRow(col, frac_[level], level, full_ + c * static_cast<ptrdiff_t>(pitch_), x0, x1);
     }
-    Composite(full_, pitch_, x0, x1, out_ + (y - y0) * row_stride);
+    int32_t* out = out_ + (y - y0) * row_stride;
+    if (channels_ == 1) {
+      LerpComposite<1>(box_ + 1, pitch_, frac_[level], level, x0, x1, out, width_);
+    } else {
+      LerpComposite<2>(box_ + 1, pitch_, frac_[level], level, x0, x1, out, width_);
+    }
   }
 }
 
