@@ -82,6 +82,34 @@ void LerpComposite(const int32_t* col, ptrdiff_t stride, const uint8_t* frac, in
   }
 }
 
+// box[x >> level] += (sum of v over its 2^level columns within [x0, x1]) << up. Whole groups
+// have a fixed length, so the inner loop is unrolled for each level.
+template <int L>
+void SumGroupsT(const int16_t* v, int32_t x0, int32_t x1, int32_t up, int32_t* box) {
+  int32_t x = x0;
+  for (; x + (1 << L) - 1 <= x1; x += 1 << L) {
+    int32_t sum = 0;
+    for (int32_t k = 0; k < (1 << L); ++k) sum += v[x + k];
+    box[x >> L] += sum * (1 << up);
+  }
+  int32_t sum = 0;
+  for (int32_t k = x; k <= x1; ++k) sum += v[k];
+  if (x <= x1) box[x >> L] += sum * (1 << up);
+}
+
+void SumGroups(const int16_t* v, int32_t x0, int32_t x1, int32_t level, int32_t up, int32_t* box) {
+  switch (level) {
+    case 1:
+      return SumGroupsT<1>(v, x0, x1, up, box);
+    case 2:
+      return SumGroupsT<2>(v, x0, x1, up, box);
+    case 3:
+      return SumGroupsT<3>(v, x0, x1, up, box);
+    default:
+      return SumGroupsT<4>(v, x0, x1, up, box);
+  }
+}
+
 struct KernelPlan {
   float radius;
   int32_t level, half;
@@ -146,7 +174,6 @@ void LayerPlane::Carve(Arena& arena, int32_t width, int32_t height, int32_t chan
   box_ = arena.Allocate<int32_t>(planes * pitch_);
   acc_ = arena.Allocate<uint32_t>(planes * pitch_);
   layer_ = arena.Allocate<int32_t>(static_cast<size_t>(low_rows_) * planes * pitch_);
-  full_ = arena.Allocate<int32_t>(planes * pitch_);
   out_ = arena.Allocate<int32_t>(static_cast<size_t>(strip_rows) * planes * width);
   kernels_ = arena.Allocate<KernelRow>(static_cast<size_t>(radii) * kernel_rows_);
   // Column l of a reduced level samples the low-res row at (2x + 1 - f) / 2f, Q8.
@@ -288,12 +315,20 @@ void LayerPlane::BuildPrefixT(int32_t k, int32_t level, int32_t h, int32_t jlo, 
           const uint64_t bit = uint64_t{1} << (t0 >> tile_shift_);
           if (!(any & bit)) continue;
           const int32_t t1 = Min(x1, t0 + tile - 1);
-          const bool whole = (pure & bit) != 0;
+          if ((pure & bit) && shift <= 8) {
+            // Wholly in the layer: weight 256 everywhere, and as v * 256 is a multiple of
+            // 2^shift, the sum of (v * 256) >> shift is (sum of v) << (8 - shift) exactly.
+            for (int32_t c = 0; c < C; ++c) SumGroups(v[c], t0, t1, level, 8 - shift, box[c]);
+            for (int32_t q = t0 >> level; q <= t1 >> level; ++q) {
+              box[C][q] += 256 * (Min(t1, ((q + 1) << level) - 1) - (q << level) + 1);
+            }
+            continue;
+          }
           for (int32_t q = t0 >> level; q <= t1 >> level; ++q) {
             int32_t sum[C + 1] = {};
             const int32_t xe = Min(t1, ((q + 1) << level) - 1);
             for (int32_t x = q << level; x <= xe; ++x) {
-              const int32_t a = whole ? 256 : weight(layer_of[s[x] + offset]);
+              const int32_t a = weight(layer_of[s[x] + offset]);
               for (int32_t c = 0; c < C; ++c) sum[c] += (v[c][x] * a) >> shift;
               sum[C] += a;
             }

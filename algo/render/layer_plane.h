@@ -119,7 +119,6 @@ class LayerPlane {
   int32_t* box_ = nullptr;        // (channels + 1) x pitch: one low-res row's box sums
   uint32_t* acc_ = nullptr;       // (channels + 1) x pitch: kernel sums, wrapping
   int32_t* layer_ = nullptr;      // low_rows x (channels + 1) x pitch: normalised layer, Q16
-  int32_t* full_ = nullptr;       // (channels + 1) x pitch: one upsampled row of a layer, Q16
   int32_t* out_ = nullptr;        // strip_rows x (channels + 1) x width, premultiplied Q16
   KernelRow* kernels_ = nullptr;  // radii x kernel_rows
   uint8_t* frac_[kMaxLevel + 1] = {};  // per level and column: the right low-res tap's weight
