@@ -72,7 +72,10 @@ Status DepthStage::Carve(Arena& arena) {
   weight_right_ = arena.Allocate<uint16_t>(n);
   weight_down_ = arena.Allocate<uint16_t>(n);
   state_ = arena.Allocate<uint8_t>(n);
-  reach_ = arena.Allocate<uint16_t>(n);
+  reach_ = arena.Allocate<uint16_t>(static_cast<size_t>(w));
+  prev_alpha_ = arena.Allocate<uint16_t>(n);
+  below_ = arena.Allocate<uint16_t>(n);
+  above_ = arena.Allocate<uint16_t>(n);
   stats_.arena_bytes = arena.used() - start;
   if (arena.overflowed()) return Status(Code::kOutOfMemory, "depth: arena too small");
   return Status::Ok();
@@ -109,16 +112,6 @@ void DepthStage::EdgeWeights(const ConstImageU8& ref) {
       const int32_t p = y * w + x;
       weight_right_[p] = x + 1 < w ? weight(row + 3 * x, row + 3 * x + 3) : 0;
       weight_down_[p] = y + 1 < h ? weight(row + 3 * x, below + 3 * x) : 0;
-    }
-  }
-  // Largest change of the pair terms around a pixel when it alone switches label.
-  for (int32_t y = 0; y < h; ++y) {
-    for (int32_t x = 0; x < w; ++x) {
-      const int32_t p = y * w + x;
-      const int32_t sum = weight_right_[p] + (x > 0 ? weight_right_[p - 1] : 0) + weight_down_[p] +
-                          (y > 0 ? weight_down_[p - w] : 0);
-      const int32_t reach = sum * config_.smooth_trunc;  // saturating is safe: D <= 2295
-      reach_[p] = static_cast<uint16_t>(reach > 0xffff ? 0xffff : reach);
     }
   }
 }
@@ -183,7 +176,15 @@ bool DepthStage::Expand(int32_t alpha) {
     uint8_t* state = state_ + row;
     const uint16_t* ca = cost_alpha_ + row;
     const uint16_t* cc = cost_ + row;
-    const uint16_t* reach = reach_ + row;
+    // Largest change of the pair terms around a pixel when it alone switches label
+    // (saturating is safe: D <= 2295).
+    uint16_t* reach = reach_;
+    for (int32_t x = 0; x < w; ++x) {
+      const int32_t sum = weight_right_[row + x] + (x > 0 ? weight_right_[row + x - 1] : 0) +
+                          weight_down_[row + x] + (y > 0 ? weight_down_[row + x - w] : 0);
+      const int32_t r = sum * config_.smooth_trunc;
+      reach[x] = static_cast<uint16_t>(r > 0xffff ? 0xffff : r);
+    }
     bool open = false;
     for (int32_t x = 0; x < w; ++x) {
       const int32_t u = ca[x] - cc[x];
@@ -222,7 +223,10 @@ bool DepthStage::Expand(int32_t alpha) {
       y_hi = y;
     }
   }
-  if (y_hi < 0) return false;
+  if (y_hi < 0) {
+    Record(alpha);
+    return false;
+  }
 
   // Pass 2: the cut over the free pixels of rows y_lo..y_hi (node = p - y_lo * w). A fixed
   // neighbour turns a pair term into a unary one: E(x_p) = a + (c - a) x_p with a = V(fp, lq),
@@ -305,11 +309,37 @@ bool DepthStage::Expand(int32_t alpha) {
     }
   }
   energy_ += delta;
+  Record(alpha);
   return delta < 0;
+}
+
+// Keeps D_p(f_p - 1) and D_p(f_p + 1) for the sub-label fit without another pass of the data
+// term: moves run in label order, so a pixel that keeps label f saw D(f - 1) and D(f + 1) in
+// the moves before and after f, and one that just took alpha saw D(alpha - 1) in the move
+// before (kept in prev_alpha_) and will see D(alpha + 1) in the next.
+void DepthStage::Record(int32_t alpha) {
+  const int32_t n = config_.width * config_.height;
+  const bool have_prev = prev_label_ == alpha - 1;
+  for (int32_t p = 0; p < n; ++p) {
+    const int32_t f = labels_[p];
+    if (state_[p] == kTake) {
+      below_[p] = have_prev ? prev_alpha_[p] : 0xffff;
+      above_[p] = 0xffff;
+    } else if (f == alpha + 1) {
+      below_[p] = cost_alpha_[p];
+    } else if (f + 1 == alpha) {
+      above_[p] = cost_alpha_[p];
+    }
+  }
+  uint16_t* t = prev_alpha_;
+  prev_alpha_ = cost_alpha_;
+  cost_alpha_ = t;
+  prev_label_ = alpha;
 }
 
 int64_t DepthStage::Energy(const uint8_t* labels) {
   const int32_t w = config_.width, h = config_.height;
+  prev_label_ = -1;  // cost_alpha_ is used as scratch below
   int64_t data = 0;
   for (int32_t label = 0; label < config_.labels; ++label) {
     data_.ComputeRows(LabelDispQ8(label), 0, h, cost_alpha_, w);
@@ -323,23 +353,11 @@ int64_t DepthStage::Energy(const uint8_t* labels) {
          LabelEnergy(labels, cost_alpha_, weight_right_, weight_down_, w, h, config_.smooth_trunc);
 }
 
-// Sub-label disparity: a parabola through D at f_p - 1, f_p, f_p + 1, its vertex clamped to half a
-// label either side. Runs after the optimiser, so it may borrow the move buffers.
+// Sub-label disparity: a parabola through D at f_p - 1, f_p, f_p + 1 (as recorded by the
+// moves), its vertex within half a label either side. Without expansion moves there is nothing
+// recorded and the output is the labels' disparities.
 void DepthStage::Refine(ImageU16 disp_q8) {
-  const int32_t w = config_.width, h = config_.height, n = w * h;
-  uint16_t* below = cost_alpha_;     // D_p(f_p - 1)
-  uint16_t* above = weight_right_;   // D_p(f_p + 1)
-  uint16_t* scratch = weight_down_;  // D of the label being evaluated
-  if (config_.subpixel) {
-    for (int32_t p = 0; p < n; ++p) below[p] = above[p] = 0xffff;
-    for (int32_t label = 0; label < config_.labels; ++label) {
-      data_.ComputeRows(LabelDispQ8(label), 0, h, scratch, w);
-      for (int32_t p = 0; p < n; ++p) {
-        if (labels_[p] == label + 1) below[p] = scratch[p];
-        if (labels_[p] + 1 == label) above[p] = scratch[p];
-      }
-    }
-  }
+  const int32_t w = config_.width, h = config_.height;
   for (int32_t y = 0; y < h; ++y) {
     uint16_t* out = disp_q8.Row(y);
     for (int32_t x = 0; x < w; ++x) {
@@ -347,9 +365,9 @@ void DepthStage::Refine(ImageU16 disp_q8) {
       const int32_t f = labels_[p];
       int32_t d_q8 = LabelDispQ8(f);
       if (config_.subpixel && f > 0 && f + 1 < config_.labels) {
-        const int32_t cm = below[p], c0 = cost_[p], cp = above[p];
+        const int32_t cm = below_[p], c0 = cost_[p], cp = above_[p];
         const int32_t curvature = cm + cp - 2 * c0;
-        if (c0 <= cm && c0 <= cp && curvature > 0) {
+        if (cm != 0xffff && cp != 0xffff && c0 <= cm && c0 <= cp && curvature > 0) {
           const int32_t step_q8 = (LabelDispQ8(f + 1) - LabelDispQ8(f - 1)) / 2;
           // Vertex at (cm - cp) / (2 * curvature) labels; |cm - cp| <= curvature keeps it
           // within half a label. Truncating division, the same on every target.
@@ -380,6 +398,8 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
   WinnerTakeAll();
   energy_ = LabelEnergy(labels_, cost_, weight_right_, weight_down_, w, h, c.smooth_trunc);
   stats_.initial_energy = energy_;
+  for (int32_t p = 0; p < w * h; ++p) below_[p] = above_[p] = 0xffff;
+  prev_label_ = -1;
   stats_.cycles = 0;
   stats_.moves = 0;
   stats_.cut_pixels = 0;
@@ -396,7 +416,6 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
   }
   stats_.energy = energy_;
   Refine(disp_q8);
-  EdgeWeights(views[c.reference]);  // Refine borrowed the weight buffers
   return Status::Ok();
 }
 

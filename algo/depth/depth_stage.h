@@ -86,6 +86,7 @@ class DepthStage {
   void WinnerTakeAll();
   // One alpha-expansion move; returns true when it lowered the energy.
   bool Expand(int32_t alpha);
+  void Record(int32_t alpha);
   void Refine(ImageU16 disp_q8);
   int32_t Smooth(int32_t a, int32_t b) const {
     const int32_t d = a > b ? a - b : b - a;
@@ -97,14 +98,17 @@ class DepthStage {
   DataTerm data_;
   GridMaxflow maxflow_;
   uint8_t* labels_ = nullptr;
-  uint16_t* cost_ = nullptr;  // D_p(f_p) of the current labels
-  uint16_t* cost_alpha_ =
-      nullptr;  // D_p(alpha) of the move in progress; D_p(f_p - 1) when refining
-  uint16_t* weight_right_ = nullptr;  // w_pq to the right neighbour; D_p(f_p + 1) when refining
+  uint16_t* cost_ = nullptr;          // D_p(f_p) of the current labels
+  uint16_t* cost_alpha_ = nullptr;    // D_p(alpha) of the move in progress
+  uint16_t* weight_right_ = nullptr;  // w_pq to the right neighbour
   uint16_t* weight_down_ = nullptr;
   enum : uint8_t { kFree = 0, kKeep = 1, kTake = 2 };
-  uint8_t* state_ = nullptr;   // per pixel in a move: free for the cut, or fixed
-  uint16_t* reach_ = nullptr;  // per pixel: sum of its pair weights times smooth_trunc
+  uint8_t* state_ = nullptr;        // per pixel in a move: free for the cut, or fixed
+  uint16_t* reach_ = nullptr;       // one row: each pixel's pair weights summed, times smooth_trunc
+  uint16_t* prev_alpha_ = nullptr;  // D of the previous move's label, prev_label_
+  int32_t prev_label_ = -1;
+  uint16_t* below_ = nullptr;  // D_p(f_p - 1), 0xffff when not seen
+  uint16_t* above_ = nullptr;  // D_p(f_p + 1)
   int64_t energy_ = 0;
 };
 
