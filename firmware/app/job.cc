@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <ctime>
 
+#include "firmware/app/refocusable.h"
 #include "firmware/jpeg/jpeg_writer.h"
 #include "firmware/storage/atomic_file.h"
 
@@ -70,6 +71,9 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
   double t2 = Now();
   r.depth_s = t2 - t1;
 
+  LB_RETURN_IF_ERROR(p.BeginRender(options_.render));
+  r.focus_disp_q8 = p.render().focus_disp_q8();
+
   JpegMetadata meta;
   meta.make = options_.make;
   meta.model = options_.model;
@@ -78,10 +82,18 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
   FormatExifTime(when, sizeof(when));
   meta.datetime_original = when;
   meta.f_number = options_.render.f_number;
+  if (options_.refocusable) {
+    // The XMP precedes the image data, so it is built before the first strip is encoded.
+    std::vector<uint8_t> original;
+    LB_RETURN_IF_ERROR(EncodeYCbCr420(p.reference(), options_.quality, &original));
+    const PipelineConfig& pc = p.config();
+    LB_RETURN_IF_ERROR(
+        BuildRefocusableSegments(p.disparity_q8(), {pc.disp_min_q8, pc.disp_max_q8}, original,
+                                 FocusOf(p.render(), options_.render, mode_.width, mode_.height),
+                                 mode_.width, &meta.extra_segments));
+  }
   JpegWriter writer;
   LB_RETURN_IF_ERROR(writer.Begin(&file, mode_.width, mode_.height, options_.quality, meta));
-  LB_RETURN_IF_ERROR(p.BeginRender(options_.render));
-  r.focus_disp_q8 = p.render().focus_disp_q8();
   for (;;) {
     ConstPlanarU8 strip;
     int32_t y0 = 0, rows = 0;

@@ -18,6 +18,9 @@ struct JobOptions {
   PipelineConfig pipeline;  // width/height/frames are taken from the sensor's mode
   RenderParams render;
   int quality = 92;
+  // Embed the depth map, the all-in-focus original and the focus (GDepth/GImage/GFocus XMP) so
+  // the photo can be refocused later (`refocus rerender`, Google Photos and other viewers).
+  bool refocusable = true;
   const char* make = "LensBlur";
   const char* model = "Simulated camera";
   const char* software = "refocus";

@@ -8,7 +8,9 @@ namespace {
 // Largest disparity the product uses is far below this; it keeps 65535 * span inside int64.
 constexpr int32_t kMaxDispQ8 = 1 << 24;
 
-int32_t FarQ8(const DisparityRange& range) { return range.min_q8 > 0 ? range.min_q8 : 1; }
+// A range that reaches infinity (disparity 0) gets a finite Far, as viewers expect, far enough
+// that it reads back as disparity 0 (256 / 1e6 < 1/2 in Q8) so the map stays lossless.
+constexpr double kFarForInfinity = 1e6;
 
 bool SameSize(ConstImageU16 a, ConstImageU16 b) {
   return !a.empty() && !b.empty() && a.width == b.width && a.height == b.height &&
@@ -18,12 +20,12 @@ bool SameSize(ConstImageU16 a, ConstImageU16 b) {
 }  // namespace
 
 Status DepthNearFar(const DisparityRange& range, double* near_depth, double* far_depth) {
-  if (range.min_q8 < 0 || range.max_q8 > kMaxDispQ8 || FarQ8(range) >= range.max_q8) {
+  if (range.min_q8 < 0 || range.max_q8 > kMaxDispQ8 || range.min_q8 >= range.max_q8) {
     return Status(Code::kInvalidArgument, "depth encoding: disparity range %d..%d (Q8) is empty",
                   static_cast<int>(range.min_q8), static_cast<int>(range.max_q8));
   }
   *near_depth = 256.0 / range.max_q8;
-  *far_depth = 256.0 / FarQ8(range);
+  *far_depth = range.min_q8 > 0 ? 256.0 / range.min_q8 : kFarForInfinity;
   return Status::Ok();
 }
 
@@ -50,7 +52,7 @@ double DepthForDisparity(int32_t disp_q8) { return 256.0 / (disp_q8 > 0 ? disp_q
 
 uint16_t EncodeRangeInverse(int32_t disp_q8, const DisparityRange& range, int bits) {
   const int64_t top = bits == 8 ? 255 : 65535;
-  const int32_t far_q8 = FarQ8(range);
+  const int32_t far_q8 = range.min_q8;
   const int32_t d = disp_q8 < far_q8 ? far_q8 : (disp_q8 > range.max_q8 ? range.max_q8 : disp_q8);
   const int64_t span = range.max_q8 - far_q8;
   // Round half up; the numerator is at most 65535 * 2^24 * 2.
@@ -60,8 +62,7 @@ uint16_t EncodeRangeInverse(int32_t disp_q8, const DisparityRange& range, int bi
 int32_t DecodeRangeInverse(uint16_t value, const DisparityRange& range, int bits) {
   const int64_t top = bits == 8 ? 255 : 65535;
   const int64_t v = value > top ? top : value;
-  const int32_t far_q8 = FarQ8(range);
-  const int64_t span = range.max_q8 - far_q8;
+  const int64_t span = range.max_q8 - range.min_q8;
   return range.max_q8 - static_cast<int32_t>((v * span * 2 + top) / (2 * top));
 }
 

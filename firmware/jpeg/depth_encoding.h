@@ -15,7 +15,7 @@
 namespace lb {
 
 struct DisparityRange {
-  int32_t min_q8 = 0;  // farthest plane; 0 (infinity) is encoded as 1/256 px
+  int32_t min_q8 = 0;  // farthest plane; 0 (infinity) is written with a Far of 1e6
   int32_t max_q8 = 0;  // nearest plane
 };
 
@@ -26,7 +26,7 @@ Status DepthNearFar(const DisparityRange& range, double* near_depth, double* far
 Status DisparityRangeFromNearFar(double near_depth, double far_depth, DisparityRange* range);
 
 // The depth (in Near/Far units) of a disparity, e.g. the focal plane for GFocus:FocalDistance.
-// Disparity 0 (infinity) is taken as 1/256 px, like the far plane.
+// Disparity 0 (infinity) is taken as 1/256 px.
 double DepthForDisparity(int32_t disp_q8);
 
 // dispQ8 -> RangeInverse value of `bits` (8 or 16) bits, rounded to nearest; disparities outside

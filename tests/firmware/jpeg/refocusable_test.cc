@@ -37,14 +37,14 @@ void ExpectSameAsWritten(const RefocusSample& s, const RefocusableImage& r) {
   EXPECT_DOUBLE_EQ(r.xmp.focus.focal_distance, 0.25);
   EXPECT_DOUBLE_EQ(r.xmp.focus.focal_point_x, 0.375);
   EXPECT_DOUBLE_EQ(r.xmp.focus.focal_point_y, 0.625);
-  // The exact disparities come back (16 bits; 0 is stored as the far plane, 1/256 px).
+  // The exact disparities come back (16 bits), infinity (0) included.
   std::vector<uint16_t> disp;
   DisparityRange range;
   ASSERT_TRUE(DisparityFromDepth(r, &disp, &range).ok());
   EXPECT_EQ(range.max_q8, s.range.max_q8);
   ASSERT_EQ(disp.size(), s.disp_q8.size());
   for (size_t i = 0; i < disp.size(); ++i) {
-    ASSERT_EQ(disp[i], std::max<uint16_t>(s.disp_q8[i], 1)) << "pixel " << i;
+    ASSERT_EQ(disp[i], s.disp_q8[i]) << "pixel " << i;
   }
 }
 

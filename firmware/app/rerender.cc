@@ -1,0 +1,119 @@
+#include "firmware/app/rerender.h"
+
+#include <cstdlib>
+#include <memory>
+
+#include "algo/core/color.h"
+#include "firmware/app/refocusable.h"
+#include "firmware/jpeg/jpeg_writer.h"
+#include "firmware/jpeg/refocusable_reader.h"
+#include "firmware/storage/atomic_file.h"
+#include "sim/files/image_file.h"
+
+namespace lb {
+
+Status Rerenderer::Load(const char* path) {
+  RefocusableImage file;
+  LB_RETURN_IF_ERROR(ReadRefocusableFile(path, &file));
+  if (file.xmp.image.empty()) {
+    return Status(Code::kUnsupported, "%s: no all-in-focus original (GImage) to re-render from",
+                  path);
+  }
+  LB_RETURN_IF_ERROR(DisparityFromDepth(file, &disp_q8_, &range_));
+  ImageFileInfo info;
+  std::vector<uint8_t> pixels;
+  Status s = ReadImageMemory(file.xmp.image.data(), file.xmp.image.size(), "GImage", &info, &pixels,
+                             ImageFileType::kJpeg);
+  if (!s.ok()) return s.Prefix("%s: ", path);
+  depth_w_ = file.depth.width;
+  depth_h_ = file.depth.height;
+  width_ = info.width;
+  height_ = info.height;
+  scale_ = depth_w_ > 0 ? width_ / depth_w_ : 0;
+  if (scale_ < 1 || depth_h_ * scale_ > height_ || depth_w_ * scale_ > width_ ||
+      height_ / scale_ != depth_h_) {
+    return Status(Code::kUnsupported,
+                  "%s: depth map %dx%d is not a whole-number fraction of the %dx%d original", path,
+                  depth_w_, depth_h_, width_, height_);
+  }
+  // The same conversion the pipeline applies to a sensor's reference frame.
+  const int32_t cw = (width_ + 1) / 2, ch = (height_ + 1) / 2;
+  y_.assign(static_cast<size_t>(width_) * height_, 0);
+  cb_.assign(static_cast<size_t>(cw) * ch, 0);
+  cr_.assign(static_cast<size_t>(cw) * ch, 0);
+  std::vector<uint8_t> rgb(static_cast<size_t>(width_) * 3 * 2);
+  const int bpp = BytesPerPixel(info.format);
+  for (int32_t y = 0; y < height_; ++y) {
+    uint8_t* row = rgb.data() + (y & 1) * width_ * 3;
+    RowToRgb8(info.format, pixels.data() + static_cast<size_t>(y) * width_ * bpp, nullptr, width_,
+              row);
+    RowRgb8ToY(row, width_, y_.data() + static_cast<size_t>(y) * width_);
+    if ((y & 1) || y == height_ - 1) {
+      const uint8_t* above = (y & 1) ? rgb.data() : row;
+      RowsRgb8ToCbCr420(above, row, width_, cb_.data() + static_cast<size_t>(y / 2) * cw,
+                        cr_.data() + static_cast<size_t>(y / 2) * cw);
+    }
+  }
+  original_jpeg_ = std::move(file.xmp.image);
+  return Status::Ok();
+}
+
+ConstPlanarU8 Rerenderer::reference() const {
+  ConstPlanarU8 p;
+  p.count = 3;
+  const int32_t cw = (width_ + 1) / 2, ch = (height_ + 1) / 2;
+  p.planes[0] = {y_.data(), width_, height_, 1, width_};
+  p.planes[1] = {cb_.data(), cw, ch, 1, cw};
+  p.planes[2] = {cr_.data(), cw, ch, 1, cw};
+  return p;
+}
+
+ConstImageU16 Rerenderer::disparity_q8() const {
+  return {disp_q8_.data(), depth_w_, depth_h_, 1, depth_w_};
+}
+
+Status Rerenderer::Render(const RerenderOptions& options, const char* out_path,
+                          StripObserver* observer) {
+  if (width_ == 0) return Status(Code::kInvalidArgument, "rerender before a file was loaded");
+  RenderConfig rc;
+  rc.width = width_;
+  rc.height = height_;
+  rc.working_scale = scale_;
+  rc.working_width = depth_w_;
+  rc.working_height = depth_h_;
+  rc.max_radius = options.max_blur_radius;
+  LB_RETURN_IF_ERROR(RenderStage::Validate(rc));
+  const size_t bytes = RenderStage::RequiredBytes(rc);
+  std::unique_ptr<void, decltype(&free)> block(aligned_alloc(Arena::kAlign, Arena::RoundUp(bytes)),
+                                               &free);
+  if (!block) return Status(Code::kOutOfMemory, "cannot allocate %zu bytes to render", bytes);
+  Arena arena(block.get(), Arena::RoundUp(bytes));
+  RenderStage render;
+  LB_RETURN_IF_ERROR(render.Configure(rc, arena));
+  LB_RETURN_IF_ERROR(render.Begin(reference(), disparity_q8(), options.render));
+
+  AtomicFile file;
+  LB_RETURN_IF_ERROR(file.Open(out_path));
+  JpegMetadata meta;
+  meta.make = "LensBlur";
+  meta.model = "Re-rendered";
+  meta.software = "refocus rerender";
+  meta.f_number = options.render.f_number;
+  LB_RETURN_IF_ERROR(BuildRefocusableSegments(disparity_q8(), range_, original_jpeg_,
+                                              FocusOf(render, options.render, width_, height_),
+                                              width_, &meta.extra_segments));
+  JpegWriter writer;
+  LB_RETURN_IF_ERROR(writer.Begin(&file, width_, height_, options.quality, meta));
+  for (;;) {
+    ConstPlanarU8 strip;
+    int32_t y0 = 0, rows = 0;
+    LB_RETURN_IF_ERROR(render.NextStrip(&strip, &y0, &rows));
+    if (rows == 0) break;
+    if (observer) observer->OnStrip(strip, y0, rows);
+    LB_RETURN_IF_ERROR(writer.WriteStrip(strip, rows));
+  }
+  LB_RETURN_IF_ERROR(writer.Finish());
+  return file.Commit();
+}
+
+}  // namespace lb

@@ -1,0 +1,45 @@
+// Re-renders a refocusable JPEG with a new focus or aperture, from the file alone: the stored
+// depth map (GDepth) and the all-in-focus original (GImage) go through the same render stage as
+// a fresh burst, and the result is written refocusable again. Host-side tool: allocates.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "algo/core/image.h"
+#include "algo/render/render_stage.h"
+#include "firmware/app/job.h"
+#include "firmware/jpeg/depth_encoding.h"
+
+namespace lb {
+
+struct RerenderOptions {
+  RenderParams render;
+  int32_t max_blur_radius = 32;
+  int quality = 92;
+};
+
+class Rerenderer {
+ public:
+  // Reads `path`: its GDepth must be RangeInverse and its depth map a whole-number fraction of
+  // the original's size (as `refocus run` writes them).
+  Status Load(const char* path);
+  // Renders and writes `out_path` atomically; `observer` sees every strip before encoding.
+  Status Render(const RerenderOptions& options, const char* out_path,
+                StripObserver* observer = nullptr);
+
+  ConstPlanarU8 reference() const;
+  ConstImageU16 disparity_q8() const;
+  int32_t width() const { return width_; }
+  int32_t height() const { return height_; }
+  int32_t working_scale() const { return scale_; }
+
+ private:
+  int32_t width_ = 0, height_ = 0, scale_ = 1, depth_w_ = 0, depth_h_ = 0;
+  std::vector<uint8_t> y_, cb_, cr_;  // the original as JFIF YCbCr 4:2:0
+  std::vector<uint16_t> disp_q8_;
+  DisparityRange range_;
+  std::vector<uint8_t> original_jpeg_;
+};
+
+}  // namespace lb
