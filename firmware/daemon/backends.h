@@ -1,0 +1,24 @@
+// The sensor and the shutter button a configuration names, built from the hal/ backends.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "algo/core/status.h"
+#include "firmware/daemon/config.h"
+#include "hal/button.h"
+#include "hal/sensor.h"
+
+namespace lb {
+
+// The backends this build holds, e.g. "v4l2, libcamera, synthetic".
+const char* BuiltBackends();
+
+Status MakeSensor(const DaemonConfig& config, std::unique_ptr<Sensor>* sensor);
+
+// `button`: "auto" (the first input device that sends KEY_CAMERA), an evdev node, or a FIFO
+// that carries struct input_event records (how the host tests press the button). `*where` gets
+// the path opened.
+Status OpenButton(const DaemonConfig& config, std::unique_ptr<Button>* button, std::string* where);
+
+}  // namespace lb

@@ -1,0 +1,125 @@
+// The daemon's state machine: idle -> capture -> process -> save -> idle, one photo per press.
+//
+// The caller's thread waits on the button (Run) while one worker thread takes the photos, so a
+// press that arrives while a photo is being taken is seen at once and either queued (at most
+// one) or refused, with a log line either way. A photo that fails (the sensor times out, a frame
+// is dropped, the card is full) is logged and leaves the daemon idle and ready; after a capture
+// failure the sensor is closed and opened again at the next press. A dropped frame first gets
+// `capture_retries` fresh bursts, since the depth stage needs evenly spaced views.
+//
+// One Job is configured once (on the first half press or press) and reused for every photo, so
+// nothing grows from press to press. Sensor, button, clock and log are borrowed; tests inject a
+// synthetic sensor, a scripted button and a fixed clock.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <mutex>
+#include <thread>
+
+#include "firmware/app/job.h"
+#include "firmware/daemon/clock.h"
+#include "firmware/daemon/config.h"
+#include "firmware/daemon/log.h"
+#include "firmware/daemon/photo_namer.h"
+#include "hal/button.h"
+#include "hal/sensor.h"
+
+namespace lb {
+
+class CameraDaemon {
+ public:
+  enum class State : uint8_t { kIdle, kCapture, kProcess, kSave };
+  static const char* StateName(State state);
+
+  struct Counts {
+    int32_t presses = 0, saved = 0, failed = 0, queued = 0, refused = 0;
+  };
+
+  // How often Run looks at the stop flag while the button is quiet.
+  static constexpr int32_t kPollMs = 200;
+
+  CameraDaemon(const DaemonConfig& config, Sensor* sensor, Button* button, const Clock* clock,
+               Log* log);
+  ~CameraDaemon();
+  CameraDaemon(const CameraDaemon&) = delete;
+  CameraDaemon& operator=(const CameraDaemon&) = delete;
+
+  // Scans the output folder (removing temporaries a killed run left) and starts the worker.
+  Status Start();
+  // Handles button events until RequestStop or a button failure. Then a photo in progress is
+  // finished, a queued press is dropped (logged), the worker ends and the sensor is released.
+  Status Run();
+  // Async-signal-safe (a signal handler may call it).
+  void RequestStop() { stop_.store(true); }
+
+  State state() const;
+  Counts counts() const;
+  // Tests: waits until no photo is in progress or queued; false on timeout.
+  bool WaitIdle(int32_t timeout_ms);
+
+ private:
+  // Forwards to the real sensor and notes where a burst ends (capture -> process).
+  class StageSensor : public Sensor {
+   public:
+    explicit StageSensor(CameraDaemon* owner) : owner_(owner) {}
+    const char* name() const override { return owner_->sensor_->name(); }
+    Status Configure(const SensorConfig& config, SensorMode* mode) override;
+    Status CaptureBurst(FrameSink& sink) override;
+    void Stop() override { owner_->sensor_->Stop(); }
+
+   private:
+    CameraDaemon* owner_;
+  };
+  // Notes the first strip going to the encoder (process -> save).
+  class StageObserver : public StripObserver {
+   public:
+    explicit StageObserver(CameraDaemon* owner) : owner_(owner) {}
+    void OnStrip(const ConstPlanarU8& strip, int32_t y0, int32_t rows) override;
+
+   private:
+    CameraDaemon* owner_;
+  };
+
+  void OnPress();
+  void OnHalfPress();
+  void Shutdown();
+  void Worker();
+  void TakePhoto(int32_t number);
+  Status ConfigureSensor();
+  void SetState(State state);
+  double SecondsSince(int64_t start_ns) const;
+
+  const DaemonConfig config_;
+  const JobOptions options_;
+  Sensor* sensor_;
+  Button* button_;
+  const Clock* clock_;
+  Log* log_;
+  std::atomic<bool> stop_{false};
+
+  // Worker-only.
+  Job job_;
+  StageSensor stage_sensor_{this};
+  StageObserver stage_observer_{this};
+  PhotoNamer namer_;
+  bool configured_ = false;
+  bool capture_failed_ = false;
+
+  // Shared, under mutex_.
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;  // worker: something to do
+  std::condition_variable idle_;  // WaitIdle
+  State state_ = State::kIdle;
+  bool busy_ = false;   // a photo accepted and not finished
+  bool start_ = false;  // the worker should start photo current_
+  bool queued_ = false;
+  bool configure_ = false;
+  bool quit_ = false;
+  int32_t current_ = 0;  // number of the photo in progress (1, 2, ...)
+  Counts counts_;
+  std::thread worker_;
+};
+
+}  // namespace lb

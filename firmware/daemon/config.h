@@ -1,0 +1,60 @@
+// refocusd's configuration file: `key = value` lines, `#` comments, blank lines. Every key is
+// documented in the default file firmware/daemon/refocusd.conf (installed as /etc/refocusd.conf).
+// Unknown keys, keys given twice and bad values are errors naming the file and the line.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "algo/core/status.h"
+#include "firmware/app/job.h"
+#include "firmware/daemon/log.h"
+
+namespace lb {
+
+enum class Backend : uint8_t { kV4l2, kLibcamera, kSynthetic };
+const char* BackendName(Backend backend);
+
+// What a press does while a photo is being taken.
+enum class BusyPolicy : uint8_t { kQueue, kRefuse };
+
+struct DaemonConfig {
+  // Sensor.
+  Backend backend = Backend::kV4l2;
+  std::string device;                  // "" (auto): v4l2 /dev/video0, libcamera the first camera
+  int32_t width = 1280, height = 960;  // 0 x 0 = the sensor's native size
+  int32_t frames = 5;
+  int32_t fps = 0;  // v4l2 only; 0 = the driver's choice
+  int32_t frame_timeout_ms = 2000;
+  uint64_t seed = 1;  // synthetic scene
+  // Button.
+  std::string button = "auto";  // "auto", an evdev node, or a FIFO of input_event records
+  int32_t debounce_ms = 30;
+  BusyPolicy busy = BusyPolicy::kQueue;
+  int32_t capture_retries = 1;  // fresh bursts after a dropped frame
+  // Storage.
+  std::string output_dir = "/var/lib/refocusd";
+  int32_t quality = 92;
+  std::string make = "LensBlur", model = "LensBlur camera";
+  // Depth and lens.
+  int32_t labels = 32;
+  int32_t working_width = 640, working_height = 480;
+  RenderParams render;  // focus, f-number, aperture
+  int32_t max_blur_radius = 32;
+  // Log.
+  LogLevel log_level = LogLevel::kInfo;
+};
+
+// Parses the text of a configuration file over the defaults in `config`; `name` is the file
+// name for messages ("refocusd.conf:12: unknown key 'burst'").
+Status ParseConfig(const char* name, const char* text, DaemonConfig* config);
+// Reads and parses `path` (at most 64 KiB).
+Status LoadConfig(const char* path, DaemonConfig* config);
+
+// The job settings the configuration implies; make and model point into `config`.
+JobOptions MakeJobOptions(const DaemonConfig& config);
+
+// The keys ParseConfig accepts, i = 0, 1, ... until nullptr (tests check each is documented).
+const char* ConfigKeyName(int i);
+
+}  // namespace lb

@@ -1,0 +1,421 @@
+// The daemon's state machine without hardware: the synthetic sensor (with scripted faults and a
+// gate that holds a burst open), a button the test presses, a fixed clock and a recording log.
+#include "firmware/daemon/camera_daemon.h"
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "sim/synthetic/synthetic_sensor.h"
+#include "tests/firmware/jpeg/jpeg_test_util.h"
+
+namespace lb {
+namespace {
+
+using std::chrono::milliseconds;
+
+class TestButton : public Button {
+ public:
+  void Push(ButtonEvent e) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    events_.push_back(e);
+    cv_.notify_all();
+  }
+  void Break() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    broken_ = true;
+    cv_.notify_all();
+  }
+  Status Wait(int32_t timeout_ms, ButtonEvent* event) override {
+    std::unique_lock<std::mutex> lock(mutex_);
+    cv_.wait_for(lock, milliseconds(timeout_ms), [this] { return broken_ || !events_.empty(); });
+    *event = ButtonEvent::kNone;
+    if (broken_) return Status(Code::kNotFound, "test button: the input device went away");
+    if (!events_.empty()) {
+      *event = events_.front();
+      events_.pop_front();
+    }
+    return Status::Ok();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<ButtonEvent> events_;
+  bool broken_ = false;
+};
+
+enum class Fault { kNone, kTimeout, kDrop };
+
+// The synthetic sensor with faults per burst and a gate: while closed, a burst waits at its start.
+class TestSensor : public Sensor {
+ public:
+  const char* name() const override { return "test"; }
+  Status Configure(const SensorConfig& config, SensorMode* mode) override {
+    ++configures;
+    return inner_.Configure(config, mode);
+  }
+  Status CaptureBurst(FrameSink& sink) override {
+    std::unique_lock<std::mutex> lock(mutex_);
+    ++bursts_started_;
+    cv_.notify_all();
+    cv_.wait(lock, [this] { return open_; });
+    const Fault fault = faults_.empty() ? Fault::kNone : faults_.front();
+    if (!faults_.empty()) faults_.pop_front();
+    lock.unlock();
+    if (fault == Fault::kTimeout) return Status(Code::kTimeout, "test: no frame within 2000 ms");
+    if (fault == Fault::kNone) return inner_.CaptureBurst(sink);
+    DropAfter drop(&sink, 2);
+    return inner_.CaptureBurst(drop);
+  }
+  void Stop() override { ++stops; }
+
+  void AddFault(Fault f) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    faults_.push_back(f);
+  }
+  void SetOpen(bool open) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    open_ = open;
+    cv_.notify_all();
+  }
+  bool WaitBursts(int n) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    return cv_.wait_for(lock, milliseconds(10000), [&] { return bursts_started_ >= n; });
+  }
+
+  std::atomic<int> configures{0}, stops{0};
+
+ private:
+  // Passes frames on until `index`, then reports it lost, as a driver's sequence gap does.
+  class DropAfter : public FrameSink {
+   public:
+    DropAfter(FrameSink* inner, int32_t index) : inner_(inner), index_(index) {}
+    Status BeginFrame(const FrameInfo& info) override {
+      if (info.index == index_) {
+        return Status(Code::kCorruptData, "test: frame %d: 1 frame(s) dropped", index_);
+      }
+      return inner_->BeginFrame(info);
+    }
+    Status Rows(const FrameRows& rows) override { return inner_->Rows(rows); }
+    Status EndFrame() override { return inner_->EndFrame(); }
+
+   private:
+    FrameSink* inner_;
+    int32_t index_;
+  };
+
+  SyntheticSensor inner_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<Fault> faults_;
+  bool open_ = true;
+  int bursts_started_ = 0;
+};
+
+class FixedClock : public Clock {
+ public:
+  int64_t MonotonicNs() const override { return system_.MonotonicNs(); }
+  void LocalTime(tm* out) const override {
+    *out = tm{};
+    out->tm_year = 2026 - 1900;
+    out->tm_mon = 2;
+    out->tm_mday = 14;
+    out->tm_hour = 15;
+    out->tm_min = 9;
+    out->tm_sec = 26;
+  }
+
+ private:
+  SystemClock system_;
+};
+
+class RecordingSink : public LogSink {
+ public:
+  void Write(LogLevel level, const char* text) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    lines_.push_back(std::string(LogLevelName(level)) + ": " + text);
+  }
+  int Count(const std::string& part) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    return static_cast<int>(std::count_if(lines_.begin(), lines_.end(), [&](const std::string& l) {
+      return l.find(part) != std::string::npos;
+    }));
+  }
+  bool WaitFor(const std::string& part) {
+    for (int i = 0; i < 1000; ++i) {
+      if (Count(part) > 0) return true;
+      std::this_thread::sleep_for(milliseconds(10));
+    }
+    return false;
+  }
+  std::string All() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::string all;
+    for (const auto& l : lines_) all += l + "\n";
+    return all;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::string> lines_;
+};
+
+const char kFirst[] = "IMG_20260314_150926_0001.jpg";
+const char kSecond[] = "IMG_20260314_150926_0002.jpg";
+
+class CameraDaemonTest : public ::testing::Test {
+ protected:
+  CameraDaemonTest() {
+    config_.backend = Backend::kSynthetic;
+    config_.width = 128;
+    config_.height = 96;
+    config_.frames = 5;
+    config_.labels = 8;
+    config_.output_dir = dir_.dir();
+    config_.log_level = LogLevel::kDebug;
+  }
+  ~CameraDaemonTest() override { Stop(); }
+
+  void StartDaemon() {
+    daemon_ = std::make_unique<CameraDaemon>(config_, &sensor_, &button_, &clock_, &log_);
+    ASSERT_TRUE(daemon_->Start().ok());
+    runner_ = std::thread([this] { run_status_ = daemon_->Run(); });
+  }
+  void Stop() {
+    if (!runner_.joinable()) return;
+    daemon_->RequestStop();
+    runner_.join();
+  }
+  void PressAndWait() {
+    // The press must be seen before WaitIdle can mean "done".
+    const int presses = daemon_->counts().presses;
+    button_.Push(ButtonEvent::kPress);
+    for (int i = 0; i < 500 && daemon_->counts().presses == presses; ++i) {
+      std::this_thread::sleep_for(milliseconds(10));
+    }
+    ASSERT_TRUE(daemon_->WaitIdle(30000)) << sink_.All();
+  }
+  // Photo names in the folder, sorted; temporaries included (they start with a dot).
+  std::vector<std::string> Files() {
+    auto names = dir_.Entries();
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+  void ExpectWholeJpeg(const std::string& name) {
+    int32_t w = 0, h = 0;
+    std::vector<uint8_t> ycc;
+    std::string error;
+    ASSERT_TRUE(test::DecodeYcc(test::ReadFile(dir_.Path(name)), &w, &h, &ycc, &error))
+        << name << ": " << error;
+    EXPECT_EQ(w, config_.width);
+    EXPECT_EQ(h, config_.height);
+  }
+
+  test::ScratchDir dir_;
+  DaemonConfig config_;
+  TestSensor sensor_;
+  TestButton button_;
+  FixedClock clock_;
+  RecordingSink sink_;
+  Log log_{&sink_, LogLevel::kDebug};
+  std::unique_ptr<CameraDaemon> daemon_;
+  std::thread runner_;
+  Status run_status_;
+};
+
+TEST_F(CameraDaemonTest, PressSavesOneWholeJpegNamedByTimeAndCounter) {
+  StartDaemon();
+  PressAndWait();
+  PressAndWait();
+  Stop();
+  EXPECT_TRUE(run_status_.ok()) << run_status_.message();
+  EXPECT_EQ(Files(), (std::vector<std::string>{kFirst, kSecond}));
+  ExpectWholeJpeg(kFirst);
+  ExpectWholeJpeg(kSecond);
+  EXPECT_EQ(sink_.Count("photo 1: saved " + dir_.Path(kFirst)), 1) << sink_.All();
+  EXPECT_EQ(sink_.Count("stopped: 2 photo(s) saved, 0 failed"), 1) << sink_.All();
+  EXPECT_EQ(daemon_->state(), CameraDaemon::State::kIdle);
+  // One configuration serves every press.
+  EXPECT_EQ(sensor_.configures.load(), 1);
+}
+
+TEST_F(CameraDaemonTest, HalfPressReadiesTheSensorBeforeThePress) {
+  StartDaemon();
+  button_.Push(ButtonEvent::kHalfPress);
+  ASSERT_TRUE(sink_.WaitFor("half press: sensor ready")) << sink_.All();
+  EXPECT_EQ(sensor_.configures.load(), 1);
+  PressAndWait();
+  EXPECT_EQ(sensor_.configures.load(), 1);
+  EXPECT_EQ(Files(), std::vector<std::string>{kFirst});
+}
+
+TEST_F(CameraDaemonTest, PressesWhileBusyAreQueuedOnceThenRefused) {
+  StartDaemon();
+  sensor_.SetOpen(false);
+  button_.Push(ButtonEvent::kPress);
+  ASSERT_TRUE(sensor_.WaitBursts(1));
+  button_.Push(ButtonEvent::kPress);
+  button_.Push(ButtonEvent::kPress);
+  ASSERT_TRUE(sink_.WaitFor("refused")) << sink_.All();
+  EXPECT_EQ(sink_.Count("info: press during photo 1 (capture): queued"), 1) << sink_.All();
+  EXPECT_EQ(sink_.Count("warning: press during photo 1 (capture): refused, one press is already "
+                        "queued"),
+            1)
+      << sink_.All();
+  sensor_.SetOpen(true);
+  ASSERT_TRUE(daemon_->WaitIdle(30000));
+  EXPECT_EQ(Files(), (std::vector<std::string>{kFirst, kSecond}));
+  const CameraDaemon::Counts c = daemon_->counts();
+  EXPECT_EQ(c.presses, 3);
+  EXPECT_EQ(c.saved, 2);
+  EXPECT_EQ(c.queued, 1);
+  EXPECT_EQ(c.refused, 1);
+}
+
+TEST_F(CameraDaemonTest, RefusePolicyRefusesEveryPressWhileBusy) {
+  config_.busy = BusyPolicy::kRefuse;
+  StartDaemon();
+  sensor_.SetOpen(false);
+  button_.Push(ButtonEvent::kPress);
+  ASSERT_TRUE(sensor_.WaitBursts(1));
+  button_.Push(ButtonEvent::kPress);
+  ASSERT_TRUE(sink_.WaitFor("refused, busy_press = refuse")) << sink_.All();
+  sensor_.SetOpen(true);
+  ASSERT_TRUE(daemon_->WaitIdle(30000));
+  EXPECT_EQ(Files(), std::vector<std::string>{kFirst});
+}
+
+TEST_F(CameraDaemonTest, SensorTimeoutIsLoggedAndTheNextPressWorks) {
+  sensor_.AddFault(Fault::kTimeout);
+  StartDaemon();
+  PressAndWait();
+  EXPECT_EQ(Files(), std::vector<std::string>{});  // no photo, no temporary
+  EXPECT_EQ(sink_.Count("error: photo 1: not saved: test: no frame within 2000 ms (the sensor is "
+                        "reopened at the next press)"),
+            1)
+      << sink_.All();
+  EXPECT_EQ(sensor_.stops.load(), 1);
+  EXPECT_EQ(daemon_->state(), CameraDaemon::State::kIdle);
+  PressAndWait();
+  EXPECT_EQ(sensor_.configures.load(), 2);
+  EXPECT_EQ(Files(), std::vector<std::string>{kFirst});
+  ExpectWholeJpeg(kFirst);
+}
+
+TEST_F(CameraDaemonTest, DroppedFrameGetsAFreshBurst) {
+  sensor_.AddFault(Fault::kDrop);
+  StartDaemon();
+  PressAndWait();
+  EXPECT_EQ(sink_.Count("photo 1: sensor synthetic frame 2: test: frame 2: 1 frame(s) dropped; "
+                        "taking a fresh burst (retry 1 of 1)"),
+            1)
+      << sink_.All();
+  EXPECT_EQ(Files(), std::vector<std::string>{kFirst});
+  ExpectWholeJpeg(kFirst);
+}
+
+TEST_F(CameraDaemonTest, DroppedFrameWithoutRetriesFailsThePhotoOnly) {
+  config_.capture_retries = 0;
+  sensor_.AddFault(Fault::kDrop);
+  StartDaemon();
+  PressAndWait();
+  EXPECT_EQ(Files(), std::vector<std::string>{});
+  EXPECT_EQ(sink_.Count("photo 1: not saved: sensor synthetic frame 2: test: frame 2: 1 frame(s) "
+                        "dropped (the sensor is reopened at the next press)"),
+            1)
+      << sink_.All();
+  PressAndWait();
+  // The failed photo did not use up a number.
+  EXPECT_EQ(Files(), std::vector<std::string>{kFirst});
+  EXPECT_EQ(daemon_->counts().failed, 1);
+}
+
+TEST_F(CameraDaemonTest, MissingFolderFailsUntilItAppears) {
+  config_.output_dir = dir_.Path("card");
+  StartDaemon();
+  EXPECT_EQ(sink_.Count("is not a folder (yet)"), 1) << sink_.All();
+  PressAndWait();
+  EXPECT_EQ(sink_.Count("photo 1: not saved: " + dir_.Path("card/") + kFirst +
+                        ": cannot create a file in " + dir_.Path("card")),
+            1)
+      << sink_.All();
+  ASSERT_EQ(mkdir(dir_.Path("card").c_str(), 0755), 0);
+  PressAndWait();
+  EXPECT_EQ(sink_.Count("photo 2: saved"), 1) << sink_.All();
+  // A missing folder is no sensor fault: the sensor stays configured.
+  EXPECT_EQ(sensor_.configures.load(), 1);
+}
+
+TEST_F(CameraDaemonTest, FailedWriteLeavesNothingUnderTheName) {
+  // The medium refuses the bytes (a file size limit here; a full card in the VM scenario).
+  signal(SIGXFSZ, SIG_IGN);
+  rlimit old;
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old), 0);
+  rlimit small = old;
+  small.rlim_cur = 512;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+  StartDaemon();
+  PressAndWait();
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &old), 0);
+  EXPECT_EQ(Files(), std::vector<std::string>{});
+  EXPECT_EQ(sink_.Count("error: photo 1: not saved: " + dir_.Path(kFirst) + ": file too large"), 1)
+      << sink_.All();
+  PressAndWait();
+  EXPECT_EQ(Files(), std::vector<std::string>{kFirst});
+  ExpectWholeJpeg(kFirst);
+}
+
+TEST_F(CameraDaemonTest, StopFinishesThePhotoInProgressAndDropsTheQueuedPress) {
+  StartDaemon();
+  sensor_.SetOpen(false);
+  button_.Push(ButtonEvent::kPress);
+  ASSERT_TRUE(sensor_.WaitBursts(1));
+  button_.Push(ButtonEvent::kPress);
+  ASSERT_TRUE(sink_.WaitFor("queued")) << sink_.All();
+  daemon_->RequestStop();
+  ASSERT_TRUE(sink_.WaitFor("stopping: queued press dropped")) << sink_.All();
+  sensor_.SetOpen(true);
+  runner_.join();
+  EXPECT_TRUE(run_status_.ok());
+  EXPECT_EQ(Files(), std::vector<std::string>{kFirst});
+  ExpectWholeJpeg(kFirst);
+  EXPECT_EQ(sink_.Count("stopping: finishing photo 1 first"), 1) << sink_.All();
+  EXPECT_GE(sensor_.stops.load(), 1);
+}
+
+TEST_F(CameraDaemonTest, ButtonFailureEndsRunWithTheError) {
+  StartDaemon();
+  button_.Break();
+  runner_.join();
+  EXPECT_EQ(run_status_.code(), Code::kNotFound);
+  EXPECT_EQ(sink_.Count("error: button: test button: the input device went away"), 1)
+      << sink_.All();
+}
+
+TEST_F(CameraDaemonTest, StartClearsTemporariesAndContinuesTheCount) {
+  FILE* f = fopen(dir_.Path(".IMG_20260101_120000_0007.jpg.AbCdEf").c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  fclose(f);
+  f = fopen(dir_.Path("IMG_20260101_120000_0006.jpg").c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  fclose(f);
+  StartDaemon();
+  EXPECT_EQ(sink_.Count("output: removed 1 unfinished photo(s)"), 1) << sink_.All();
+  PressAndWait();
+  EXPECT_EQ(Files(), (std::vector<std::string>{"IMG_20260101_120000_0006.jpg",
+                                               "IMG_20260314_150926_0007.jpg"}));
+}
+
+}  // namespace
+}  // namespace lb
