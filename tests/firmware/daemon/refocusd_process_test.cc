@@ -1,0 +1,161 @@
+// The refocusd program as the board runs it (synthetic sensor, FIFO button): its command line,
+// clean shutdown on SIGTERM, and SIGKILL at random moments of a photo, after which a photo's
+// name holds a whole JPEG or nothing and the next start clears the leftovers.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "tests/firmware/daemon/refocusd_process.h"
+#include "tests/firmware/jpeg/jpeg_test_util.h"
+
+namespace lb::test {
+namespace {
+
+constexpr int kStartMs = 10000;
+constexpr int kPhotoMs = 60000;
+
+// A whole JPEG: libjpeg decodes every row, and the file ends with the EOI marker.
+void ExpectWholeJpeg(const std::string& path, int32_t width, int32_t height) {
+  const std::vector<uint8_t> bytes = ReadFile(path);
+  ASSERT_GE(bytes.size(), 4u) << path;
+  EXPECT_EQ(bytes[bytes.size() - 2], 0xFF) << path;
+  EXPECT_EQ(bytes[bytes.size() - 1], 0xD9) << path;
+  int32_t w = 0, h = 0;
+  std::vector<uint8_t> ycc;
+  std::string error;
+  ASSERT_TRUE(DecodeYcc(bytes, &w, &h, &ycc, &error)) << path << ": " << error;
+  EXPECT_EQ(w, width);
+  EXPECT_EQ(h, height);
+}
+
+TEST(RefocusdCommandTest, VersionHelpAndUsageErrors) {
+  std::string out;
+  EXPECT_EQ(RunRefocusd({"--version"}, &out), 0);
+  EXPECT_EQ(out.rfind("refocusd 0.", 0), 0u) << out;
+  EXPECT_NE(out.find("synthetic"), std::string::npos) << out;
+  EXPECT_EQ(RunRefocusd({"--help"}, &out), 0);
+  EXPECT_NE(out.find("--config FILE"), std::string::npos) << out;
+  EXPECT_EQ(RunRefocusd({"--frobnicate"}, &out), 2);
+  EXPECT_NE(out.find("refocusd: unknown option"), std::string::npos) << out;
+  EXPECT_EQ(RunRefocusd({"--config"}, &out), 2);
+  EXPECT_EQ(RunRefocusd({"--config", "/nonexistent.conf"}, &out), 1);
+  EXPECT_EQ(out, "refocusd: /nonexistent.conf: cannot open: No such file or directory\n");
+}
+
+TEST(RefocusdCommandTest, CheckConfigReportsTheLine) {
+  ScratchDir dir;
+  const std::string good = dir.Path("good.conf"), bad = dir.Path("bad.conf");
+  FILE* f = fopen(good.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  fputs("backend = synthetic\nf_number = 2\n", f);
+  fclose(f);
+  f = fopen(bad.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  fputs("backend = synthetic\n# comment\nf_number = 0.5\n", f);
+  fclose(f);
+  std::string out;
+  EXPECT_EQ(RunRefocusd({"--check-config", "--config", good}, &out), 0);
+  EXPECT_EQ(out, "refocusd: " + good + ": configuration OK\n");
+  EXPECT_EQ(RunRefocusd({"--check-config", "--config", bad}, &out), 1);
+  EXPECT_EQ(out, "refocusd: " + bad + ":3: f_number: '0.5' is not a number from 1 to 22\n");
+}
+
+TEST(RefocusdCommandTest, MissingButtonIsAClearStartupError) {
+  ScratchDir dir;
+  RefocusdProcess d(dir.dir(), "button = " + dir.Path("no-such-button") + "\n");
+  ASSERT_TRUE(d.Start());
+  EXPECT_EQ(d.Wait(kStartMs), 1);
+  EXPECT_NE(d.log().find("error: " + dir.Path("no-such-button") + ": cannot open"),
+            std::string::npos)
+      << d.log();
+}
+
+TEST(RefocusdProcessTest, SigtermLetsThePhotoInProgressFinish) {
+  ScratchDir dir;
+  // Large enough that the signal lands while the photo is being taken.
+  RefocusdProcess d(dir.dir(), "resolution = 640x480\nlabels = 16\n");
+  ASSERT_TRUE(d.Start());
+  ASSERT_TRUE(d.WaitForLine("ready:", kStartMs)) << d.log();
+  d.Press();
+  ASSERT_TRUE(d.WaitForLine("press: photo 1", kStartMs)) << d.log();
+  usleep(100 * 1000);
+  d.Signal(SIGTERM);
+  EXPECT_EQ(d.Wait(kPhotoMs), 0) << d.log();
+  EXPECT_EQ(d.Count("stopped: 1 photo(s) saved, 0 failed"), 1) << d.log();
+  std::vector<std::string> photos, temps;
+  ListPhotos(d.out_dir(), &photos, &temps);
+  ASSERT_EQ(photos.size(), 1u) << d.log();
+  EXPECT_TRUE(temps.empty());
+  ExpectWholeJpeg(d.out_dir() + "/" + photos[0], 640, 480);
+}
+
+TEST(RefocusdProcessTest, KilledAtRandomMomentsLeavesWholePhotosOrNothing) {
+  ScratchDir dir;
+  RefocusdProcess d(dir.dir(), "");
+  // One clean photo first, to learn how long a photo takes on this machine.
+  ASSERT_TRUE(d.Start());
+  ASSERT_TRUE(d.WaitForLine("ready:", kStartMs)) << d.log();
+  timespec t0, t1;
+  clock_gettime(CLOCK_MONOTONIC, &t0);
+  d.Press();
+  ASSERT_TRUE(d.WaitForLine("photo 1: saved", kPhotoMs)) << d.log();
+  clock_gettime(CLOCK_MONOTONIC, &t1);
+  const double photo_us = static_cast<double>(t1.tv_sec - t0.tv_sec) * 1e6 +
+                          static_cast<double>(t1.tv_nsec - t0.tv_nsec) * 1e-3;
+  d.Signal(SIGTERM);
+  ASSERT_EQ(d.Wait(kPhotoMs), 0) << d.log();
+
+  std::mt19937 rng(20261123);
+  // Half the kills anywhere in the photo, half in its last third (rendering into the file).
+  std::uniform_real_distribution<double> anywhere(0.0, 1.2), late(0.66, 1.05);
+  constexpr int kTrials = 50;
+  int leftovers_seen = 0, removed_reported = 0;
+  for (int trial = 0; trial < kTrials; ++trial) {
+    std::vector<std::string> photos, temps;
+    ListPhotos(d.out_dir(), &photos, &temps);
+    ASSERT_TRUE(d.Start());
+    ASSERT_TRUE(d.WaitForLine("ready:", kStartMs)) << d.log();
+    // Leftovers of the previous kill are gone before the first press.
+    std::vector<std::string> after;
+    ListPhotos(d.out_dir(), &photos, &after);
+    EXPECT_TRUE(after.empty()) << "trial " << trial << ": " << after[0];
+    if (!temps.empty()) {
+      ++leftovers_seen;
+      removed_reported +=
+          d.Count("output: removed " + std::to_string(temps.size()) + " unfinished");
+    }
+    d.Press();
+    const double f = trial % 2 ? late(rng) : anywhere(rng);
+    usleep(static_cast<useconds_t>(f * photo_us));
+    d.Signal(SIGKILL);
+    ASSERT_EQ(d.Wait(kPhotoMs), 128 + SIGKILL);
+    ListPhotos(d.out_dir(), &photos, &temps);
+    for (const std::string& name : photos) {
+      ExpectWholeJpeg(d.out_dir() + "/" + name, 160, 120);
+      if (HasFailure()) {
+        FAIL() << "trial " << trial << " (kill after " << f << " of a photo): " << name;
+      }
+    }
+  }
+  // The last kill's leftovers go at the next start too.
+  ASSERT_TRUE(d.Start());
+  ASSERT_TRUE(d.WaitForLine("ready:", kStartMs)) << d.log();
+  d.Signal(SIGTERM);
+  EXPECT_EQ(d.Wait(kPhotoMs), 0) << d.log();
+  std::vector<std::string> photos, temps;
+  ListPhotos(d.out_dir(), &photos, &temps);
+  EXPECT_TRUE(temps.empty());
+  printf("%d kills: %zu photos whole, %d runs found a temporary left by the previous kill\n",
+         kTrials, photos.size(), leftovers_seen);
+  // The kills did land inside photos (each leaves its temporary), and every start cleared them.
+  EXPECT_GT(leftovers_seen, kTrials / 10);
+  EXPECT_EQ(removed_reported, leftovers_seen);
+}
+
+}  // namespace
+}  // namespace lb::test
