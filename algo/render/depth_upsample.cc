@@ -1,5 +1,6 @@
 #include "algo/render/depth_upsample.h"
 
+#include <cmath>
 #include <initializer_list>
 
 namespace lb {
@@ -26,7 +27,7 @@ void DepthUpsampler::Carve(Arena& arena, int32_t width, int32_t height, int32_t 
     for (int32_t o = 0; o < 3; ++o) {
       const double d = (u - (o - 1)) / 1.75;
       const double w = d * d >= 1.0 ? 0.0 : (1.0 - d * d) * (1.0 - d * d);
-      spatial_q8_[f * 3 + o] = static_cast<uint16_t>(w * 256.0 + 0.5);
+      spatial_q8_[f * 3 + o] = static_cast<uint16_t>(std::lround(w * 256.0));
     }
   }
   // Range term sigma^4 / (sigma^2 + D^2)^2, in integers.

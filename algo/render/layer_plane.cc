@@ -161,7 +161,7 @@ void LayerPlane::Carve(Arena& arena, int32_t width, int32_t height, int32_t chan
   pitch_ = static_cast<int32_t>(Arena::RoundUp((width + 2 * max_half + 8) * sizeof(uint32_t)) /
                                 sizeof(uint32_t));
   const size_t ring = static_cast<size_t>(ring_rows_) * width;
-  const size_t planes = static_cast<size_t>(channels + 1);
+  const size_t planes = static_cast<size_t>(channels) + 1;
   ring_s_ = arena.Allocate<int16_t>(ring);
   ring_v_ = arena.Allocate<int16_t>(ring * channels);
   tile_shift_ = 6;

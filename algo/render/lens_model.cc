@@ -1,11 +1,14 @@
+
 #include "algo/render/lens_model.h"
+
+#include <cmath>
 
 namespace lb {
 
 void LensModel::Set(float f_number, int32_t working_scale, int32_t max_radius,
                     int32_t focus_disp_q8) {
   const double radius = 0.5 * kDiameterPerDispAtF28 * (2.8 / f_number) * working_scale;
-  radius_per_disp_q16_ = static_cast<int32_t>(radius * 65536.0 + 0.5);
+  radius_per_disp_q16_ = static_cast<int32_t>(std::lround(radius * 65536.0));
   focus_disp_q8_ = focus_disp_q8;
   cap_q4_ = max_radius * 16;
 }

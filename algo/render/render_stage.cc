@@ -1,4 +1,7 @@
+
 #include "algo/render/render_stage.h"
+
+#include <cmath>
 
 namespace lb {
 namespace {
@@ -180,7 +183,7 @@ Status RenderStage::Begin(const ConstPlanarU8& ref, ConstImageU16 disp_q8,
     if (y >= threshold && params.highlight_gain > 1.0f) {
       gain += (params.highlight_gain - 1.0) * (y - threshold + 1) / (256 - threshold);
     }
-    boost_q8_[y] = static_cast<uint16_t>(gain * 256.0 + 0.5);
+    boost_q8_[y] = static_cast<uint16_t>(std::lround(gain * 256.0));
   }
   int32_t max_luma = 0, max_gain = 0;
   for (int32_t y = 0; y < 256; ++y) {
