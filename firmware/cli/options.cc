@@ -118,6 +118,80 @@ bool ParseSize(const char* text, int32_t* width, int32_t* height, std::string* e
   return true;
 }
 
+namespace {
+enum LensId {
+  kFocus = kFirstLensOption,
+  kFNumber,
+  kAperture,
+  kRotation,
+  kCurvature,
+  kHighlightThreshold,
+  kHighlightGain,
+  kMaxRadius,
+  kQuality,
+};
+}  // namespace
+
+const char kLensUsage[] =
+    "Lens:\n"
+    "  --focus X,Y[,W,H]      point or rectangle to keep sharp (default: the centre)\n"
+    "  --f-number N           aperture as on a lens, 1.4 .. 16 (default 2.8)\n"
+    "  --aperture SHAPE       disc (default), or N-blade for a polygonal iris (3..12)\n"
+    "  --rotation DEG         rotation of the polygonal iris\n"
+    "  --curvature C          blade curvature, 0 (straight) .. 1 (round)\n"
+    "  --highlight-threshold T, --highlight-gain G   bright bokeh boost (default off)\n"
+    "  --max-radius R         largest blur radius in px (default 32)\n"
+    "  --quality Q            JPEG quality 1..100 (default 92)\n";
+
+std::vector<option> WithLensOptions(std::initializer_list<option> own) {
+  std::vector<option> all(own);
+  all.insert(all.end(),
+             {
+                 {"focus", required_argument, nullptr, kFocus},
+                 {"f-number", required_argument, nullptr, kFNumber},
+                 {"aperture", required_argument, nullptr, kAperture},
+                 {"rotation", required_argument, nullptr, kRotation},
+                 {"curvature", required_argument, nullptr, kCurvature},
+                 {"highlight-threshold", required_argument, nullptr, kHighlightThreshold},
+                 {"highlight-gain", required_argument, nullptr, kHighlightGain},
+                 {"max-radius", required_argument, nullptr, kMaxRadius},
+                 {"quality", required_argument, nullptr, kQuality},
+                 {nullptr, 0, nullptr, 0},
+             });
+  return all;
+}
+
+bool ParseLensOption(int id, const char* arg, LensOptions* lens, std::string* error) {
+  RenderParams& r = lens->render;
+  switch (id) {
+    case kFocus:
+      return ParseFocus(arg, &r.focus, error);
+    case kFNumber:
+      return ParseFloat(arg, 1.0f, 22.0f, &r.f_number, error);
+    case kAperture:
+      return ParseAperture(arg, &r.aperture, error);
+    case kRotation:
+      return ParseFloat(arg, -360.0f, 360.0f, &r.aperture.rotation_deg, error);
+    case kCurvature:
+      return ParseFloat(arg, 0.0f, 1.0f, &r.aperture.curvature, error);
+    case kHighlightThreshold: {
+      int32_t t = 255;
+      const bool ok = ParseInt(arg, 0, 255, &t, error);
+      r.highlight_threshold = static_cast<uint8_t>(t);
+      return ok;
+    }
+    case kHighlightGain:
+      return ParseFloat(arg, 1.0f, 8.0f, &r.highlight_gain, error);
+    case kMaxRadius:
+      return ParseInt(arg, 0, 128, &lens->max_radius, error);
+    case kQuality:
+      return ParseInt(arg, 1, 100, &lens->quality, error);
+    default:
+      *error = "unknown option";
+      return false;
+  }
+}
+
 int Fail(const char* message) {
   fprintf(stderr, "refocus: %s\n", message);
   return 1;

@@ -2,8 +2,11 @@
 // fills a one-line message when the text is not a valid value.
 #pragma once
 
+#include <getopt.h>
+
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "algo/render/render_stage.h"
 
@@ -17,6 +20,21 @@ bool ParseFocus(const char* text, FocusRegion* out, std::string* error);
 bool ParseAperture(const char* text, Aperture* out, std::string* error);
 // "WxH".
 bool ParseSize(const char* text, int32_t* width, int32_t* height, std::string* error);
+
+// The lens and output options `run` and `rerender` share: --focus, --f-number, --aperture,
+// --rotation, --curvature, --highlight-threshold, --highlight-gain, --max-radius, --quality.
+struct LensOptions {
+  RenderParams render;
+  int32_t max_radius = 32;
+  int quality = 92;
+};
+extern const char kLensUsage[];  // their lines of --help
+// Option ids from kFirstLensOption up belong to the lens options; a command's own ids stay below.
+inline constexpr int kFirstLensOption = 1000;
+// `own` (without the terminating zero entry) followed by the lens options and the zero entry.
+std::vector<option> WithLensOptions(std::initializer_list<option> own);
+// Parses lens option `id`; returns false with `error` set for a bad value.
+bool ParseLensOption(int id, const char* arg, LensOptions* lens, std::string* error);
 
 // Prints "refocus: <message>" on stderr and returns exit code 1.
 int Fail(const char* message);

@@ -30,17 +30,8 @@ const char kUsage[] =
     "  --labels N             depth labels (default 64)\n"
     "  --disparity MIN,MAX    label range, working px per view step (files; default 0,16)\n"
     "  --working-size WxH     largest working resolution for depth (default 640x480)\n"
-    "Lens:\n"
-    "  --focus X,Y[,W,H]      point or rectangle to keep sharp (default: the centre)\n"
-    "  --f-number N           aperture as on a lens, 1.4 .. 16 (default 2.8)\n"
-    "  --aperture SHAPE       disc (default), or N-blade for a polygonal iris (3..12)\n"
-    "  --rotation DEG         rotation of the polygonal iris\n"
-    "  --curvature C          blade curvature, 0 (straight) .. 1 (round)\n"
-    "  --highlight-threshold T, --highlight-gain G   bright bokeh boost (default off)\n"
-    "  --max-radius R         largest blur radius in px (default 32)\n"
     "Output:\n"
-    "  --out OUT.jpg          written atomically: the name holds a whole JPEG or nothing\n"
-    "  --quality Q            JPEG quality 1..100 (default 92)\n";
+    "  --out OUT.jpg          written atomically: the name holds a whole JPEG or nothing\n";
 
 enum Opt {
   kSynthetic = 256,
@@ -52,45 +43,12 @@ enum Opt {
   kLabels,
   kDisparity,
   kWorking,
-  kFocus,
-  kFNumber,
-  kAperture,
-  kRotation,
-  kCurvature,
-  kHiThreshold,
-  kHiGain,
-  kMaxRadius,
   kOut,
-  kQuality,
   kHelp
 };
 
-const option kOptions[] = {
-    {"synthetic", no_argument, nullptr, kSynthetic},
-    {"input", required_argument, nullptr, kInput},
-    {"size", required_argument, nullptr, kSize},
-    {"frames", required_argument, nullptr, kFrames},
-    {"seed", required_argument, nullptr, kSeed},
-    {"ref", required_argument, nullptr, kRef},
-    {"labels", required_argument, nullptr, kLabels},
-    {"disparity", required_argument, nullptr, kDisparity},
-    {"working-size", required_argument, nullptr, kWorking},
-    {"focus", required_argument, nullptr, kFocus},
-    {"f-number", required_argument, nullptr, kFNumber},
-    {"aperture", required_argument, nullptr, kAperture},
-    {"rotation", required_argument, nullptr, kRotation},
-    {"curvature", required_argument, nullptr, kCurvature},
-    {"highlight-threshold", required_argument, nullptr, kHiThreshold},
-    {"highlight-gain", required_argument, nullptr, kHiGain},
-    {"max-radius", required_argument, nullptr, kMaxRadius},
-    {"out", required_argument, nullptr, kOut},
-    {"quality", required_argument, nullptr, kQuality},
-    {"help", no_argument, nullptr, kHelp},
-    {nullptr, 0, nullptr, 0},
-};
-
 int Usage(const std::string& error) {
-  fprintf(stderr, "refocus run: %s\n\n%s", error.c_str(), kUsage);
+  fprintf(stderr, "refocus run: %s\n\n%s%s", error.c_str(), kUsage, kLensUsage);
   return 2;
 }
 
@@ -118,8 +76,22 @@ int RunCommand(int argc, char** argv) {
   SceneParams scene;
   int32_t seed = 1;
 
+  const std::vector<option> options = WithLensOptions({
+      {"synthetic", no_argument, nullptr, kSynthetic},
+      {"input", required_argument, nullptr, kInput},
+      {"size", required_argument, nullptr, kSize},
+      {"frames", required_argument, nullptr, kFrames},
+      {"seed", required_argument, nullptr, kSeed},
+      {"ref", required_argument, nullptr, kRef},
+      {"labels", required_argument, nullptr, kLabels},
+      {"disparity", required_argument, nullptr, kDisparity},
+      {"working-size", required_argument, nullptr, kWorking},
+      {"out", required_argument, nullptr, kOut},
+      {"help", no_argument, nullptr, kHelp},
+  });
+  LensOptions lens;
   optind = 1;
-  for (int c; (c = getopt_long(argc, argv, "", kOptions, nullptr)) != -1;) {
+  for (int c; (c = getopt_long(argc, argv, "", options.data(), nullptr)) != -1;) {
     bool ok = true;
     switch (c) {
       case kSynthetic:
@@ -151,47 +123,22 @@ int RunCommand(int argc, char** argv) {
         ok = ParseSize(optarg, &job.pipeline.max_working_width, &job.pipeline.max_working_height,
                        &error);
         break;
-      case kFocus:
-        ok = ParseFocus(optarg, &job.render.focus, &error);
-        break;
-      case kFNumber:
-        ok = ParseFloat(optarg, 1.0f, 22.0f, &job.render.f_number, &error);
-        break;
-      case kAperture:
-        ok = ParseAperture(optarg, &job.render.aperture, &error);
-        break;
-      case kRotation:
-        ok = ParseFloat(optarg, -360.0f, 360.0f, &job.render.aperture.rotation_deg, &error);
-        break;
-      case kCurvature:
-        ok = ParseFloat(optarg, 0.0f, 1.0f, &job.render.aperture.curvature, &error);
-        break;
-      case kHiThreshold: {
-        int32_t t = 255;
-        ok = ParseInt(optarg, 0, 255, &t, &error);
-        job.render.highlight_threshold = static_cast<uint8_t>(t);
-        break;
-      }
-      case kHiGain:
-        ok = ParseFloat(optarg, 1.0f, 16.0f, &job.render.highlight_gain, &error);
-        break;
-      case kMaxRadius:
-        ok = ParseInt(optarg, 0, 128, &job.pipeline.max_blur_radius, &error);
-        break;
       case kOut:
         out_path = optarg;
         break;
-      case kQuality:
-        ok = ParseInt(optarg, 1, 100, &job.quality, &error);
-        break;
       case kHelp:
-        fputs(kUsage, stdout);
+        printf("%s%s", kUsage, kLensUsage);
         return 0;
-      default:
+      case '?':
         return Usage("unknown option");
+      default:
+        ok = ParseLensOption(c, optarg, &lens, &error);
     }
     if (!ok) return Usage(error);
   }
+  job.render = lens.render;
+  job.pipeline.max_blur_radius = lens.max_radius;
+  job.quality = lens.quality;
   std::vector<std::string> files(argv + optind, argv + argc);
   if (out_path.empty()) return Usage("--out OUT.jpg is required");
   if (synthetic + !input_dir.empty() + !files.empty() > 1) {
