@@ -152,10 +152,6 @@ void CameraDaemon::OnHalfPress() {
 void CameraDaemon::Shutdown() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (start_) {  // accepted but not begun
-      log_->Printf(LogLevel::kWarning, "stopping: photo %d dropped before its capture", current_);
-      start_ = busy_ = false;
-    }
     if (queued_) {
       log_->Printf(LogLevel::kWarning, "stopping: queued press dropped");
       queued_ = false;
@@ -175,7 +171,7 @@ void CameraDaemon::Worker() {
   std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {
     wake_.wait(lock, [this] { return quit_ || start_ || configure_; });
-    if (quit_) break;
+    // A photo whose press was acknowledged is taken even when a stop came meanwhile.
     if (start_) {
       start_ = configure_ = false;
       const int32_t number = current_;
@@ -195,6 +191,7 @@ void CameraDaemon::Worker() {
       }
       continue;
     }
+    if (quit_) break;
     configure_ = false;
     if (configured_) continue;
     lock.unlock();

@@ -48,8 +48,9 @@ class CameraDaemon {
 
   // Scans the output folder (removing temporaries a killed run left) and starts the worker.
   Status Start();
-  // Handles button events until RequestStop or a button failure. Then a photo in progress is
-  // finished, a queued press is dropped (logged), the worker ends and the sensor is released.
+  // Handles button events until RequestStop or a button failure. Then the photo in progress (its
+  // press acknowledged) is finished, a queued press is dropped (logged), the worker ends and the
+  // sensor is released.
   Status Run();
   // Async-signal-safe (a signal handler may call it).
   void RequestStop() { stop_.store(true); }

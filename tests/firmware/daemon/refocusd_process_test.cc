@@ -77,21 +77,21 @@ TEST(RefocusdCommandTest, MissingButtonIsAClearStartupError) {
 
 TEST(RefocusdProcessTest, SigtermLetsThePhotoInProgressFinish) {
   ScratchDir dir;
-  // Large enough that the signal lands while the photo is being taken.
-  RefocusdProcess d(dir.dir(), "resolution = 640x480\nlabels = 16\n");
+  // Slow enough (half a second) that the signal lands while the photo is being taken.
+  RefocusdProcess d(dir.dir(), "resolution = 480x360\nlabels = 16\n");
   ASSERT_TRUE(d.Start());
   ASSERT_TRUE(d.WaitForLine("ready:", kStartMs)) << d.log();
   d.Press();
   ASSERT_TRUE(d.WaitForLine("press: photo 1", kStartMs)) << d.log();
-  usleep(100 * 1000);
   d.Signal(SIGTERM);
   EXPECT_EQ(d.Wait(kPhotoMs), 0) << d.log();
+  EXPECT_EQ(d.Count("stopping: finishing photo 1 first"), 1) << d.log();
   EXPECT_EQ(d.Count("stopped: 1 photo(s) saved, 0 failed"), 1) << d.log();
   std::vector<std::string> photos, temps;
   ListPhotos(d.out_dir(), &photos, &temps);
   ASSERT_EQ(photos.size(), 1u) << d.log();
   EXPECT_TRUE(temps.empty());
-  ExpectWholeJpeg(d.out_dir() + "/" + photos[0], 640, 480);
+  ExpectWholeJpeg(d.out_dir() + "/" + photos[0], 480, 360);
 }
 
 TEST(RefocusdProcessTest, KilledAtRandomMomentsLeavesWholePhotosOrNothing) {
