@@ -47,10 +47,10 @@ cmake --preset host-asan >/dev/null || die "configure host-asan"
 cmake --build --preset host-asan -j "$jobs" || die "build host-asan"
 run_ctest host-asan --preset host-asan -LE 'data|vm'
 
-step "host (Release): Middlebury accuracy tests and the command line"
+step "host (Release): Middlebury accuracy tests and the refocusd soak (500 presses)"
 cmake --preset host >/dev/null || die "configure host"
 cmake --build --preset host -j "$jobs" || die "build host"
-run_ctest host-data --preset host -L data
+run_ctest host-data --preset host -L 'data|soak'
 
 if [ -d tests/vm ]; then
   step "kernel drivers in a VM (vivid, uinput, vimc)"
@@ -79,6 +79,9 @@ for arch in aarch64 armhf; do
   cmake --build --preset "$arch" -j "$jobs" || die "build $arch"
   run_ctest "$arch" --preset "$arch"
 done
+
+step "aarch64: the board's .deb (cpack, dpkg-deb -c, packaged refocusd --version under qemu)"
+run_ctest aarch64-deb --test-dir build/aarch64 -L deb
 
 echo
 echo "tests: $passed passed, $failed failed, $skipped skipped"
