@@ -1,0 +1,217 @@
+#include "algo/motion/bundle.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+namespace lb {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+
+Mat3 Rot(const ViewMotion& m) { return Eigen::Map<const Mat3>(&m.rotation[0][0]); }
+
+// Point on the reference ray of `point` at inverse depth w, in view coordinates (up to scale).
+Vec3 Ray(const BundleInput& in, const ViewMotion& m, double w, int32_t point, Vec3* rr) {
+  const Vec3 r(in.ref_xy[2 * point], in.ref_xy[2 * point + 1], 1.0);
+  *rr = Rot(m) * r;
+  return *rr + w * Eigen::Map<const Vec3>(m.translation);
+}
+
+const double* Obs(const BundleInput& in, int32_t view, int32_t point) {
+  return in.obs_xy + 2 * (static_cast<size_t>(view) * in.points + point);
+}
+bool ObsOk(const BundleInput& in, int32_t view, int32_t point) {
+  return in.obs_ok[static_cast<size_t>(view) * in.points + point] != 0;
+}
+
+double Huber(double e2, double huber) {
+  if (e2 <= huber * huber) return 0.5 * e2;
+  return huber * (__builtin_sqrt(e2) - 0.5 * huber);
+}
+
+// Left update R <- Q(d) R with Q the rotation of the unit quaternion (1, d/2) / norm.
+void RotateBy(const double d[3], ViewMotion* m) {
+  double qw = 1, qx = 0.5 * d[0], qy = 0.5 * d[1], qz = 0.5 * d[2];
+  const double n = __builtin_sqrt(qw * qw + qx * qx + qy * qy + qz * qz);
+  qw /= n, qx /= n, qy /= n, qz /= n;
+  Mat3 q;
+  q << 1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw),
+      2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw),
+      2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy);
+  Eigen::Map<Mat3>(&m->rotation[0][0]) = (q * Rot(*m)).eval();
+}
+
+}  // namespace
+
+Status Bundle::Carve(int32_t max_views, int32_t max_points, Arena& arena) {
+  if (max_views < 2 || max_views > kMaxViews || max_points < 1) {
+    return Status(Code::kInvalidArgument, "bundle: %d views (2..%d), %d points", max_views,
+                  kMaxViews, max_points);
+  }
+  max_views_ = max_views;
+  max_points_ = max_points;
+  const size_t nc = 6 * static_cast<size_t>(max_views - 1);
+  hcc_ = arena.Allocate<double>(nc * 6);
+  g_ = arena.Allocate<double>(nc);
+  s_ = arena.Allocate<double>(nc * nc);
+  g2_ = arena.Allocate<double>(nc);
+  hww_ = arena.Allocate<double>(max_points);
+  gw_ = arena.Allocate<double>(max_points);
+  hcw_ = arena.Allocate<double>(nc * max_points);
+  w_try_ = arena.Allocate<double>(max_points);
+  return Status::Ok();
+}
+
+double Bundle::ErrorPx(const BundleInput& in, const ViewMotion& m, double w, int32_t view,
+                       int32_t point) {
+  Vec3 rr;
+  const Vec3 a = Ray(in, m, w, point, &rr);
+  const double* o = Obs(in, view, point);
+  const double ex = in.fx * (a[0] / a[2] - o[0]), ey = in.fy * (a[1] / a[2] - o[1]);
+  return __builtin_sqrt(ex * ex + ey * ey);
+}
+
+double Bundle::Cost(const BundleInput& in, const ViewMotion* motion, const double* w, double huber,
+                    int32_t* count) const {
+  double cost = 0;
+  int32_t n = 0;
+  for (int32_t j = 0; j < in.points; ++j) {
+    if (!in.point_ok[j]) continue;
+    for (int32_t v = 0; v < in.views; ++v) {
+      if (v == in.reference || !ObsOk(in, v, j)) continue;
+      const double e = ErrorPx(in, motion[v], w[j], v, j);
+      cost += Huber(e * e, huber);
+      ++n;
+    }
+  }
+  if (count) *count = n;
+  return cost;
+}
+
+Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber,
+                     ViewMotion* motion, double* w, BundleReport* report) {
+  if (in.views < 2 || in.views > max_views_ || in.points > max_points_ || in.reference < 0 ||
+      in.reference >= in.views) {
+    return Status(Code::kInvalidArgument, "bundle: %d views, %d points beyond the configuration",
+                  in.views, in.points);
+  }
+  const int32_t nc = 6 * (in.views - 1);
+  // Hcc is block diagonal (an observation involves one camera): kept as nc x 6 undamped blocks.
+  Eigen::Map<Eigen::MatrixXd> hcc(hcc_, nc, 6);
+  Eigen::Map<Eigen::VectorXd> g(g_, nc);
+  Eigen::Map<Eigen::MatrixXd> s(s_, nc, nc);
+  Eigen::Map<Eigen::VectorXd> g2(g2_, nc);
+  // Camera block index of a view (the reference has none).
+  auto block = [&](int32_t v) { return 6 * (v < in.reference ? v : v - 1); };
+  int32_t count = 0;
+  double cost = Cost(in, motion, w, huber, &count);
+  *report = BundleReport{};
+  report->observations = count;
+  report->initial_rms_px = count ? __builtin_sqrt(2 * cost / count) : 0;
+  if (count == 0) return Status(Code::kDegenerate, "bundle: no observations");
+  double lambda = 1e-3;
+  const double eps = 1e-12 * in.fx * in.fx;
+  ViewMotion trial[kMaxViews];
+  int32_t it = 0;
+  for (; it < max_iterations; ++it) {
+    // Normal equations of the IRLS-weighted problem; the point unknowns are eliminated below.
+    hcc.setZero();
+    g.setZero();
+    for (int32_t j = 0; j < in.points; ++j) {
+      hww_[j] = 0;
+      gw_[j] = 0;
+      Eigen::Map<Eigen::VectorXd> hcw(hcw_ + static_cast<size_t>(nc) * j, nc);
+      hcw.setZero();
+      if (!in.point_ok[j]) continue;
+      for (int32_t v = 0; v < in.views; ++v) {
+        if (v == in.reference || !ObsOk(in, v, j)) continue;
+        Vec3 rr;
+        const Vec3 a = Ray(in, motion[v], w[j], j, &rr);
+        const double* o = Obs(in, v, j);
+        const double iz = 1.0 / a[2];
+        const Eigen::Vector2d e(in.fx * (a[0] * iz - o[0]), in.fy * (a[1] * iz - o[1]));
+        const double en = e.norm();
+        const double rw = en <= huber ? 1.0 : huber / en;
+        Eigen::Matrix<double, 2, 3> ja;
+        ja << in.fx * iz, 0, -in.fx * a[0] * iz * iz, 0, in.fy * iz, -in.fy * a[1] * iz * iz;
+        Mat3 skew;  // d(R r)/dd = -[R r]x
+        skew << 0, rr[2], -rr[1], -rr[2], 0, rr[0], rr[1], -rr[0], 0;
+        Eigen::Matrix<double, 2, 6> jc;
+        jc.leftCols<3>() = ja * skew;
+        jc.rightCols<3>() = ja * w[j];
+        const Eigen::Vector2d jw = ja * Eigen::Map<const Vec3>(motion[v].translation);
+        const int32_t b = block(v);
+        hcc.block<6, 6>(b, 0) += rw * jc.transpose() * jc;
+        g.segment<6>(b) -= rw * jc.transpose() * e;
+        hcw.segment<6>(b) += rw * jc.transpose() * jw;
+        hww_[j] += rw * jw.squaredNorm();
+        gw_[j] -= rw * jw.dot(e);
+      }
+    }
+    bool accepted = false;
+    for (int32_t tries = 0; tries < 10 && !accepted; ++tries) {
+      // Damped reduced system S = Hcc - sum_j Hcw_j Hww_j^-1 Hwc_j (Marquardt: diagonal scaled).
+      s.setZero();
+      for (int32_t b = 0; b < nc; b += 6) s.block<6, 6>(b, b) = hcc.block<6, 6>(b, 0);
+      for (int32_t k = 0; k < nc; ++k) s(k, k) = s(k, k) * (1 + lambda) + eps;
+      g2 = g;
+      for (int32_t j = 0; j < in.points; ++j) {
+        if (!in.point_ok[j]) continue;
+        const double hd = hww_[j] * (1 + lambda) + eps;
+        Eigen::Map<const Eigen::VectorXd> hcw(hcw_ + static_cast<size_t>(nc) * j, nc);
+        s.noalias() -= (hcw / hd) * hcw.transpose();
+        g2 -= hcw * (gw_[j] / hd);
+      }
+      Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(s);
+      if (llt.info() != Eigen::Success) {
+        lambda *= 10;
+        continue;
+      }
+      llt.solveInPlace(g2);
+      for (int32_t v = 0; v < in.views; ++v) {
+        trial[v] = motion[v];
+        if (v == in.reference) continue;
+        const int32_t b = block(v);
+        const double d[3] = {g2[b], g2[b + 1], g2[b + 2]};
+        RotateBy(d, &trial[v]);
+        for (int32_t k = 0; k < 3; ++k) trial[v].translation[k] += g2[b + 3 + k];
+      }
+      double mean = 0;
+      int32_t used = 0;
+      for (int32_t j = 0; j < in.points; ++j) {
+        w_try_[j] = w[j];
+        if (!in.point_ok[j]) continue;
+        const double hd = hww_[j] * (1 + lambda) + eps;
+        Eigen::Map<const Eigen::VectorXd> hcw(hcw_ + static_cast<size_t>(nc) * j, nc);
+        w_try_[j] = w[j] + (gw_[j] - hcw.dot(g2)) / hd;
+        mean += w_try_[j];
+        ++used;
+      }
+      const double new_cost = Cost(in, trial, w_try_, huber, nullptr);
+      if (new_cost < cost) {
+        accepted = true;
+        const double rel = (cost - new_cost) / cost;
+        cost = new_cost;
+        lambda = lambda / 3 > 1e-9 ? lambda / 3 : 1e-9;
+        // Gauge: mean inverse depth 1 (a positive mean; a sign flip would put points behind).
+        mean = used ? mean / used : 1;
+        const double scale = mean > 1e-9 ? mean : 1;
+        for (int32_t j = 0; j < in.points; ++j) w[j] = w_try_[j] / scale;
+        for (int32_t v = 0; v < in.views; ++v) {
+          motion[v] = trial[v];
+          for (int32_t k = 0; k < 3; ++k) motion[v].translation[k] *= scale;
+        }
+        if (rel < 1e-10) it = max_iterations;
+      } else {
+        lambda *= 4;
+      }
+    }
+    if (!accepted) break;
+  }
+  report->iterations = it;
+  report->rms_px = __builtin_sqrt(2 * Cost(in, motion, w, huber, nullptr) / count);
+  return Status::Ok();
+}
+
+}  // namespace lb

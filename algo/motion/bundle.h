@@ -1,0 +1,73 @@
+// Small-motion bundle adjustment (Levenberg-Marquardt, Eigen, double): every non-reference view's
+// rotation and translation and every point's inverse depth, from points observed in the
+// reference (held exact, as in the accidental-motion literature: the reference pixel fixes the
+// ray) and tracked into the other views.
+//
+// Model: a point on the reference ray r = (x, y, 1) at inverse depth w is seen in view v along
+// R_v r + w t_v; residuals are in pixels (normalised error times fx, fy) under a Huber loss.
+// Rotations are updated by a unit quaternion (1, d/2) normalised, so no sin/cos is needed and the
+// same bits come out on every target. Start: identity rotations, zero translations, w = 1; small
+// motion makes that close enough. Gauge: after every accepted step the inverse depths are scaled
+// to mean 1 (translations scaled inversely), so a unit is the harmonic mean depth of the points.
+//
+// Linear algebra: the point block is diagonal (one unknown per point), so each step solves the
+// reduced camera system (6 per view, <= 90 unknowns) with an in-place Cholesky in arena memory.
+#pragma once
+
+#include <cstdint>
+
+#include "algo/core/arena.h"
+#include "algo/core/status.h"
+#include "algo/motion/camera.h"
+
+namespace lb {
+
+struct BundleInput {
+  int32_t views = 0;
+  int32_t reference = 0;
+  int32_t points = 0;
+  double fx = 1, fy = 1;
+  const double* ref_xy = nullptr;     // 2 per point: normalised reference coordinates
+  const double* obs_xy = nullptr;     // 2 per (view, point), view-major: normalised
+  const uint8_t* obs_ok = nullptr;    // per (view, point), view-major
+  const uint8_t* point_ok = nullptr;  // per point
+};
+
+struct BundleReport {
+  int32_t iterations = 0;
+  double initial_rms_px = 0;
+  double rms_px = 0;  // over the used observations
+  int32_t observations = 0;
+};
+
+class Bundle {
+ public:
+  static constexpr int32_t kMaxViews = 16;
+
+  Status Carve(int32_t max_views, int32_t max_points, Arena& arena);
+
+  // Refines `motion` (one per view; the reference's is left the identity) and `inv_depth` (one
+  // per point) from their current values.
+  Status Solve(const BundleInput& in, int32_t max_iterations, double huber_px, ViewMotion* motion,
+               double* inv_depth, BundleReport* report);
+
+  // Reprojection error in px of one observation under the given parameters.
+  static double ErrorPx(const BundleInput& in, const ViewMotion& m, double w, int32_t view,
+                        int32_t point);
+
+ private:
+  double Cost(const BundleInput& in, const ViewMotion* motion, const double* w, double huber,
+              int32_t* count) const;
+
+  int32_t max_views_ = 0, max_points_ = 0;
+  double* hcc_ = nullptr;    // camera blocks, 6(V-1) x 6
+  double* g_ = nullptr;      // camera gradient, 6(V-1)
+  double* s_ = nullptr;      // damped reduced camera matrix, 6(V-1) squared
+  double* g2_ = nullptr;     // its right-hand side, then the camera step
+  double* hww_ = nullptr;    // per point
+  double* gw_ = nullptr;     // per point
+  double* hcw_ = nullptr;    // per point: 6(V-1)
+  double* w_try_ = nullptr;  // per point
+};
+
+}  // namespace lb

@@ -1,0 +1,38 @@
+// Camera model shared by the motion stage and its users: a pinhole with square-ish pixels, and
+// each view's pose relative to the reference.
+//
+// Coordinates: continuous pixel coordinates put pixel (i, j) on [i, i+1) x [j, j+1), so its
+// centre is (i + 0.5, j + 0.5); cx, cy are in those coordinates (the image centre is (w/2, h/2)).
+// A reference-camera point X (x right, y down, z forward) is X_v = rotation * X + translation in
+// view v's camera (row-major rotation).
+#pragma once
+
+#include <cstdint>
+
+namespace lb {
+
+struct CameraIntrinsics {
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+};
+
+// Without EXIF or a sensor description: fx = fy = 0.8 * width (a ~64 degree horizontal field of
+// view, a typical compact camera at its wide end), principal point at the centre.
+inline CameraIntrinsics DefaultIntrinsics(int32_t width, int32_t height) {
+  const double f = 0.8 * width;
+  return {f, f, 0.5 * width, 0.5 * height};
+}
+
+// Focal length in pixels from an EXIF focal length and the sensor width (both mm, or a 35 mm
+// equivalent focal length with sensor_width_mm = 36), principal point at the centre.
+inline CameraIntrinsics IntrinsicsFromFocal(double focal_mm, double sensor_width_mm, int32_t width,
+                                            int32_t height) {
+  const double f = focal_mm / sensor_width_mm * width;
+  return {f, f, 0.5 * width, 0.5 * height};
+}
+
+struct ViewMotion {
+  double rotation[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  double translation[3] = {0, 0, 0};
+};
+
+}  // namespace lb

@@ -1,0 +1,323 @@
+#include "algo/motion/motion_stage.h"
+
+#include <algorithm>
+
+namespace lb {
+namespace {
+
+int32_t Cell(const MotionConfig& c) {
+  if (c.cell > 0) return c.cell;
+  return c.width / 80 > 8 ? c.width / 80 : 8;
+}
+
+// Chord |R - I|_F = 2 sqrt(2) sin(angle / 2): monotone in the angle, no acos needed.
+double RotationChord(const ViewMotion& m) {
+  double s = 0;
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      const double d = m.rotation[i][j] - (i == j ? 1.0 : 0.0);
+      s += d * d;
+    }
+  }
+  return __builtin_sqrt(s);
+}
+
+}  // namespace
+
+const char* MotionDiagnosisName(MotionDiagnosis d) {
+  switch (d) {
+    case MotionDiagnosis::kOk:
+      return "ok";
+    case MotionDiagnosis::kTooFewFeatures:
+      return "too few features";
+    case MotionDiagnosis::kBlurredFrame:
+      return "blurred frame";
+    case MotionDiagnosis::kLostTracking:
+      return "lost tracking";
+    case MotionDiagnosis::kNoMotion:
+      return "no motion";
+    case MotionDiagnosis::kPureRotation:
+      return "pure rotation";
+  }
+  return "?";
+}
+
+Status MotionStage::Validate(const MotionConfig& c) {
+  if (c.views < 2 || c.views > MotionConfig::kMaxViews) {
+    return Status(Code::kInvalidArgument, "motion: %d views (2..%d)", c.views,
+                  MotionConfig::kMaxViews);
+  }
+  if (c.width < 64 || c.height < 64 || c.width > 8192 || c.height > 8192) {
+    return Status(Code::kInvalidArgument, "motion: %dx%d working resolution (64..8192)", c.width,
+                  c.height);
+  }
+  if (c.min_features < 8 || c.bundle_iterations < 1 || c.bundle_rounds < 1 ||
+      c.bundle_rounds > 10 || !(c.huber_px > 0) || !(c.outlier_px > 0) ||
+      !(c.min_parallax_px >= 0) || c.blur_percent < 0 || c.blur_percent > 100) {
+    return Status(Code::kInvalidArgument,
+                  "motion: min_features >= 8, iterations >= 1, 1..10 rounds, positive "
+                  "thresholds and blur_percent 0..100 expected");
+  }
+  return Status::Ok();
+}
+
+size_t MotionStage::RequiredBytes(const MotionConfig& config) {
+  if (!Validate(config).ok()) return 0;
+  MotionStage planner;
+  Arena counting;
+  planner.config_ = config;
+  if (!planner.Carve(counting).ok()) return 0;
+  return counting.used();
+}
+
+Status MotionStage::Configure(const MotionConfig& config, Arena& arena) {
+  LB_RETURN_IF_ERROR(Validate(config));
+  config_ = config;
+  const size_t before = arena.used();
+  LB_RETURN_IF_ERROR(Carve(arena));
+  arena_bytes_ = arena.used() - before;
+  if (arena.overflowed()) {
+    return Status(Code::kOutOfMemory, "motion: arena of %zu bytes too small (needs %zu more)",
+                  arena.size(), arena_bytes_);
+  }
+  return Status::Ok();
+}
+
+Status MotionStage::Carve(Arena& arena) {
+  const MotionConfig& c = config_;
+  LB_RETURN_IF_ERROR(ref_.Carve(c.width, c.height, c.pyramid_levels, arena));
+  LB_RETURN_IF_ERROR(view_.Carve(c.width, c.height, c.pyramid_levels, arena));
+  LB_RETURN_IF_ERROR(corners_.Carve(c.width, c.height, Cell(c), arena));
+  LB_RETURN_IF_ERROR(tracker_.Carve(c.tracker, arena));
+  max_points_ = corners_.max_corners();
+  LB_RETURN_IF_ERROR(bundle_.Carve(c.views, max_points_, arena));
+  const size_t n = static_cast<size_t>(max_points_);
+  const size_t vn = n * static_cast<size_t>(c.views);
+  corner_ = arena.Allocate<Corner>(n);
+  pos_q16_ = arena.Allocate<int32_t>(2 * n);
+  disp_q16_ = arena.Allocate<int32_t>(2 * vn);
+  obs_ok_ = arena.Allocate<uint8_t>(vn);
+  point_ok_ = arena.Allocate<uint8_t>(n);
+  ref_xy_ = arena.Allocate<double>(2 * n);
+  obs_xy_ = arena.Allocate<double>(2 * vn);
+  inv_depth_ = arena.Allocate<double>(n);
+  out_xy_ = arena.Allocate<double>(2 * n);
+  out_w_ = arena.Allocate<double>(n);
+  sorted_ = arena.Allocate<double>(n);
+  return Status::Ok();
+}
+
+Status MotionStage::Estimate(const ConstImageU8* views, int32_t reference,
+                             const CameraIntrinsics& k, MotionResult* result) {
+  const MotionConfig& c = config_;
+  if (corner_ == nullptr) return Status(Code::kInvalidArgument, "motion: not configured");
+  if (reference < 0 || reference >= c.views) {
+    return Status(Code::kInvalidArgument, "motion: reference %d of %d views", reference, c.views);
+  }
+  if (!(k.fx > 0) || !(k.fy > 0)) {
+    return Status(Code::kInvalidArgument, "motion: focal length %g x %g px", k.fx, k.fy);
+  }
+  for (int32_t v = 0; v < c.views; ++v) {
+    if (views[v].width != c.width || views[v].height != c.height ||
+        (views[v].channels != 1 && views[v].channels != 3) || views[v].data == nullptr) {
+      return Status(Code::kInvalidArgument, "motion: view %d is %dx%dx%d, expected %dx%d", v,
+                    views[v].width, views[v].height, views[v].channels, c.width, c.height);
+    }
+  }
+  *result = MotionResult{};
+  result->views = c.views;
+  result->reference = reference;
+  result->intrinsics = k;
+  LB_RETURN_IF_ERROR(Track(views, reference, result));
+  LB_RETURN_IF_ERROR(Adjust(k, reference, result));
+  return Check(result);
+}
+
+Status MotionStage::Track(const ConstImageU8* views, int32_t reference, MotionResult* result) {
+  const MotionConfig& c = config_;
+  LB_RETURN_IF_ERROR(ref_.Build(views[reference]));
+  result->sharpness_q4[reference] = SharpnessQ4(ref_.level(0));
+  // A corner must stand out from the frame's noise: its response at least 1/1000 of the
+  // strongest, and that of a 4-level step over the 5x5 box.
+  const int32_t n = corners_.Detect(ref_.level(0), 4000000, 1000, corner_);
+  result->corners = n;
+  if (n < c.min_features) {
+    result->diagnosis = MotionDiagnosis::kTooFewFeatures;
+    return Status(Code::kDegenerate,
+                  "too few features: %d corners in the reference frame, %d needed; aim at a "
+                  "scene with more texture or light",
+                  n, c.min_features);
+  }
+  for (int32_t i = 0; i < n; ++i) {
+    pos_q16_[i] = corner_[i].x << 16;
+    pos_q16_[max_points_ + i] = corner_[i].y << 16;
+  }
+  for (int32_t v = 0; v < c.views; ++v) {
+    if (v == reference) continue;
+    LB_RETURN_IF_ERROR(view_.Build(views[v]));
+    result->sharpness_q4[v] = SharpnessQ4(view_.level(0));
+    int32_t* dx = disp_q16_ + 2 * static_cast<size_t>(v) * max_points_;
+    int32_t* dy = dx + max_points_;
+    for (int32_t i = 0; i < n; ++i) dx[i] = dy[i] = 0;
+    tracker_.Track(ref_, view_, pos_q16_, pos_q16_ + max_points_, n, dx, dy,
+                   obs_ok_ + static_cast<size_t>(v) * n);
+  }
+  return Status::Ok();
+}
+
+Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionResult* result) {
+  const MotionConfig& c = config_;
+  const int32_t n = result->corners;
+  for (int32_t i = 0; i < n; ++i) {
+    // Index coordinates to continuous (+0.5), then normalised.
+    ref_xy_[2 * i] = (pos_q16_[i] / 65536.0 + 0.5 - k.cx) / k.fx;
+    ref_xy_[2 * i + 1] = (pos_q16_[max_points_ + i] / 65536.0 + 0.5 - k.cy) / k.fy;
+    point_ok_[i] = 0;
+    inv_depth_[i] = 1.0;
+  }
+  for (int32_t v = 0; v < c.views; ++v) {
+    uint8_t* ok = obs_ok_ + static_cast<size_t>(v) * n;
+    if (v == reference) {
+      for (int32_t i = 0; i < n; ++i) ok[i] = 0;
+      continue;
+    }
+    const int32_t* dx = disp_q16_ + 2 * static_cast<size_t>(v) * max_points_;
+    const int32_t* dy = dx + max_points_;
+    for (int32_t i = 0; i < n; ++i) {
+      double* o = obs_xy_ + 2 * (static_cast<size_t>(v) * n + i);
+      o[0] = ((pos_q16_[i] + dx[i]) / 65536.0 + 0.5 - k.cx) / k.fx;
+      o[1] = ((pos_q16_[max_points_ + i] + dy[i]) / 65536.0 + 0.5 - k.cy) / k.fy;
+      if (ok[i]) point_ok_[i] = 1;
+    }
+  }
+  BundleInput in;
+  in.views = c.views;
+  in.reference = reference;
+  in.points = n;
+  in.fx = k.fx;
+  in.fy = k.fy;
+  in.ref_xy = ref_xy_;
+  in.obs_xy = obs_xy_;
+  in.obs_ok = obs_ok_;
+  in.point_ok = point_ok_;
+  BundleReport report;
+  for (int32_t round = 0; round < c.bundle_rounds; ++round) {
+    LB_RETURN_IF_ERROR(
+        bundle_.Solve(in, c.bundle_iterations, c.huber_px, result->motion, inv_depth_, &report));
+    if (round + 1 == c.bundle_rounds) break;
+    // Drop the observations the fit cannot explain (mismatched corners, moving things), and
+    // points left with none or seen behind a camera.
+    for (int32_t i = 0; i < n; ++i) {
+      if (!point_ok_[i]) continue;
+      bool any = false;
+      for (int32_t v = 0; v < c.views; ++v) {
+        uint8_t& ok = obs_ok_[static_cast<size_t>(v) * n + i];
+        if (!ok) continue;
+        if (Bundle::ErrorPx(in, result->motion[v], inv_depth_[i], v, i) > c.outlier_px) ok = 0;
+        any = any || ok;
+      }
+      if (!any || !(inv_depth_[i] > 0)) point_ok_[i] = 0;
+    }
+  }
+  result->rms_px = report.rms_px;
+  int32_t m = 0;
+  for (int32_t i = 0; i < n; ++i) {
+    if (!point_ok_[i]) continue;
+    for (int32_t v = 0; v < c.views; ++v)
+      result->inliers[v] += obs_ok_[static_cast<size_t>(v) * n + i];
+    out_xy_[2 * m] = pos_q16_[i] / 65536.0;
+    out_xy_[2 * m + 1] = pos_q16_[max_points_ + i] / 65536.0;
+    out_w_[m] = inv_depth_[i];
+    sorted_[m] = inv_depth_[i];
+    ++m;
+  }
+  result->inliers[reference] = m;
+  result->points = m;
+  result->point_xy = out_xy_;
+  result->inv_depth = out_w_;
+  if (m == 0) return Status::Ok();
+  std::sort(sorted_, sorted_ + m);
+  result->inv_depth_min = sorted_[(m - 1) * 2 / 100];
+  result->inv_depth_max = sorted_[(m - 1) * 98 / 100];
+  // Parallax: how far depth moves a point in the view, against the same ray at the median
+  // depth. Without translation the fit can still give wild depths (w t stays tiny), so this,
+  // not |t| or the depth spread alone, says whether the burst holds depth.
+  const double w_med = sorted_[m / 2];
+  for (int32_t v = 0; v < c.views; ++v) {
+    if (v == reference) continue;
+    for (int32_t j = 0; j < m; ++j) {
+      double p[2][3];
+      const double r[3] = {(out_xy_[2 * j] + 0.5 - k.cx) / k.fx,
+                           (out_xy_[2 * j + 1] + 0.5 - k.cy) / k.fy, 1.0};
+      const ViewMotion& mo = result->motion[v];
+      const double ws[2] = {out_w_[j], w_med};
+      for (int s = 0; s < 2; ++s) {
+        for (int i = 0; i < 3; ++i) {
+          p[s][i] = mo.rotation[i][0] * r[0] + mo.rotation[i][1] * r[1] + mo.rotation[i][2] * r[2] +
+                    ws[s] * mo.translation[i];
+        }
+      }
+      const double dx = k.fx * (p[0][0] / p[0][2] - p[1][0] / p[1][2]);
+      const double dy = k.fy * (p[0][1] / p[0][2] - p[1][1] / p[1][2]);
+      sorted_[j] = __builtin_sqrt(dx * dx + dy * dy);
+    }
+    std::sort(sorted_, sorted_ + m);
+    result->parallax_px[v] = sorted_[(m - 1) * 90 / 100];
+  }
+  return Status::Ok();
+}
+
+Status MotionStage::Check(MotionResult* r) {
+  const MotionConfig& c = config_;
+  // Blur first: a blurred frame also loses points, and blur is what the user should hear about.
+  int32_t sharp[MotionConfig::kMaxViews];
+  for (int32_t v = 0; v < c.views; ++v) sharp[v] = r->sharpness_q4[v];
+  std::sort(sharp, sharp + c.views);
+  const int64_t median = sharp[c.views / 2];
+  for (int32_t v = 0; v < c.views; ++v) {
+    if (int64_t{r->sharpness_q4[v]} * 100 < median * c.blur_percent) {
+      r->diagnosis = MotionDiagnosis::kBlurredFrame;
+      r->bad_view = v;
+      return Status(Code::kDegenerate,
+                    "frame %d is blurred (sharpness %lld%% of the burst's median): hold the "
+                    "camera steadier or add light, and shoot again",
+                    v, static_cast<long long>(int64_t{r->sharpness_q4[v]} * 100 / median));
+    }
+  }
+  for (int32_t v = 0; v < c.views; ++v) {
+    if (v != r->reference && r->inliers[v] < c.min_features) {
+      r->diagnosis = MotionDiagnosis::kLostTracking;
+      r->bad_view = v;
+      return Status(Code::kDegenerate,
+                    "frame %d: only %d points could be followed from the reference (%d needed); "
+                    "move the camera less between frames and keep the scene still",
+                    v, r->inliers[v], c.min_features);
+    }
+  }
+  const double f = r->intrinsics.fx > r->intrinsics.fy ? r->intrinsics.fx : r->intrinsics.fy;
+  double best = 0, chord = 0;
+  for (int32_t v = 0; v < c.views; ++v) {
+    best = r->parallax_px[v] > best ? r->parallax_px[v] : best;
+    const double ch = RotationChord(r->motion[v]);
+    chord = ch > chord ? ch : chord;
+  }
+  if (best < c.min_parallax_px) {
+    // The rotation (chord ~ sqrt(2) x angle) shows whether the hand turned: 0.05 degree moves
+    // the image by less than half a pixel at the working resolution.
+    const bool turned = chord * f > 0.5 * 1.41421356;
+    r->diagnosis = turned ? MotionDiagnosis::kPureRotation : MotionDiagnosis::kNoMotion;
+    if (turned) {
+      return Status(Code::kDegenerate,
+                    "the camera turned but did not shift (parallax %.2f px): move the camera a "
+                    "little sideways between frames instead of turning it",
+                    best);
+    }
+    return Status(Code::kDegenerate,
+                  "the camera did not move between frames (parallax %.2f px): move the camera a "
+                  "little sideways between frames",
+                  best);
+  }
+  return Status::Ok();
+}
+
+}  // namespace lb

@@ -1,0 +1,133 @@
+// Motion stage: from the working-resolution views of a handheld burst to every view's rotation
+// and translation relative to the reference, the sparse points' inverse depths and the
+// inverse-depth range they span, or a diagnosis of why the burst cannot give depth.
+//
+// Steps: grey pyramids (pyramid.h), corners on the reference (corners.h), pyramidal
+// Lucas-Kanade into every view (tracker.h), small-motion bundle adjustment under a Huber loss
+// with the worst observations dropped and the adjustment rerun (bundle.h), then the checks.
+//
+// Scale convention: inverse depths are scaled to mean 1 over the inlier points, so their unit is
+// 1 / (harmonic mean depth of the points), and translations are in units of that depth. Only
+// the product inv_depth * translation reaches pixels (plane_homography.h), and it does not
+// depend on the convention. A rectified rig of spacing b seen at mean inverse depth m has
+// |translation| = b m per view step.
+//
+// Memory: every buffer is carved at Configure; Estimate allocates nothing (Eigen runs on arena
+// memory and fixed-size temporaries; EIGEN_NO_MALLOC guards it).
+// Determinism: integer pyramids, corners and tracking; double geometry without FMA contraction,
+// SIMD or transcendentals, so the same burst gives the same bits on x86-64, aarch64 and armhf.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "algo/core/arena.h"
+#include "algo/core/image.h"
+#include "algo/core/status.h"
+#include "algo/motion/bundle.h"
+#include "algo/motion/camera.h"
+#include "algo/motion/corners.h"
+#include "algo/motion/plane_homography.h"
+#include "algo/motion/pyramid.h"
+#include "algo/motion/tracker.h"
+
+namespace lb {
+
+struct MotionConfig {
+  static constexpr int32_t kMaxViews = Bundle::kMaxViews;
+
+  int32_t width = 0;  // working resolution
+  int32_t height = 0;
+  int32_t views = 0;
+  int32_t pyramid_levels = 4;  // follows motions up to ~(radius + 1) * 2^(levels - 1) px
+  int32_t cell = 0;            // corner grid cell in px; 0 = max(12, width / 20)
+  TrackerParams tracker;
+  int32_t min_features = 40;        // corners, and followed points per view, below: degenerate
+  int32_t bundle_iterations = 100;  // per round
+  int32_t bundle_rounds = 3;        // adjust, drop observations off by > outlier_px, adjust again
+  double huber_px = 0.5;
+  double outlier_px = 0.8;
+  double min_parallax_px = 1.0;  // depth-dependent motion the best view must show
+  int32_t blur_percent = 55;     // a frame whose sharpness is below this % of the median: blurred
+};
+
+enum class MotionDiagnosis : uint8_t {
+  kOk,
+  kTooFewFeatures,  // the reference has too little texture
+  kBlurredFrame,    // one frame is much less sharp than the others
+  kLostTracking,    // a frame moved too far (or differs too much) to follow the points
+  kNoMotion,        // the frames show the same view: the camera did not move
+  kPureRotation,    // the camera turned but did not move sideways: no parallax
+};
+const char* MotionDiagnosisName(MotionDiagnosis d);
+
+struct MotionResult {
+  MotionDiagnosis diagnosis = MotionDiagnosis::kOk;
+  int32_t bad_view = -1;  // the frame a per-frame diagnosis names
+  int32_t views = 0, reference = 0;
+  CameraIntrinsics intrinsics;
+  ViewMotion motion[MotionConfig::kMaxViews];     // the reference's is the identity
+  int32_t inliers[MotionConfig::kMaxViews] = {};  // points used per view
+  int32_t sharpness_q4[MotionConfig::kMaxViews] = {};
+  // Per view: 90th percentile over the points of how far their depth moves them (against the
+  // median depth on the same ray), px.
+  double parallax_px[MotionConfig::kMaxViews] = {};
+  // Sparse points (arena memory, valid until the next Estimate): reference pixel-index position
+  // and inverse depth, inliers only.
+  int32_t points = 0;
+  const double* point_xy = nullptr;  // 2 per point
+  const double* inv_depth = nullptr;
+  // Inverse-depth range for the depth labels: the 2nd and 98th percentiles of the points (a
+  // caller adds its own margin).
+  double inv_depth_min = 0, inv_depth_max = 0;
+  double rms_px = 0;  // reprojection error of the final adjustment
+  int32_t corners = 0;
+
+  // Plane homography of `view` for a plane at `inv_depth` (in this result's units).
+  PlaneHomography Homography(int32_t view, double inv_depth) const {
+    return MakePlaneHomography(intrinsics, motion[view], inv_depth);
+  }
+};
+
+class MotionStage {
+ public:
+  static Status Validate(const MotionConfig& config);
+  static size_t RequiredBytes(const MotionConfig& config);
+  Status Configure(const MotionConfig& config, Arena& arena);
+
+  // `views` (config.views of them) are RGB8 or grey images of the working resolution. Fills
+  // `result` and returns Ok, or a kDegenerate status whose message says what to do (the
+  // diagnosis is in the result too), or kInvalidArgument for views that do not match.
+  Status Estimate(const ConstImageU8* views, int32_t reference, const CameraIntrinsics& intrinsics,
+                  MotionResult* result);
+
+  const MotionConfig& config() const { return config_; }
+  size_t arena_bytes() const { return arena_bytes_; }
+
+ private:
+  Status Carve(Arena& arena);
+  Status Track(const ConstImageU8* views, int32_t reference, MotionResult* result);
+  Status Adjust(const CameraIntrinsics& k, int32_t reference, MotionResult* result);
+  Status Check(MotionResult* result);
+
+  MotionConfig config_;
+  size_t arena_bytes_ = 0;
+  int32_t max_points_ = 0;
+  GreyPyramid ref_, view_;
+  CornerDetector corners_;
+  Tracker tracker_;
+  Bundle bundle_;
+  Corner* corner_ = nullptr;     // max_points_
+  int32_t* pos_q16_ = nullptr;   // corner x (max_points_), then y (max_points_)
+  int32_t* disp_q16_ = nullptr;  // dx, dy per (view, point)
+  uint8_t* obs_ok_ = nullptr;    // per (view, point)
+  uint8_t* point_ok_ = nullptr;  // per point
+  double* ref_xy_ = nullptr;     // normalised, 2 per point
+  double* obs_xy_ = nullptr;     // normalised, 2 per (view, point)
+  double* inv_depth_ = nullptr;  // per point
+  double* out_xy_ = nullptr;     // inliers: pixel positions
+  double* out_w_ = nullptr;      // inliers: inverse depths (sorted copy for percentiles too)
+  double* sorted_ = nullptr;
+};
+
+}  // namespace lb

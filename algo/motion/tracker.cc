@@ -1,0 +1,127 @@
+#include "algo/motion/tracker.h"
+
+namespace lb {
+namespace {
+
+// Bilinear sample at Q16 index coordinates, Q4 result; the caller keeps (x, y) and (x+1, y+1)
+// inside the image.
+inline int32_t SampleQ4(const ImageU8& img, int32_t x_q16, int32_t y_q16) {
+  const int32_t ix = x_q16 >> 16, iy = y_q16 >> 16;
+  const int32_t fx = (x_q16 >> 8) & 255, fy = (y_q16 >> 8) & 255;
+  const uint8_t* a = img.Row(iy) + ix;
+  const uint8_t* b = a + img.stride;
+  const int32_t top = a[0] * (256 - fx) + a[1] * fx;
+  const int32_t bot = b[0] * (256 - fx) + b[1] * fx;
+  return (top * (256 - fy) + bot * fy + 2048) >> 12;
+}
+
+// True when the window of half size `half` around (x, y) can be sampled bilinearly.
+inline bool Inside(const ImageU8& img, int32_t x_q16, int32_t y_q16, int32_t half) {
+  const int32_t x0 = (x_q16 >> 16) - half, y0 = (y_q16 >> 16) - half;
+  return x0 >= 0 && y0 >= 0 && x0 + 2 * half + 1 < img.width && y0 + 2 * half + 1 < img.height;
+}
+
+inline int32_t RoundQ16(double v) {
+  const double s = v * 65536.0;
+  return static_cast<int32_t>(s >= 0 ? s + 0.5 : s - 0.5);
+}
+
+}  // namespace
+
+Status Tracker::Carve(const TrackerParams& params, Arena& arena) {
+  if (params.radius < 1 || params.radius > 8 || params.max_iterations < 1 ||
+      params.max_iterations > 50 || params.max_error_q4 < 1) {
+    return Status(Code::kInvalidArgument, "tracker: radius %d (1..8), iterations %d (1..50)",
+                  params.radius, params.max_iterations);
+  }
+  params_ = params;
+  const size_t t = static_cast<size_t>(2 * params.radius + 3);
+  const size_t w = static_cast<size_t>(2 * params.radius + 1);
+  tmpl_ = arena.Allocate<int32_t>(t * t);
+  gx_ = arena.Allocate<int32_t>(w * w);
+  gy_ = arena.Allocate<int32_t>(w * w);
+  return Status::Ok();
+}
+
+void Tracker::Track(const GreyPyramid& ref, const GreyPyramid& view, const int32_t* x_q16,
+                    const int32_t* y_q16, int32_t n, int32_t* dx_q16, int32_t* dy_q16,
+                    uint8_t* ok) const {
+  for (int32_t i = 0; i < n; ++i) {
+    ok[i] = TrackOne(ref, view, x_q16[i], y_q16[i], &dx_q16[i], &dy_q16[i]) ? 1 : 0;
+  }
+}
+
+bool Tracker::TrackOne(const GreyPyramid& ref, const GreyPyramid& view, int32_t x_q16,
+                       int32_t y_q16, int32_t* dx_q16, int32_t* dy_q16) const {
+  const int32_t r = params_.radius;
+  const int32_t tw = 2 * r + 3, ww = 2 * r + 1;
+  constexpr int32_t kHalfQ16 = 1 << 15;
+  int32_t dx = *dx_q16, dy = *dy_q16;
+  const int32_t top = ref.levels() - 1;
+  dx >>= top;  // the guess, at the coarsest level
+  dy >>= top;
+  int32_t mean_error = 0;
+  for (int32_t level = top; level >= 0; --level) {
+    const ImageU8& ti = ref.level(level);
+    const ImageU8& vi = view.level(level);
+    const int32_t px = ((x_q16 + kHalfQ16) >> level) - kHalfQ16;
+    const int32_t py = ((y_q16 + kHalfQ16) >> level) - kHalfQ16;
+    if (!Inside(ti, px, py, r + 1)) return false;
+    for (int32_t j = 0; j < tw; ++j) {
+      for (int32_t i = 0; i < tw; ++i) {
+        tmpl_[j * tw + i] = SampleQ4(ti, px + ((i - r - 1) << 16), py + ((j - r - 1) << 16));
+      }
+    }
+    int64_t gxx = 0, gyy = 0, gxy = 0;
+    for (int32_t j = 0; j < ww; ++j) {
+      for (int32_t i = 0; i < ww; ++i) {
+        const int32_t* t = tmpl_ + (j + 1) * tw + (i + 1);
+        const int32_t gx = t[1] - t[-1];
+        const int32_t gy = t[tw] - t[-tw];
+        gx_[j * ww + i] = gx;
+        gy_[j * ww + i] = gy;
+        gxx += int64_t{gx} * gx;
+        gyy += int64_t{gy} * gy;
+        gxy += int64_t{gx} * gy;
+      }
+    }
+    const double a = static_cast<double>(gxx), b = static_cast<double>(gxy);
+    const double c = static_cast<double>(gyy);
+    const double det = a * c - b * b;
+    // A flat or edge-only window has no 2D position: its smaller eigenvalue is ~0.
+    if (!(det > 1e-6 * (a + c) * (a + c)) || a + c <= 0) return false;
+    for (int32_t it = 0; it < params_.max_iterations; ++it) {
+      const int32_t qx = px + dx, qy = py + dy;
+      if (!Inside(vi, qx, qy, r)) return false;
+      int64_t bx = 0, by = 0, abs_err = 0;
+      for (int32_t j = 0; j < ww; ++j) {
+        for (int32_t i = 0; i < ww; ++i) {
+          const int32_t e = SampleQ4(vi, qx + ((i - r) << 16), qy + ((j - r) << 16)) -
+                            tmpl_[(j + 1) * tw + (i + 1)];
+          bx += int64_t{gx_[j * ww + i]} * e;
+          by += int64_t{gy_[j * ww + i]} * e;
+          abs_err += e < 0 ? -e : e;
+        }
+      }
+      mean_error = static_cast<int32_t>(abs_err / (ww * ww));
+      const double sx = 2.0 * (c * static_cast<double>(bx) - b * static_cast<double>(by)) / det;
+      const double sy = 2.0 * (a * static_cast<double>(by) - b * static_cast<double>(bx)) / det;
+      const double lim = r;  // one step never leaves the window
+      const int32_t stx = RoundQ16(sx > lim ? lim : (sx < -lim ? -lim : sx));
+      const int32_t sty = RoundQ16(sy > lim ? lim : (sy < -lim ? -lim : sy));
+      dx -= stx;
+      dy -= sty;
+      if ((stx < 0 ? -stx : stx) + (sty < 0 ? -sty : sty) < 512) break;  // < 1/128 px
+    }
+    if (level > 0) {
+      dx *= 2;
+      dy *= 2;
+    }
+  }
+  if (!Inside(view.level(0), x_q16 + dx, y_q16 + dy, r)) return false;
+  *dx_q16 = dx;
+  *dy_q16 = dy;
+  return mean_error <= params_.max_error_q4;
+}
+
+}  // namespace lb
