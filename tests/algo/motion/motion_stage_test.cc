@@ -37,7 +37,7 @@ void Estimate(Burst& b, Estimation* run, MotionConfig config = MotionConfig()) {
 
 TEST(MotionStage, HandheldBurstPosesMatchTheTruth) {
   std::vector<double> dirs;
-  for (uint64_t seed : {1u, 2u}) {
+  for (uint64_t seed : {1u}) {  // more seeds: accuracy_test.cc
     Burst b;
     ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(seed), 640, 480, 5, &b));
     Estimation run;
@@ -81,12 +81,12 @@ TEST(MotionStage, HandheldBurstPosesMatchTheTruth) {
 // The estimated plane homographies carry the sparse points to where the view sees them.
 TEST(MotionStage, PlaneHomographiesMapThePointsIntoTheViews) {
   Burst b;
-  ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(5), 640, 480, 5, &b));
+  ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(5), 320, 240, 5, &b));
   Estimation run;
   Estimate(b, &run);
   ASSERT_TRUE(run.status.ok()) << run.status.message();
   const MotionResult& r = run.result;
-  ASSERT_GT(r.points, 100);
+  ASSERT_GT(r.points, 50);
   for (int32_t v = 0; v < r.views; ++v) {
     double worst = 0;
     for (int32_t i = 0; i < r.points; i += 7) {
