@@ -45,12 +45,12 @@ fi
 step "host-asan: build and all tests but data and vm (AddressSanitizer + UBSan)"
 cmake --preset host-asan >/dev/null || die "configure host-asan"
 cmake --build --preset host-asan -j "$jobs" || die "build host-asan"
-run_ctest host-asan --preset host-asan -LE 'data|vm'
+run_ctest host-asan --preset host-asan -LE 'data|vm|accuracy'
 
-step "host (Release): Middlebury accuracy tests and the refocusd soak (500 presses)"
+step "host (Release): Middlebury and motion accuracy, the refocusd soak (500 presses)"
 cmake --preset host >/dev/null || die "configure host"
 cmake --build --preset host -j "$jobs" || die "build host"
-run_ctest host-data --preset host -L 'data|soak'
+run_ctest host-data --preset host -L 'data|soak|accuracy'
 
 if [ -d tests/vm ]; then
   step "kernel drivers in a VM (vivid, uinput, vimc)"
