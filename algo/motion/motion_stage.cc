@@ -270,7 +270,7 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
 Status MotionStage::Check(MotionResult* r) {
   const MotionConfig& c = config_;
   // Blur first: a blurred frame also loses points, and blur is what the user should hear about.
-  int32_t sharp[MotionConfig::kMaxViews];
+  int32_t sharp[MotionConfig::kMaxViews] = {};
   for (int32_t v = 0; v < c.views; ++v) sharp[v] = r->sharpness_q4[v];
   std::sort(sharp, sharp + c.views);
   const int64_t median = sharp[c.views / 2];

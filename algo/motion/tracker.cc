@@ -35,8 +35,8 @@ Status Tracker::Carve(const TrackerParams& params, Arena& arena) {
                   params.radius, params.max_iterations);
   }
   params_ = params;
-  const size_t t = static_cast<size_t>(2 * params.radius + 3);
-  const size_t w = static_cast<size_t>(2 * params.radius + 1);
+  const size_t t = 2 * static_cast<size_t>(params.radius) + 3;
+  const size_t w = 2 * static_cast<size_t>(params.radius) + 1;
   tmpl_ = arena.Allocate<int32_t>(t * t);
   gx_ = arena.Allocate<int32_t>(w * w);
   gy_ = arena.Allocate<int32_t>(w * w);
