@@ -1,10 +1,7 @@
 // Depth by graph cuts: labels start at the winner-take-all choice of the data term, then
 // alpha-expansion cycles lower E(f) = sum D_p(f_p) + sum w_pq min(|f_p - f_q|, K), each move an
-// exact minimum cut on the pixel grid, until a cycle changes nothing or the cycle cap.
-// The 2-label move energy per neighbour pair, with x = 1 meaning "switch to alpha",
-// A = V(fp,fq), B = V(fp,alpha), C = V(alpha,fq), V(alpha,alpha) = 0, is
-//   A + (C - A) x_p - C x_q + (B + C - A) (1 - x_p) x_q,
-// and B + C - A >= 0 because truncated linear is a metric, so every move is a graph cut.
+// exact minimum cut on the pixel grid (expansion_move.cc), until a cycle changes nothing or the
+// cycle cap.
 #include "algo/depth/depth_stage.h"
 
 namespace lb {
@@ -72,7 +69,7 @@ Status DepthStage::Carve(Arena& arena) {
   weight_right_ = arena.Allocate<uint16_t>(n);
   weight_down_ = arena.Allocate<uint16_t>(n);
   state_ = arena.Allocate<uint8_t>(n);
-  reach_ = arena.Allocate<uint16_t>(static_cast<size_t>(w));
+  sum_w_ = arena.Allocate<uint16_t>(static_cast<size_t>(w));
   prev_alpha_ = arena.Allocate<uint16_t>(n);
   below_ = arena.Allocate<uint16_t>(n);
   above_ = arena.Allocate<uint16_t>(n);
@@ -90,6 +87,9 @@ Status DepthStage::Configure(const DepthConfig& config, Arena& arena) {
   params.color_trunc = config.color_trunc;
   params.census_weight = config.census_weight;
   data_.SetParams(params, config.reference);
+  for (int32_t d = 0; d < DepthConfig::kMaxLabels; ++d) {
+    smooth_[d] = d < config.smooth_trunc ? d : config.smooth_trunc;
+  }
   return Carve(arena);
 }
 
@@ -156,185 +156,6 @@ void DepthStage::WinnerTakeAll() {
       }
     }
   }
-}
-
-bool DepthStage::Expand(int32_t alpha) {
-  const int32_t w = config_.width, h = config_.height;
-  data_.ComputeRows(LabelDispQ8(alpha), 0, h, cost_alpha_, w);
-  // Pass 1: pixels whose choice does not depend on their neighbours are fixed before the cut.
-  // Flipping p to alpha changes the energy by u_p plus, per neighbour q, C - A (q keeps its
-  // label) or -B (q takes alpha); if that is > 0 whatever the neighbours do, p keeps its label
-  // in every optimal move, and if it is < 0 whatever they do, p takes alpha. Each pair term
-  // moves the sum by at most w_pq * trunc, which settles most pixels without looking further.
-  // With a move margin, pixels for which alpha costs more than that above their label also keep
-  // it: a restricted move, still an exact cut over the pixels it frees, so the energy still
-  // never rises, over a much smaller graph.
-  const int32_t margin = config_.move_margin > 0 ? config_.move_margin : INT32_MAX;
-  int32_t y_lo = h, y_hi = -1;  // rows holding free or switching pixels
-  for (int32_t y = 0; y < h; ++y) {
-    const int32_t row = y * w;
-    uint8_t* state = state_ + row;
-    const uint16_t* ca = cost_alpha_ + row;
-    const uint16_t* cc = cost_ + row;
-    // Largest change of the pair terms around a pixel when it alone switches label
-    // (saturating is safe: D <= 2295).
-    uint16_t* reach = reach_;
-    for (int32_t x = 0; x < w; ++x) {
-      const int32_t sum = weight_right_[row + x] + (x > 0 ? weight_right_[row + x - 1] : 0) +
-                          weight_down_[row + x] + (y > 0 ? weight_down_[row + x - w] : 0);
-      const int32_t r = sum * config_.smooth_trunc;
-      reach[x] = static_cast<uint16_t>(r > 0xffff ? 0xffff : r);
-    }
-    bool open = false;
-    for (int32_t x = 0; x < w; ++x) {
-      const int32_t u = ca[x] - cc[x];
-      const int32_t limit = reach[x] < margin ? reach[x] : margin;
-      state[x] = u > limit ? kKeep : kFree;
-      open |= u <= limit;
-    }
-    if (!open) continue;
-    for (int32_t x = 0; x < w; ++x) {
-      if (state[x] == kKeep) continue;
-      const int32_t p = row + x;
-      const int32_t fp = labels_[p];
-      if (fp == alpha) {
-        state[x] = kKeep;
-        continue;
-      }
-      const int32_t u = ca[x] - cc[x];
-      int32_t lo = u, hi = u;
-      auto edge = [&](int32_t q, int32_t wpq) {
-        const int32_t fq = labels_[q];
-        const int32_t keep = wpq * (Smooth(alpha, fq) - Smooth(fp, fq));
-        const int32_t take = -wpq * Smooth(fp, alpha);
-        lo += keep < take ? keep : take;
-        hi += keep < take ? take : keep;
-      };
-      if (x + 1 < w) edge(p + 1, weight_right_[p]);
-      if (x > 0) edge(p - 1, weight_right_[p - 1]);
-      if (y + 1 < h) edge(p + w, weight_down_[p]);
-      if (y > 0) edge(p - w, weight_down_[p - w]);
-      if (lo > 0) {
-        state[x] = kKeep;
-        continue;
-      }
-      state[x] = hi < 0 ? kTake : kFree;
-      y_lo = y < y_lo ? y : y_lo;
-      y_hi = y;
-    }
-  }
-  if (y_hi < 0) {
-    Record(alpha);
-    return false;
-  }
-
-  // Pass 2: the cut over the free pixels of rows y_lo..y_hi (node = p - y_lo * w). A fixed
-  // neighbour turns a pair term into a unary one: E(x_p) = a + (c - a) x_p with a = V(fp, lq),
-  // c = V(alpha, lq), lq the label the neighbour is fixed to.
-  const int32_t base = y_lo * w;
-  maxflow_.Reset(w, y_hi - y_lo + 1);
-  bool any_free = false;
-  for (int32_t y = y_lo; y <= y_hi; ++y) {
-    for (int32_t x = 0; x < w; ++x) {
-      const int32_t p = y * w + x;
-      if (state_[p] != kFree) continue;
-      any_free = true;
-      ++stats_.cut_pixels;
-      const int32_t fp = labels_[p];
-      const int32_t node = p - base;
-      int32_t balance = cost_alpha_[p] - cost_[p];
-      auto fixed = [&](int32_t q, int32_t wpq) {
-        const int32_t lq = state_[q] == kTake ? alpha : labels_[q];
-        balance += wpq * (Smooth(alpha, lq) - Smooth(fp, lq));
-      };
-      auto pair = [&](int32_t q, int32_t wpq, GridMaxflow::Dir dir) {
-        if (state_[q] != kFree) return fixed(q, wpq);
-        const int32_t fq = labels_[q];
-        const int32_t a = wpq * Smooth(fp, fq), b = wpq * Smooth(fp, alpha);
-        const int32_t c = wpq * Smooth(alpha, fq);
-        balance += c - a;
-        maxflow_.AddTerminalBalance(node + (q - p), -c);
-        maxflow_.AddEdge(node, dir, b + c - a, 0);
-      };
-      if (x + 1 < w) pair(p + 1, weight_right_[p], GridMaxflow::kRight);
-      if (y + 1 < h) {
-        if (y + 1 <= y_hi) {
-          pair(p + w, weight_down_[p], GridMaxflow::kDown);
-        } else {
-          fixed(p + w, weight_down_[p]);
-        }
-      }
-      // Left and upper pairs with a free neighbour were added from that neighbour.
-      if (x > 0 && state_[p - 1] != kFree) fixed(p - 1, weight_right_[p - 1]);
-      if (y > 0 && state_[p - w] != kFree) fixed(p - w, weight_down_[p - w]);
-      maxflow_.AddTerminalBalance(node, balance);
-    }
-  }
-  if (any_free) (void)maxflow_.Solve();
-
-  // Apply, and update the energy from the pixels that changed and their pair terms.
-  for (int32_t y = y_lo; y <= y_hi; ++y) {
-    for (int32_t x = 0; x < w; ++x) {
-      const int32_t p = y * w + x;
-      if (state_[p] == kFree) state_[p] = maxflow_.InSource(p - base) ? kKeep : kTake;
-    }
-  }
-  int64_t delta = 0;
-  for (int32_t y = y_lo; y <= y_hi; ++y) {
-    for (int32_t x = 0; x < w; ++x) {
-      const int32_t p = y * w + x;
-      if (state_[p] != kTake) continue;
-      const int32_t fp = labels_[p];
-      delta += cost_alpha_[p] - cost_[p];
-      // Pairs with an unchanged neighbour; a pair of two switching pixels goes from
-      // V(fp, fq) to 0 and is counted once, from its left or upper pixel.
-      auto pair = [&](int32_t q, int32_t wpq, bool first) {
-        if (state_[q] == kTake && !(first && q > p)) return;
-        const int32_t fq = labels_[q];
-        const int32_t after = state_[q] == kTake ? 0 : Smooth(alpha, fq);
-        delta += int64_t{wpq} * (after - Smooth(fp, fq));
-      };
-      if (x + 1 < w) pair(p + 1, weight_right_[p], true);
-      if (x > 0) pair(p - 1, weight_right_[p - 1], false);
-      if (y + 1 < h) pair(p + w, weight_down_[p], true);
-      if (y > 0) pair(p - w, weight_down_[p - w], false);
-    }
-  }
-  for (int32_t y = y_lo; y <= y_hi; ++y) {
-    for (int32_t x = 0; x < w; ++x) {
-      const int32_t p = y * w + x;
-      if (state_[p] != kTake) continue;
-      labels_[p] = static_cast<uint8_t>(alpha);
-      cost_[p] = cost_alpha_[p];
-    }
-  }
-  energy_ += delta;
-  Record(alpha);
-  return delta < 0;
-}
-
-// Keeps D_p(f_p - 1) and D_p(f_p + 1) for the sub-label fit without another pass of the data
-// term: moves run in label order, so a pixel that keeps label f saw D(f - 1) and D(f + 1) in
-// the moves before and after f, and one that just took alpha saw D(alpha - 1) in the move
-// before (kept in prev_alpha_) and will see D(alpha + 1) in the next.
-void DepthStage::Record(int32_t alpha) {
-  const int32_t n = config_.width * config_.height;
-  const bool have_prev = prev_label_ == alpha - 1;
-  for (int32_t p = 0; p < n; ++p) {
-    const int32_t f = labels_[p];
-    if (state_[p] == kTake) {
-      below_[p] = have_prev ? prev_alpha_[p] : 0xffff;
-      above_[p] = 0xffff;
-    } else if (f == alpha + 1) {
-      below_[p] = cost_alpha_[p];
-    } else if (f + 1 == alpha) {
-      above_[p] = cost_alpha_[p];
-    }
-  }
-  uint16_t* t = prev_alpha_;
-  prev_alpha_ = cost_alpha_;
-  cost_alpha_ = t;
-  prev_label_ = alpha;
 }
 
 int64_t DepthStage::Energy(const uint8_t* labels) {

@@ -84,14 +84,12 @@ class DepthStage {
   Status Carve(Arena& arena);
   void EdgeWeights(const ConstImageU8& ref);
   void WinnerTakeAll();
-  // One alpha-expansion move; returns true when it lowered the energy.
+  // One alpha-expansion move (expansion_move.cc); returns true when it lowered the energy.
   bool Expand(int32_t alpha);
+  void Classify(int32_t alpha, int32_t* y_lo, int32_t* y_hi);
+  int32_t BuildMove(int32_t alpha, int32_t y_lo, int32_t y_hi);
   void Record(int32_t alpha);
   void Refine(ImageU16 disp_q8);
-  int32_t Smooth(int32_t a, int32_t b) const {
-    const int32_t d = a > b ? a - b : b - a;
-    return d < config_.smooth_trunc ? d : config_.smooth_trunc;
-  }
 
   DepthConfig config_;
   DepthStats stats_;
@@ -103,9 +101,10 @@ class DepthStage {
   uint16_t* weight_right_ = nullptr;  // w_pq to the right neighbour
   uint16_t* weight_down_ = nullptr;
   enum : uint8_t { kFree = 0, kKeep = 1, kTake = 2 };
-  uint8_t* state_ = nullptr;        // per pixel in a move: free for the cut, or fixed
-  uint16_t* reach_ = nullptr;       // one row: each pixel's pair weights summed, times smooth_trunc
-  uint16_t* prev_alpha_ = nullptr;  // D of the previous move's label, prev_label_
+  uint8_t* state_ = nullptr;                      // per pixel in a move: free for the cut, or fixed
+  uint16_t* sum_w_ = nullptr;                     // one row: each pixel's pair weights summed
+  int32_t smooth_[DepthConfig::kMaxLabels] = {};  // min(d, smooth_trunc) for a label distance d
+  uint16_t* prev_alpha_ = nullptr;                // D of the previous move's label, prev_label_
   int32_t prev_label_ = -1;
   uint16_t* below_ = nullptr;  // D_p(f_p - 1), 0xffff when not seen
   uint16_t* above_ = nullptr;  // D_p(f_p + 1)

@@ -73,6 +73,7 @@ void GridMaxflow::Augment(int32_t s_node, int dir) {
     }
     const int32_t parent = Neighbour(p, n.parent);
     const int32_t c = nodes_[parent].cap[n.parent ^ 1];
+
     if (c < bottleneck) bottleneck = c;
     p = parent;
   }
@@ -188,26 +189,78 @@ void GridMaxflow::Adopt(int32_t p) {
   n.tree = kFree;
 }
 
+// Augments every path source -> p -> q -> sink over one arc in one raster pass, before any tree
+// search: the asymmetric split of the pair terms leaves many such neighbouring pairs.
+void GridMaxflow::PushDirect() {
+  const int32_t w = width_;
+  auto push = [&](Node& from, Node& to, int dir) {
+    int32_t d = from.tcap < -to.tcap ? from.tcap : -to.tcap;
+    d = d < from.cap[dir] ? d : from.cap[dir];
+    from.tcap -= d;
+    to.tcap += d;
+    from.cap[dir] -= d;
+    to.cap[dir ^ 1] += d;
+    flow_ += d;
+  };
+  for (int32_t y = 0; y < height_; ++y) {
+    for (int32_t x = 0; x < w; ++x) {
+      const int32_t p = y * w + x;
+      Node& n = nodes_[p];
+      if (n.tcap == 0) continue;
+      if (x + 1 < w) {
+        Node& m = nodes_[p + 1];
+        if (n.tcap > 0 && m.tcap < 0)
+          push(n, m, kRight);
+        else if (n.tcap < 0 && m.tcap > 0)
+          push(m, n, kLeft);
+      }
+      if (y + 1 < height_) {
+        Node& m = nodes_[p + w];
+        if (n.tcap > 0 && m.tcap < 0)
+          push(n, m, kDown);
+        else if (n.tcap < 0 && m.tcap > 0)
+          push(m, n, kUp);
+      }
+    }
+  }
+}
+
 int64_t GridMaxflow::Solve() {
   queue_head_ = queue_tail_ = kNotActive;
   orphan_head_ = orphan_count_ = 0;
   time_ = 0;
-  for (int32_t p = 0; p < count_; ++p) {
-    Node& n = nodes_[p];
-    n.next = kNotActive;
-    n.ts = 0;
-    n.dist = 1;
-    if (n.tcap > 0) {
-      n.tree = kSourceTree;
+  PushDirect();
+  const int32_t w = width_;
+  for (int32_t y = 0; y < height_; ++y) {
+    for (int32_t x = 0; x < w; ++x) {
+      const int32_t p = y * w + x;
+      Node& n = nodes_[p];
+      n.next = kNotActive;
+      n.ts = 0;
+      n.dist = 1;
+      if (n.tcap == 0) {
+        n.tree = kFree;
+        n.parent = kOrphan;
+        continue;
+      }
       n.parent = kTerminal;
-      Activate(p);
-    } else if (n.tcap < 0) {
-      n.tree = kSinkTree;
-      n.parent = kTerminal;
-      Activate(p);
-    } else {
-      n.tree = kFree;
-      n.parent = kOrphan;
+      // Only a root with a residual arc into another tree (or to a free node) can grow; the
+      // rest become active later if a neighbour leaves their tree (Adopt activates them).
+      bool grows = false;
+      if (n.tcap > 0) {
+        n.tree = kSourceTree;
+        grows = (x + 1 < w && n.cap[kRight] > 0 && nodes_[p + 1].tcap <= 0) ||
+                (x > 0 && n.cap[kLeft] > 0 && nodes_[p - 1].tcap <= 0) ||
+                (y + 1 < height_ && n.cap[kDown] > 0 && nodes_[p + w].tcap <= 0) ||
+                (y > 0 && n.cap[kUp] > 0 && nodes_[p - w].tcap <= 0);
+      } else {
+        n.tree = kSinkTree;
+        grows = (x + 1 < w && nodes_[p + 1].cap[kLeft] > 0 && nodes_[p + 1].tcap >= 0) ||
+                (x > 0 && nodes_[p - 1].cap[kRight] > 0 && nodes_[p - 1].tcap >= 0) ||
+                (y + 1 < height_ && nodes_[p + w].cap[kUp] > 0 && nodes_[p + w].tcap >= 0) ||
+                (y > 0 && nodes_[p - w].cap[kDown] > 0 && nodes_[p - w].tcap >= 0);
+      }
+      if (grows) Activate(p);
     }
   }
 
@@ -216,6 +269,7 @@ int64_t GridMaxflow::Solve() {
     if (current == kNotActive || nodes_[current].tree == kFree) current = NextActive();
     if (current == kNotActive) break;
     const int32_t p = current;
+
     Node& n = nodes_[p];
     const bool source = n.tree == kSourceTree;
     int32_t touch_s = -1;

@@ -25,6 +25,25 @@ class GridMaxflow {
   // Starts a new graph of width x height nodes (width * height <= max_nodes), all capacities 0.
   void Reset(int32_t width, int32_t height);
 
+  // Starts a new graph of width x height nodes whose every node the caller then sets once with
+  // SetNode (no clearing pass).
+  void Begin(int32_t width, int32_t height) {
+    width_ = width;
+    height_ = height;
+    count_ = width * height;
+    flow_ = 0;
+  }
+  // Sets node p: its terminal balance (as AddTerminalBalance) and its arcs to the right and down
+  // neighbours; the sister arcs from those neighbours are 0.
+  void SetNode(int32_t p, int32_t balance, int32_t cap_right, int32_t cap_down) {
+    Node& n = nodes_[p];
+    n.cap[kRight] = cap_right;
+    n.cap[kLeft] = 0;
+    n.cap[kDown] = cap_down;
+    n.cap[kUp] = 0;
+    n.tcap = balance;
+  }
+
   // Adds terminal capacities source->p and p->sink (both >= 0).
   void AddTerminal(int32_t p, int32_t cap_source, int32_t cap_sink) {
     const int32_t m = cap_source < cap_sink ? cap_source : cap_sink;
@@ -80,6 +99,7 @@ class GridMaxflow {
   // Bit d set when node p has a neighbour in direction d.
   uint32_t NeighbourMask(int32_t p) const;
 
+  void PushDirect();
   void Activate(int32_t p);
   int32_t NextActive();
   void Augment(int32_t s_node, int dir);
