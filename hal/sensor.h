@@ -23,6 +23,9 @@ struct SensorMode {
   int32_t height = 0;
   PixelFormat format = PixelFormat::kRgb8;
   int32_t frames = 0;
+  // Focal length in full-resolution px, 0 when the sensor does not know it (the pipeline then
+  // assumes a typical compact camera's field of view). Motion estimation needs it.
+  double focal_px = 0;
 };
 
 class Sensor {

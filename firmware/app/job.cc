@@ -1,5 +1,6 @@
 #include "firmware/app/job.h"
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
@@ -82,6 +83,11 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
   FormatExifTime(when, sizeof(when));
   meta.datetime_original = when;
   meta.f_number = options_.render.f_number;
+  if (mode_.focal_px > 0) {
+    // The 35 mm equivalent is defined on the 43.27 mm diagonal (see sim/files/exif_focal.h).
+    const double diagonal = std::hypot(double{1} * mode_.width, double{1} * mode_.height);
+    meta.focal_35mm = static_cast<int32_t>(mode_.focal_px * 43.27 / diagonal + 0.5);
+  }
   if (options_.refocusable) {
     // The XMP precedes the image data, so it is built before the first strip is encoded.
     std::vector<uint8_t> original;

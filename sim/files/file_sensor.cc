@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cstring>
 
+#include "sim/files/exif_focal.h"
 #include "sim/files/image_file.h"
 
 namespace lb {
@@ -130,6 +131,7 @@ Status FileSensor::Configure(const SensorConfig& config, SensorMode* mode) {
   mode_.height = first.height;
   mode_.format = first.format;
   mode_.frames = static_cast<int32_t>(paths_.size());
+  mode_.focal_px = ExifFocalPx(paths_[0].c_str(), first.width, first.height);
   *mode = mode_;
   configured_ = true;
   return Status::Ok();

@@ -9,7 +9,7 @@ Status SyntheticSensor::Configure(const SensorConfig& config, SensorMode* mode) 
   const int32_t frames = config.frames == 0 ? kDefaultFrames : config.frames;
   Status status = scene_.Configure(params_, width, height, frames);
   if (!status.ok()) return status.Prefix("sensor %s: ", name());
-  mode_ = SensorMode{width, height, PixelFormat::kRgb8, frames};
+  mode_ = SensorMode{width, height, PixelFormat::kRgb8, frames, scene_.intrinsics().fx};
   strip_.assign(static_cast<size_t>(width) * 3 * kStripRows, 0);
   if (mode != nullptr) *mode = mode_;
   configured_ = true;

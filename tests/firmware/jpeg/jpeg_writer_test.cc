@@ -151,7 +151,9 @@ TEST(JpegWriterTest, ExifFieldsReadBackWithLibexif) {
   const Ycc420 img = test::MakeTexture(70, 38);
   test::ScratchDir dir;
   const std::string path = dir.Path("exif.jpg");
-  ASSERT_TRUE(EncodeToFile(img, path, CameraMetadata()).ok());
+  JpegMetadata meta = CameraMetadata();
+  meta.focal_35mm = 28;
+  ASSERT_TRUE(EncodeToFile(img, path, meta).ok());
   const std::vector<uint8_t> bytes = test::ReadFile(path);
   // EXIF straight after SOI, no JFIF.
   ASSERT_GT(bytes.size(), 12u);
@@ -168,7 +170,10 @@ TEST(JpegWriterTest, ExifFieldsReadBackWithLibexif) {
   ExifEntry* px = exif_content_get_entry(data->ifd[EXIF_IFD_EXIF], EXIF_TAG_PIXEL_X_DIMENSION);
   ExifEntry* py = exif_content_get_entry(data->ifd[EXIF_IFD_EXIF], EXIF_TAG_PIXEL_Y_DIMENSION);
   ExifEntry* fn = exif_content_get_entry(data->ifd[EXIF_IFD_EXIF], EXIF_TAG_FNUMBER);
-  ASSERT_TRUE(px && py && fn);
+  ExifEntry* f35 =
+      exif_content_get_entry(data->ifd[EXIF_IFD_EXIF], EXIF_TAG_FOCAL_LENGTH_IN_35MM_FILM);
+  ASSERT_TRUE(px && py && fn && f35);
+  EXPECT_EQ(exif_get_short(f35->data, order), 28u);
   EXPECT_EQ(exif_get_long(px->data, order), 70u);
   EXPECT_EQ(exif_get_long(py->data, order), 38u);
   const ExifRational f = exif_get_rational(fn->data, order);

@@ -1,5 +1,6 @@
 #include "sim/files/file_sensor.h"
 
+#include <libexif/exif-data.h>
 #include <png.h>
 
 #include <gtest/gtest.h>
@@ -50,8 +51,52 @@ class FileSensorTest : public ::testing::Test {
     return sensor->Configure(SensorConfig{}, mode);
   }
 
+  // A JPEG whose EXIF holds FocalLengthIn35mmFilm = f35 (0: a JPEG without EXIF), the block
+  // built with libexif and put right after the SOI marker as an APP1 segment.
+  void WriteJpeg(const std::string& name, int width, int height, uint16_t f35) {
+    std::vector<uint8_t> rgb(static_cast<size_t>(width * height * 3), 128);
+    Bytes jpeg;
+    ASSERT_TRUE(test::EncodeJpeg(width, height, 3, rgb.data(), 90, false, &jpeg));
+    if (f35 > 0) {
+      ExifData* data = exif_data_new();
+      exif_data_set_byte_order(data, EXIF_BYTE_ORDER_MOTOROLA);
+      ExifEntry* e = exif_entry_new();
+      exif_content_add_entry(data->ifd[EXIF_IFD_EXIF], e);
+      exif_entry_initialize(e, EXIF_TAG_FOCAL_LENGTH_IN_35MM_FILM);
+      exif_set_short(e->data, EXIF_BYTE_ORDER_MOTOROLA, f35);
+      exif_entry_unref(e);
+      unsigned char* block = nullptr;
+      unsigned int size = 0;
+      exif_data_save_data(data, &block, &size);
+      exif_data_unref(data);
+      ASSERT_NE(block, nullptr);
+      const unsigned length = size + 2;
+      Bytes app1 = {0xff, 0xe1, static_cast<uint8_t>(length >> 8), static_cast<uint8_t>(length)};
+      app1.insert(app1.end(), block, block + size);
+      free(block);
+      jpeg.insert(jpeg.begin() + 2, app1.begin(), app1.end());
+    }
+    ASSERT_TRUE(test::WriteFile(Path(name), jpeg));
+  }
+
   std::string dir_;
 };
+
+TEST_F(FileSensorTest, FocalLengthComesFromExifWhenTheFilesRecordIt) {
+  // 28 mm equivalent on a 640x480 frame: 28 / 43.27 of the 800 px diagonal.
+  WriteJpeg("a.jpg", 640, 480, 28);
+  WriteJpeg("b.jpg", 640, 480, 28);
+  SensorMode mode;
+  ASSERT_TRUE(ConfigureDir(&mode).ok());
+  EXPECT_NEAR(mode.focal_px, 28.0 * 800.0 / 43.27, 1e-6);
+
+  fs::remove_all(dir_);
+  fs::create_directories(dir_);
+  WriteJpeg("a.jpg", 640, 480, 0);
+  WritePng("b.png", 640, 480, 0);
+  ASSERT_TRUE(ConfigureDir(&mode).ok());
+  EXPECT_EQ(mode.focal_px, 0.0) << "no EXIF: unknown, not a guess";
+}
 
 TEST_F(FileSensorTest, StreamsEveryImageFileInNameOrderWithBurstTiming) {
   WritePnm("c.PPM", 6, 20, 3, 30);

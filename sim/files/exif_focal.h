@@ -1,0 +1,13 @@
+// The focal length a photo's EXIF records, for motion estimation on bursts read from files.
+#pragma once
+
+#include <cstdint>
+
+namespace lb {
+
+// Focal length in px of a width x height image from the file's EXIF FocalLengthIn35mmFilm (the
+// 35 mm equivalent, defined on the 43.27 mm diagonal of a 36 x 24 mm frame), or 0 when the file
+// has no EXIF or no such tag (PNG and PPM files, most edited JPEGs).
+double ExifFocalPx(const char* path, int32_t width, int32_t height);
+
+}  // namespace lb
