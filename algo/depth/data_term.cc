@@ -22,6 +22,10 @@ inline uint32_t BitCount(uint32_t v) {
   return v & 0x3fu;
 }
 
+inline void Prefetch(const uint8_t* p, size_t bytes) {
+  for (size_t i = 0; i < bytes; i += 64) __builtin_prefetch(p + i);
+}
+
 inline int32_t Clamp(int32_t v, int32_t lo, int32_t hi) { return v < lo ? lo : (v > hi ? hi : v); }
 
 // BT.601 luma, Q8 weights summing to 256, rounded; stored +/-128 (xor 0x80) so signed byte
@@ -125,27 +129,34 @@ inline uint32_t RecipQ15(int32_t keep) {
 
 // Per pixel: window sums (3 ring rows per other view, <= 2295), the mean of the smallest
 // (others + 1) / 2 of them. The kept sum is <= 8 * 2295, so 32-bit products are exact.
+// Chunks of 16 pixels so that the sorted-list insertion (a min/max chain) vectorises.
 void SelectRowC(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
                 uint16_t* out) {
+  constexpr int32_t kChunk = 16;
   const int32_t keep = (others + 1) / 2;
   const uint32_t recip_q15 = RecipQ15(keep);
-  for (int32_t x = x0; x < x1; ++x) {
-    uint32_t best[kMaxBest];  // sorted, ascending
-    int32_t count = 0;
+  for (int32_t xs = x0; xs < x1; xs += kChunk) {
+    const int32_t n = x1 - xs < kChunk ? x1 - xs : kChunk;
+    uint16_t best[kMaxBest][kChunk] = {};  // sorted, ascending
+    for (int32_t i = 0; i < keep; ++i)
+      for (int32_t l = 0; l < kChunk; ++l) best[i][l] = UINT16_MAX;
     for (int32_t j = 0; j < others; ++j) {
-      uint32_t a = uint32_t{rows[3 * j][x]} + rows[3 * j + 1][x] + rows[3 * j + 2][x];
-      for (int32_t i = 0; i < count; ++i) {
-        if (a < best[i]) {
-          const uint32_t t = best[i];
-          best[i] = a;
-          a = t;
+      uint16_t a[kChunk] = {};
+      const uint16_t *r0 = rows[3 * j] + xs, *r1 = rows[3 * j + 1] + xs, *r2 = rows[3 * j + 2] + xs;
+      for (int32_t l = 0; l < n; ++l) a[l] = static_cast<uint16_t>(r0[l] + r1[l] + r2[l]);
+      for (int32_t i = 0; i < keep; ++i) {
+        for (int32_t l = 0; l < kChunk; ++l) {
+          const uint16_t lo = best[i][l] < a[l] ? best[i][l] : a[l];
+          a[l] = best[i][l] < a[l] ? a[l] : best[i][l];
+          best[i][l] = lo;
         }
       }
-      if (count < keep) best[count++] = a;
     }
-    uint32_t sum = 0;
-    for (int32_t i = 0; i < keep; ++i) sum += best[i];
-    out[x] = static_cast<uint16_t>((sum * recip_q15 + (1u << 14)) >> 15);
+    for (int32_t l = 0; l < n; ++l) {
+      uint32_t sum = 0;
+      for (int32_t i = 0; i < keep; ++i) sum += best[i][l];
+      out[xs + l] = static_cast<uint16_t>((sum * recip_q15 + (1u << 14)) >> 15);
+    }
   }
 }
 
@@ -481,9 +492,15 @@ void DataTerm::ComputeRows(int32_t disp_q8, int32_t y0, int32_t y1, uint16_t* ou
     WindowRow(view(j), y0, disp_q8, ring(j, y0));
   }
   const uint16_t* rows[3 * 15];
+  const size_t row_bytes = static_cast<size_t>(3) * w;
   for (int32_t y = y0; y < y1; ++y) {
     for (int32_t j = 0; j < others; ++j) {
       WindowRow(view(j), y + 1, disp_q8, ring(j, y + 1));
+      // The views' next rows are far apart (a whole view each), so the hardware prefetcher
+      // misses their starts; asking early hides the cache misses behind the other views.
+      const int32_t next = Clamp(y + 2, 0, height_ - 1);
+      Prefetch(images_[view(j)].Row(next), row_bytes);
+      Prefetch(census_[view(j)] + static_cast<ptrdiff_t>(next) * 3 * w, row_bytes);
       for (int32_t k = 0; k < 3; ++k) rows[3 * j + k] = ring(j, y - 1 + k);
     }
     kernels_->select(rows, others, 0, w, out + (y - y0) * stride);
