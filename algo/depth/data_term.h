@@ -10,6 +10,9 @@
 //
 // Range: pixel cost 0..255, window sum 0..2295, D (a mean of window sums) 0..2295, uint16.
 // No costs are stored: each call computes the rows it is asked for, through a 3-row ring.
+//
+// Every kernel has a plain C reference; a SIMD variant (AVX2 on x86-64, chosen at run time in
+// Carve) gives the same bits.
 #pragma once
 
 #include <cstddef>
@@ -30,8 +33,11 @@ class DataTerm {
   static constexpr int32_t kMaxCost = 2295;  // 9 * 255
   static constexpr int32_t kCensusBits = 24;
 
-  // Carves the census images and row rings for `views` views of width x height.
+  // Carves the census images and row rings for `views` views of width x height, and picks the
+  // SIMD kernels when the CPU has them.
   void Carve(Arena& arena, int32_t width, int32_t height, int32_t views);
+  // The SIMD kernels (when `on` and the CPU has them) or the C reference; returns which is used.
+  bool UseSimd(bool on);
   void SetParams(const DataTermParams& params, int32_t reference);
 
   // Computes the census of every view. `views` stay borrowed until the next Prepare.
@@ -42,21 +48,25 @@ class DataTerm {
 
   // The pixel cost cap (what an out-of-image sample costs).
   int32_t invalid_cost() const { return invalid_cost_; }
-  const uint32_t* census(int32_t view) const { return census_[view]; }
+  // Census of a view: per row, three planes of `width` bytes (neighbours 0-7, 8-15, 16-23 in
+  // raster order, the first one in the top bit).
+  const uint8_t* census(int32_t view) const { return census_[view]; }
+
+  struct Kernels;
 
  private:
-  void PixelCostRow(int32_t view, int32_t y, int32_t disp_q8, uint16_t* out) const;
+  void PixelCostRow(int32_t view, int32_t y, int32_t disp_q8, uint8_t* out) const;
   void WindowRow(int32_t view, int32_t y, int32_t disp_q8, uint16_t* hsum);
 
   int32_t width_ = 0, height_ = 0, views_ = 0, reference_ = 0;
   DataTermParams params_;
   int32_t invalid_cost_ = 255;
   const ConstImageU8* images_ = nullptr;
-  uint32_t* census_[16] = {};
-  uint8_t* luma_ = nullptr;    // one view's luma, for the census
-  uint16_t* pixel_ = nullptr;  // one row of pixel costs
-  uint16_t* hsum_ = nullptr;   // per view, 3 rows of horizontal 3-sums
-  uint16_t* best_ = nullptr;   // up to 8 rows: the sorted smallest window sums so far
+  const Kernels* kernels_ = nullptr;
+  uint8_t* census_[16] = {};
+  uint8_t* luma_ = nullptr;   // 5 rows of one view's luma (+/-128), 2 replicated pixels a side
+  uint8_t* pixel_ = nullptr;  // one row of pixel costs, 1 replicated pixel a side
+  uint16_t* hsum_ = nullptr;  // per other view, 3 rows of horizontal 3-sums
 };
 
 }  // namespace lb

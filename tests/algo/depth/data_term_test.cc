@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <random>
 #include <vector>
 
 #include "algo/depth/data_term.h"
@@ -100,17 +101,20 @@ struct Fixed {
   DataTerm term;
 };
 
-void PrepareTerm(Fixed& f, const synth::Burst& b, const DataTermParams& params) {
+void CarveTerm(Fixed& f, int32_t width, int32_t height, int32_t views) {
   Arena plan;
   DataTerm planner;
-  const int32_t n = static_cast<int32_t>(b.views.size());
-  planner.Carve(plan, b.width, b.height, n);
+  planner.Carve(plan, width, height, views);
   f.memory.assign(plan.used() + Arena::kAlign, 0);
   const uintptr_t base = (reinterpret_cast<uintptr_t>(f.memory.data()) + Arena::kAlign - 1) &
                          ~uintptr_t{Arena::kAlign - 1};
   Arena arena(reinterpret_cast<void*>(base), plan.used());
-  f.term.Carve(arena, b.width, b.height, n);
+  f.term.Carve(arena, width, height, views);
   ASSERT_FALSE(arena.overflowed());
+}
+
+void PrepareTerm(Fixed& f, const synth::Burst& b, const DataTermParams& params) {
+  CarveTerm(f, b.width, b.height, static_cast<int32_t>(b.views.size()));
   f.term.SetParams(params, b.reference);
   f.term.Prepare(b.views.data());
 }
@@ -172,6 +176,65 @@ TEST(DataTermTest, TrueDisparityCostsLeastOnTexturedPlanes) {
   EXPECT_LT(at_front[16 * 64 + 32], at_back[16 * 64 + 32]);
   EXPECT_LT(at_back[4 * 64 + 30], at_front[4 * 64 + 30]);
   EXPECT_EQ(at_front[16 * 64 + 32], 0) << "an exact match costs nothing";
+}
+
+// The SIMD kernels against the C reference, bit for bit: widths around the vector steps (and
+// below them), every Q8 fraction (view steps of +/-1 at disparities 0..255, larger steps and
+// whole-pixel shifts beyond), truncations either side of 255, every census weight, random,
+// smooth and black/white images (saturating sums).
+TEST(DataTermTest, SimdKernelsEqualTheCReference) {
+  {
+    Fixed probe;
+    CarveTerm(probe, 8, 8, 2);
+    if (!probe.term.UseSimd(true)) GTEST_SKIP() << "no SIMD kernels on this CPU";
+  }
+  std::mt19937 rng(2024);
+  const int32_t widths[] = {8, 9, 15, 16, 17, 31, 32, 33, 47, 48, 63, 64, 65, 97, 130};
+  const int32_t truncs[] = {1, 2, 45, 127, 128, 200, 254, 255, 256, 400, 765};
+  int32_t round = 0;
+  for (int32_t w : widths) {
+    for (int32_t pass = 0; pass < 3; ++pass, ++round) {
+      const int32_t h = 8 + static_cast<int32_t>(rng() % 5);
+      const int32_t views = 2 + static_cast<int32_t>(rng() % 15);
+      const int32_t ref = static_cast<int32_t>(rng() % static_cast<uint32_t>(views));
+      std::vector<std::vector<uint8_t>> pixels(views, std::vector<uint8_t>(3 * w * h));
+      for (auto& p : pixels) {
+        const uint32_t kind = rng() % 3;
+        for (size_t i = 0; i < p.size(); ++i) {
+          const uint32_t r = rng();
+          p[i] = static_cast<uint8_t>(kind == 0   ? r
+                                      : kind == 1 ? (i / 3) * 5 + (r & 15)
+                                                  : (r & 1) * 255);
+        }
+      }
+      std::vector<ConstImageU8> imgs;
+      for (const auto& p : pixels) imgs.push_back(MakeView(p.data(), w, h, 3));
+      Fixed simd, plain;
+      CarveTerm(simd, w, h, views);
+      CarveTerm(plain, w, h, views);
+      ASSERT_TRUE(simd.term.UseSimd(true));
+      ASSERT_FALSE(plain.term.UseSimd(false));
+      const DataTermParams params{truncs[round % 11], round % 11};
+      simd.term.SetParams(params, ref);
+      plain.term.SetParams(params, ref);
+      simd.term.Prepare(imgs.data());
+      plain.term.Prepare(imgs.data());
+      for (int32_t v = 0; v < views; ++v) {
+        ASSERT_TRUE(
+            std::equal(plain.term.census(v), plain.term.census(v) + 3 * w * h, simd.term.census(v)))
+            << "census, width " << w << ", view " << v;
+      }
+      std::vector<uint16_t> a(static_cast<size_t>(w) * h), b(a.size());
+      for (int32_t d = 0; d < 256 + 24; ++d) {
+        const int32_t disp_q8 = d < 256 ? d : (d - 256) * 97 + 256;
+        simd.term.ComputeRows(disp_q8, 0, h, a.data(), w);
+        plain.term.ComputeRows(disp_q8, 0, h, b.data(), w);
+        ASSERT_EQ(a, b) << "width " << w << ", " << views << " views, reference " << ref
+                        << ", disparity " << disp_q8 << "/256, trunc " << params.color_trunc
+                        << ", census weight " << params.census_weight;
+      }
+    }
+  }
 }
 
 }  // namespace
