@@ -2,6 +2,8 @@
 
 #include <cstring>
 
+#include "algo/depth/warp_cost.h"
+
 namespace lb {
 namespace {
 
@@ -126,6 +128,11 @@ CostKernel(const uint8_t* ref, const uint8_t* img, const uint32_t* cref, const u
 }
 
 void DataTerm::PixelCostRow(int32_t view, int32_t y, int32_t disp_q8, uint16_t* out) const {
+  if (planes_ != nullptr) {
+    const WarpSource src{images_[reference_], images_[view], census_[reference_], census_[view]};
+    PlaneCostRow(planes_[view], src, y, params_, invalid_cost_, out);
+    return;
+  }
   const int32_t w = width_;
   // Sample position in the view: x * 256 + shift_q8, the same fraction for every pixel.
   const int32_t shift_q8 = -(view - reference_) * disp_q8;

@@ -17,6 +17,7 @@
 
 #include "algo/core/arena.h"
 #include "algo/core/image.h"
+#include "algo/motion/plane_homography.h"
 
 namespace lb {
 
@@ -40,6 +41,10 @@ class DataTerm {
   // D for rows y0..y1-1 at disparity dispQ8 (px per view step) into out (row stride in elements).
   void ComputeRows(int32_t disp_q8, int32_t y0, int32_t y1, uint16_t* out, ptrdiff_t stride);
 
+  // Plane sweep (warp_cost.h): the homography of each view for the label of the next ComputeRows
+  // calls (borrowed; disp_q8 is then ignored), or nullptr for the rectified shifts.
+  void SetPlanes(const PlaneHomography* per_view) { planes_ = per_view; }
+
   // The pixel cost cap (what an out-of-image sample costs).
   int32_t invalid_cost() const { return invalid_cost_; }
   const uint32_t* census(int32_t view) const { return census_[view]; }
@@ -52,6 +57,7 @@ class DataTerm {
   DataTermParams params_;
   int32_t invalid_cost_ = 255;
   const ConstImageU8* images_ = nullptr;
+  const PlaneHomography* planes_ = nullptr;
   uint32_t* census_[16] = {};
   uint8_t* luma_ = nullptr;    // one view's luma, for the census
   uint16_t* pixel_ = nullptr;  // one row of pixel costs
