@@ -121,8 +121,31 @@ struct SampleCost {
   float nominal, lo, hi;
 };
 
-SampleCost Sample(const ConstImageU8& view, const uint32_t* census, const uint8_t* ref_rgb,
+// Per view, computed once: the census and each pixel's largest channel step to its right and
+// lower neighbours.
+struct ViewData {
+  std::vector<uint32_t> census;
+  std::vector<int32_t> step;
+};
+
+ViewData Prepare(const ConstImageU8& v) {
+  const int32_t w = v.width, h = v.height;
+  ViewData d{Census(v), std::vector<int32_t>(static_cast<size_t>(w) * h, 0)};
+  for (int32_t y = 0; y < h; ++y) {
+    for (int32_t x = 0; x < w; ++x) {
+      for (int32_t c = 0; c < 3; ++c) {
+        int32_t& g = d.step[y * w + x];
+        if (x + 1 < w) g = std::max(g, std::abs(v.At(x, y)[c] - v.At(x + 1, y)[c]));
+        if (y + 1 < h) g = std::max(g, std::abs(v.At(x, y)[c] - v.At(x, y + 1)[c]));
+      }
+    }
+  }
+  return d;
+}
+
+SampleCost Sample(const ConstImageU8& view, const ViewData& data, const uint8_t* ref_rgb,
                   uint32_t cref, double vx, double vy, const DataTermParams& prm, double delta) {
+  const uint32_t* census = data.census.data();
   const int32_t w = view.width, h = view.height;
   const float invalid =
       std::min(255.0f, static_cast<float>(prm.color_trunc + 24 * prm.census_weight));
@@ -140,10 +163,7 @@ SampleCost Sample(const ConstImageU8& view, const uint32_t* census, const uint8_
   int32_t g = 0;
   for (int32_t y = std::max(0, iy - 1); y <= std::min(h - 1, iy + 2); ++y) {
     for (int32_t x = std::max(0, ix - 1); x <= std::min(w - 1, ix + 2); ++x) {
-      for (int32_t c = 0; c < 3; ++c) {
-        if (x + 1 < w) g = std::max(g, std::abs(view.At(x, y)[c] - view.At(x + 1, y)[c]));
-        if (y + 1 < h) g = std::max(g, std::abs(view.At(x, y)[c] - view.At(x, y + 1)[c]));
-      }
+      g = std::max(g, data.step[y * w + x]);
     }
   }
   float ad = 0;
@@ -184,11 +204,9 @@ SampleCost Sample(const ConstImageU8& view, const uint32_t* census, const uint8_
   return out;
 }
 
-Reference ReferenceTerm(const motiontest::Burst& b, const DataTermParams& prm, double rho,
-                        double delta) {
+Reference ReferenceTerm(const motiontest::Burst& b, const std::vector<ViewData>& data,
+                        const DataTermParams& prm, double rho, double delta) {
   const int32_t w = b.scene.width(), h = b.scene.height(), ref = b.scene.reference();
-  std::vector<std::vector<uint32_t>> census;
-  for (const ConstImageU8& v : b.views) census.push_back(Census(v));
   std::vector<std::vector<SampleCost>> cost;  // per other view
   for (int32_t v = 0; v < b.scene.views(); ++v) {
     if (v == ref) continue;
@@ -201,8 +219,8 @@ Reference ReferenceTerm(const motiontest::Burst& b, const DataTermParams& prm, d
       for (int32_t x = 0; x < w; ++x) {
         double vx = 0, vy = 0;
         ProjectPlane(b.intrinsics, m, rho, x + 0.5, y + 0.5, &vx, &vy);
-        c[y * w + x] = Sample(b.views[v], census[v].data(), b.views[ref].At(x, y),
-                              census[ref][y * w + x], vx - 0.5, vy - 0.5, prm, delta);
+        c[y * w + x] = Sample(b.views[v], data[v], b.views[ref].At(x, y),
+                              data[ref].census[y * w + x], vx - 0.5, vy - 0.5, prm, delta);
       }
     }
     cost.push_back(std::move(c));
@@ -214,8 +232,9 @@ Reference ReferenceTerm(const motiontest::Burst& b, const DataTermParams& prm, d
   out.hi.resize(out.d.size());
   for (int32_t y = 0; y < h; ++y) {
     for (int32_t x = 0; x < w; ++x) {
-      std::vector<float> sums[3];
-      for (const auto& c : cost) {
+      float sums[3][16];
+      for (size_t v = 0; v < cost.size(); ++v) {
+        const std::vector<SampleCost>& c = cost[v];
         float s[3] = {0, 0, 0};
         for (int32_t dy = -1; dy <= 1; ++dy) {
           for (int32_t dx = -1; dx <= 1; ++dx) {
@@ -226,11 +245,11 @@ Reference ReferenceTerm(const motiontest::Burst& b, const DataTermParams& prm, d
             s[2] += q.hi;
           }
         }
-        for (int i = 0; i < 3; ++i) sums[i].push_back(s[i]);
+        for (int i = 0; i < 3; ++i) sums[i][v] = s[i];
       }
       float mean[3] = {0, 0, 0};
       for (int i = 0; i < 3; ++i) {
-        std::sort(sums[i].begin(), sums[i].end());
+        std::sort(sums[i], sums[i] + cost.size());
         for (size_t k = 0; k < keep; ++k) mean[i] += sums[i][k] / static_cast<float>(keep);
       }
       out.d[y * w + x] = mean[0];
@@ -276,6 +295,8 @@ TEST(WarpCostTest, FixedPointAgreesWithFloatReference) {
   const double chord =
       kAnchorStep * kAnchorStep / 8.0 * 2 * std::sin(M_PI / 180) / b.intrinsics.fx / 0.97;
   const double delta = 1.0 / 512 + 1.0 / 65536 + chord;
+  std::vector<ViewData> data;
+  for (const ConstImageU8& v : b.views) data.push_back(Prepare(v));
   for (const DataTermParams params : {DataTermParams{}, DataTermParams{200, 10}}) {
     Fixed f;
     PrepareTerm(f, b, params);
@@ -292,7 +313,7 @@ TEST(WarpCostTest, FixedPointAgreesWithFloatReference) {
       f.term.SetPlanes(planes.data());
       std::vector<uint16_t> fixed(static_cast<size_t>(w) * h);
       f.term.ComputeRows(0, 0, h, fixed.data(), w);
-      const Reference expect = ReferenceTerm(b, params, rho, delta);
+      const Reference expect = ReferenceTerm(b, data, params, rho, delta);
       double sum = 0, worst = 0, width = 0;
       int32_t outside = 0;
       for (size_t i = 0; i < fixed.size(); ++i) {
