@@ -7,6 +7,8 @@
 #include <arm_neon.h>
 #endif
 
+#include "algo/depth/warp_cost.h"
+
 namespace lb {
 namespace {
 
@@ -616,6 +618,11 @@ void DataTerm::Prepare(const ConstImageU8* views) {
 
 void DataTerm::PixelCostRow(int32_t view, int32_t y, int32_t disp_q8, uint8_t* out) const {
   const int32_t w = width_;
+  if (planes_ != nullptr) {
+    const WarpSource src{images_[reference_], images_[view], census_[reference_], census_[view]};
+    PlaneCostRow(planes_[view], src, y, params_, invalid_cost_, out);
+    return;
+  }
   // Sample position in the view: x * 256 + shift_q8, the same fraction for every pixel.
   const int32_t shift_q8 = -(view - reference_) * disp_q8;
   const int32_t off = shift_q8 >> 8;  // floor

@@ -20,6 +20,7 @@
 
 #include "algo/core/arena.h"
 #include "algo/core/image.h"
+#include "algo/motion/plane_homography.h"
 
 namespace lb {
 
@@ -46,6 +47,10 @@ class DataTerm {
   // D for rows y0..y1-1 at disparity dispQ8 (px per view step) into out (row stride in elements).
   void ComputeRows(int32_t disp_q8, int32_t y0, int32_t y1, uint16_t* out, ptrdiff_t stride);
 
+  // Plane sweep (warp_cost.h): the homography of each view for the label of the next ComputeRows
+  // calls (borrowed; disp_q8 is then ignored), or nullptr for the rectified shifts.
+  void SetPlanes(const PlaneHomography* per_view) { planes_ = per_view; }
+
   // The pixel cost cap (what an out-of-image sample costs).
   int32_t invalid_cost() const { return invalid_cost_; }
   // Census of a view: per row, three planes of `width` bytes (neighbours 0-7, 8-15, 16-23 in
@@ -63,6 +68,7 @@ class DataTerm {
   int32_t invalid_cost_ = 255;
   const ConstImageU8* images_ = nullptr;
   const Kernels* kernels_ = nullptr;
+  const PlaneHomography* planes_ = nullptr;
   uint8_t* census_[16] = {};
   uint8_t* luma_ = nullptr;   // 5 rows of one view's luma (+/-128), 2 replicated pixels a side
   uint8_t* pixel_ = nullptr;  // one row of pixel costs, 1 replicated pixel a side

@@ -6,8 +6,7 @@
 
 namespace lb {
 
-int32_t DepthStage::LabelDispQ8(int32_t label) const {
-  const DepthConfig& c = config_;
+int32_t DepthStage::LabelDispQ8(const DepthConfig& c, int32_t label) {
   return c.disp_min_q8 +
          static_cast<int32_t>((int64_t{c.disp_max_q8 - c.disp_min_q8} * label) / (c.labels - 1));
 }
@@ -46,6 +45,10 @@ Status DepthStage::Validate(const DepthConfig& c) {
                   c.color_trunc, c.census_weight, c.smooth_weight, c.smooth_trunc, c.edge_threshold,
                   c.edge_weight_q8, c.max_cycles);
   }
+  if (c.geometry != DepthGeometry::kRectified && c.geometry != DepthGeometry::kPlanes) {
+    return Status(Code::kInvalidArgument, "depth: unknown geometry %d",
+                  static_cast<int>(c.geometry));
+  }
   return Status::Ok();
 }
 
@@ -73,6 +76,10 @@ Status DepthStage::Carve(Arena& arena) {
   prev_alpha_ = arena.Allocate<uint16_t>(n);
   below_ = arena.Allocate<uint16_t>(n);
   above_ = arena.Allocate<uint16_t>(n);
+  planes_ = nullptr;
+  if (config_.geometry == DepthGeometry::kPlanes) {
+    planes_ = arena.Allocate<PlaneHomography>(static_cast<size_t>(config_.labels) * config_.views);
+  }
   stats_.arena_bytes = arena.used() - start;
   if (arena.overflowed()) return Status(Code::kOutOfMemory, "depth: arena too small");
   return Status::Ok();
@@ -87,10 +94,31 @@ Status DepthStage::Configure(const DepthConfig& config, Arena& arena) {
   params.color_trunc = config.color_trunc;
   params.census_weight = config.census_weight;
   data_.SetParams(params, config.reference);
+  data_.SetPlanes(nullptr);
+  planes_set_ = false;
   for (int32_t d = 0; d < DepthConfig::kMaxLabels; ++d) {
     smooth_[d] = d < config.smooth_trunc ? d : config.smooth_trunc;
   }
   return Carve(arena);
+}
+
+Status DepthStage::SetPlanes(const PlaneHomography* homographies) {
+  const DepthConfig& c = config_;
+  if (c.geometry != DepthGeometry::kPlanes || planes_ == nullptr || homographies == nullptr) {
+    return Status(Code::kInvalidArgument, "depth: planes need a kPlanes configuration");
+  }
+  // Label-major, so one label's views are contiguous for the data term.
+  for (int32_t v = 0; v < c.views; ++v) {
+    for (int32_t l = 0; l < c.labels; ++l)
+      planes_[l * c.views + v] = homographies[v * c.labels + l];
+  }
+  planes_set_ = true;
+  return Status::Ok();
+}
+
+void DepthStage::LabelCosts(int32_t label, uint16_t* out) {
+  if (config_.geometry == DepthGeometry::kPlanes) data_.SetPlanes(planes_ + label * config_.views);
+  data_.ComputeRows(LabelDispQ8(label), 0, config_.height, out, config_.width);
 }
 
 void DepthStage::EdgeWeights(const ConstImageU8& ref) {
@@ -148,7 +176,7 @@ void DepthStage::WinnerTakeAll() {
     labels_[p] = 0;
   }
   for (int32_t label = 0; label < config_.labels; ++label) {
-    data_.ComputeRows(LabelDispQ8(label), 0, h, cost_alpha_, w);
+    LabelCosts(label, cost_alpha_);
     for (int32_t p = 0; p < n; ++p) {
       if (cost_alpha_[p] < cost_[p]) {
         cost_[p] = cost_alpha_[p];
@@ -163,7 +191,7 @@ int64_t DepthStage::Energy(const uint8_t* labels) {
   prev_label_ = -1;  // cost_alpha_ is used as scratch below
   int64_t data = 0;
   for (int32_t label = 0; label < config_.labels; ++label) {
-    data_.ComputeRows(LabelDispQ8(label), 0, h, cost_alpha_, w);
+    LabelCosts(label, cost_alpha_);
     for (int32_t p = 0; p < w * h; ++p) {
       if (labels[p] == label) data += cost_alpha_[p];
     }
@@ -212,6 +240,10 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
       return Status(Code::kInvalidArgument, "depth: view %d is %dx%dx%d, expected %dx%d RGB", v,
                     views[v].width, views[v].height, views[v].channels, c.width, c.height);
     }
+  }
+  if (c.geometry == DepthGeometry::kPlanes) {
+    if (!planes_set_) return Status(Code::kInvalidArgument, "depth: no planes set for this burst");
+    planes_set_ = false;
   }
   const int32_t w = c.width, h = c.height;
   data_.Prepare(views);

@@ -2,6 +2,11 @@
 // view. Disparity is in working-resolution pixels per view step, unsigned Q8.8 (`dispQ8`): a
 // point at disparity d appears at x - k*d in the view k steps to the right of the reference and
 // at x + k*d in the view k steps to its left (the views are rectified and equally spaced).
+//
+// Plane sweep (DepthGeometry::kPlanes, for handheld bursts): label l is instead a fronto-parallel
+// plane of the reference camera, given per view as its plane-induced homography (SetPlanes,
+// planes.h), and view v is sampled at H_vl(x, y) (warp_cost.h). The output stays LabelDispQ8(l):
+// the caller picks disp_min_q8..disp_max_q8 proportional to the planes' inverse depths.
 #pragma once
 
 #include <cstddef>
@@ -12,8 +17,11 @@
 #include "algo/core/status.h"
 #include "algo/depth/data_term.h"
 #include "algo/depth/grid_maxflow.h"
+#include "algo/motion/plane_homography.h"
 
 namespace lb {
+
+enum class DepthGeometry : uint8_t { kRectified, kPlanes };
 
 struct DepthConfig {
   static constexpr int32_t kMaxViews = 16;
@@ -26,6 +34,7 @@ struct DepthConfig {
   int32_t labels = 0;       // number of disparity planes
   int32_t disp_min_q8 = 0;  // disparity of label 0 and of the last label, px per view step, Q8.8
   int32_t disp_max_q8 = 0;
+  DepthGeometry geometry = DepthGeometry::kRectified;
 
   // Data term (see data_term.h).
   int32_t color_trunc = 45;   // truncation of |dR|+|dG|+|dB|, 1..765
@@ -64,6 +73,11 @@ class DepthStage {
 
   Status Configure(const DepthConfig& config, Arena& arena);
 
+  // kPlanes only, after Configure and before each Compute (a Compute consumes them, so a new
+  // burst cannot run on the last one's poses): homographies[v * labels + l] is label l's plane
+  // seen from view v (the reference's entries are ignored), copied into the arena.
+  Status SetPlanes(const PlaneHomography* homographies);
+
   // `views[i]` are RGB8 working-resolution images, left to right. Writes dispQ8 for every pixel
   // of the reference view into `disp_q8` (width x height, one channel).
   Status Compute(const ConstImageU8* views, ImageU16 disp_q8);
@@ -78,11 +92,14 @@ class DepthStage {
   int64_t energy() const { return energy_; }
   bool ExpandMove(int32_t alpha) { return Expand(alpha); }
   int64_t Energy(const uint8_t* labels);
-  int32_t LabelDispQ8(int32_t label) const;
+  int32_t LabelDispQ8(int32_t label) const { return LabelDispQ8(config_, label); }
+  // The disparity of a label, Q8.8, for any valid configuration.
+  static int32_t LabelDispQ8(const DepthConfig& config, int32_t label);
 
  private:
   Status Carve(Arena& arena);
   void EdgeWeights(const ConstImageU8& ref);
+  void LabelCosts(int32_t label, uint16_t* out);  // D of one label for the whole image
   void WinnerTakeAll();
   // One alpha-expansion move (expansion_move.cc); returns true when it lowered the energy.
   bool Expand(int32_t alpha);
@@ -109,6 +126,8 @@ class DepthStage {
   uint16_t* below_ = nullptr;  // D_p(f_p - 1), 0xffff when not seen
   uint16_t* above_ = nullptr;  // D_p(f_p + 1)
   int64_t energy_ = 0;
+  PlaneHomography* planes_ = nullptr;  // kPlanes: [label * views + view]
+  bool planes_set_ = false;
 };
 
 }  // namespace lb

@@ -125,7 +125,7 @@ int32_t DepthStage::BuildMove(int32_t alpha, int32_t y_lo, int32_t y_hi) {
 
 bool DepthStage::Expand(int32_t alpha) {
   const int32_t w = config_.width, h = config_.height;
-  data_.ComputeRows(LabelDispQ8(alpha), 0, h, cost_alpha_, w);
+  LabelCosts(alpha, cost_alpha_);
   int32_t y_lo = 0, y_hi = 0;
   Classify(alpha, &y_lo, &y_hi);
   if (y_hi < 0) {

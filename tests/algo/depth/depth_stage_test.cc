@@ -147,8 +147,11 @@ TEST(DepthStageTest, ArenaFor640x480With7ViewsAnd64LabelsIsAtMost24MiB) {
   c.reference = 3;
   c.labels = 64;
   c.disp_max_q8 = 16 << 8;
-  ASSERT_TRUE(DepthStage::Validate(c).ok());
-  EXPECT_LE(DepthStage::RequiredBytes(c), size_t{24} << 20);
+  for (const DepthGeometry g : {DepthGeometry::kRectified, DepthGeometry::kPlanes}) {
+    c.geometry = g;
+    ASSERT_TRUE(DepthStage::Validate(c).ok());
+    EXPECT_LE(DepthStage::RequiredBytes(c), size_t{24} << 20) << static_cast<int>(g);
+  }
 }
 
 TEST(DepthStageTest, RefusesBadConfigurationsAndInputs) {

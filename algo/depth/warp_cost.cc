@@ -1,0 +1,104 @@
+#include "algo/depth/warp_cost.h"
+
+namespace lb {
+namespace {
+
+// The same halving-sum bit count as data_term.cc (baseline x86-64 has no popcount).
+inline int32_t BitCount(uint32_t v) {
+  v = v - ((v >> 1) & 0x55555555u);
+  v = (v & 0x33333333u) + ((v >> 2) & 0x33333333u);
+  v = (v + (v >> 4)) & 0x0f0f0f0fu;
+  v = v + (v >> 8);
+  v = v + (v >> 16);
+  return static_cast<int32_t>(v & 0x3fu);
+}
+
+struct CostParams {
+  int32_t width, height, trunc, cw;
+  uint8_t invalid;
+};
+
+// The 24-bit census of pixel x of a census row (three planes of `width` bytes).
+inline uint32_t Census(const uint8_t* row, int32_t width, int32_t x) {
+  return (uint32_t{row[x]} << 16) | (uint32_t{row[width + x]} << 8) | row[2 * width + x];
+}
+
+// One pixel: ref_rgb / cref are the reference pixel and its census, (x_q16, y_q16) the view
+// position. The position is rounded half up to Q8; the 4 bilinear weights (256 - f) * (256 - g)
+// etc. are Q16 and sum to 65536, so a colour sum is <= 255 * 65536 (int32), rounded half up to
+// Q0. The census tap is the nearest (fractions of 128/256 round up). Cost 0..255 as in
+// data_term.cc: min(|dRGB|, trunc) + 24 bits * weight <= 765 + 240, capped.
+inline uint8_t SampleCost(const WarpSource& s, const CostParams& p, const uint8_t* ref_rgb,
+                          uint32_t cref, int32_t x_q16, int32_t y_q16) {
+  const int32_t xs = (x_q16 + 128) >> 8, ys = (y_q16 + 128) >> 8;  // |q16| < 2^30: no overflow
+  const int32_t x0 = xs >> 8, y0 = ys >> 8, fx = xs & 255, fy = ys & 255;
+  // A tap of weight zero may sit outside the view, as in the rectified kernel.
+  const int32_t x1 = x0 + (fx != 0 ? 1 : 0), y1 = y0 + (fy != 0 ? 1 : 0);
+  if (x0 < 0 || y0 < 0 || x1 >= p.width || y1 >= p.height) return p.invalid;
+  const int32_t w00 = (256 - fx) * (256 - fy), w01 = fx * (256 - fy);
+  const int32_t w10 = (256 - fx) * fy, w11 = fx * fy;
+  const uint8_t* a = s.view.At(x0, y0);
+  const uint8_t* b = s.view.At(x1, y0);
+  const uint8_t* c = s.view.At(x0, y1);
+  const uint8_t* d = s.view.At(x1, y1);
+  int32_t ad = 0;
+  for (int32_t ch = 0; ch < 3; ++ch) {
+    const int32_t v = (a[ch] * w00 + b[ch] * w01 + c[ch] * w10 + d[ch] * w11 + 32768) >> 16;
+    const int32_t diff = ref_rgb[ch] - v;
+    ad += diff < 0 ? -diff : diff;
+  }
+  ad = ad < p.trunc ? ad : p.trunc;
+  const int32_t nx = fx >= 128 ? x1 : x0, ny = fy >= 128 ? y1 : y0;
+  const uint8_t* crow = s.census_view + static_cast<ptrdiff_t>(ny) * 3 * p.width;
+  const int32_t ham = BitCount(cref ^ Census(crow, p.width, nx));
+  const int32_t cost = ad + ham * p.cw;
+  return static_cast<uint8_t>(cost > 255 ? 255 : cost);
+}
+
+}  // namespace
+
+bool WarpSpan(const PlaneHomography& h, int32_t x0, int32_t x1, int32_t y, int32_t* x_q16,
+              int32_t* y_q16) {
+  int32_t ax = 0, ay = 0, bx = 0, by = 0;
+  if (!h.Map(x0, y, &ax, &ay) || !h.Map(x1, y, &bx, &by)) return false;
+  const int32_t n = x1 - x0;
+  x_q16[0] = ax;
+  y_q16[0] = ay;
+  if (n == 0) return true;
+  // Q32 accumulators, started half a Q16 step up so the shift rounds; the truncated steps lose
+  // under n * 2^-32 px over the span.
+  const int64_t sx = (int64_t{bx} - ax) * 65536 / n, sy = (int64_t{by} - ay) * 65536 / n;
+  int64_t px = int64_t{ax} * 65536 + 32768, py = int64_t{ay} * 65536 + 32768;
+  for (int32_t i = 1; i < n; ++i) {
+    px += sx;
+    py += sy;
+    x_q16[i] = static_cast<int32_t>(px >> 16);
+    y_q16[i] = static_cast<int32_t>(py >> 16);
+  }
+  x_q16[n] = bx;
+  y_q16[n] = by;
+  return true;
+}
+
+void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
+                  const DataTermParams& params, int32_t invalid_cost, uint8_t* out) {
+  const int32_t w = src.ref.width;
+  const CostParams p{w, src.ref.height, params.color_trunc, params.census_weight,
+                     static_cast<uint8_t>(invalid_cost)};
+  const uint8_t* ref = src.ref.Row(y);
+  const uint8_t* cref = src.census_ref + static_cast<ptrdiff_t>(y) * 3 * w;
+  int32_t xq[kAnchorStep + 1], yq[kAnchorStep + 1];
+  for (int32_t x0 = 0, end = 0; x0 < w; x0 = end) {
+    const int32_t x1 = x0 + kAnchorStep < w - 1 ? x0 + kAnchorStep : w - 1;
+    end = x1 == w - 1 ? w : x1;  // the last span keeps its end anchor
+    if (!WarpSpan(h, x0, x1, y, xq, yq)) {
+      for (int32_t x = x0; x < end; ++x) out[x] = p.invalid;
+      continue;
+    }
+    for (int32_t x = x0; x < end; ++x) {
+      out[x] = SampleCost(src, p, ref + 3 * x, Census(cref, w, x), xq[x - x0], yq[x - x0]);
+    }
+  }
+}
+
+}  // namespace lb

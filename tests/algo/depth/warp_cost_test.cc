@@ -1,0 +1,336 @@
+// The plane-sweep data term (warp_cost.h): the anchor interpolation against the exact Map, and
+// the fixed-point costs against a float reference written from the definition (ProjectPlane in
+// double, float bilinear colour, the nearest tap's census Hamming distance, the same 3x3 window
+// and best half).
+#include "algo/depth/warp_cost.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+#include "algo/depth/data_term.h"
+#include "algo/motion/plane_homography.h"
+#include "tests/algo/motion/burst.h"
+
+namespace lb {
+namespace {
+
+// Rotation by `deg` about a unit axis (Rodrigues), and a translation of `frac` of the depth.
+ViewMotion RandomMotion(std::mt19937& rng, double max_deg, double max_frac) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  double axis[3] = {u(rng), u(rng), u(rng)};
+  const double n = std::sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
+  for (double& a : axis) a /= n;
+  const double th = max_deg * M_PI / 180 * (0.5 + 0.5 * std::fabs(u(rng)));
+  const double c = std::cos(th), s = std::sin(th), t = 1 - c;
+  const double x = axis[0], y = axis[1], z = axis[2];
+  ViewMotion m;
+  const double r[3][3] = {{t * x * x + c, t * x * y - s * z, t * x * z + s * y},
+                          {t * x * y + s * z, t * y * y + c, t * y * z - s * x},
+                          {t * x * z - s * y, t * y * z + s * x, t * z * z + c}};
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) m.rotation[i][j] = r[i][j];
+  }
+  double dir[3] = {u(rng), u(rng), 0.3 * u(rng)};
+  const double dn = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+  for (int i = 0; i < 3; ++i) m.translation[i] = max_frac * dir[i] / dn;
+  return m;
+}
+
+// Worst |interpolated - exact| over every span of the given rows, in px.
+double WorstAnchorError(const PlaneHomography& h, int32_t w, int32_t hgt, int32_t row_step) {
+  int32_t xq[kAnchorStep + 1], yq[kAnchorStep + 1];
+  int64_t worst = 0;
+  for (int32_t y = 0; y < hgt; y += row_step) {
+    for (int32_t x0 = 0; x0 < w - 1; x0 += kAnchorStep) {
+      const int32_t x1 = std::min(x0 + kAnchorStep, w - 1);
+      EXPECT_TRUE(WarpSpan(h, x0, x1, y, xq, yq));
+      for (int32_t x = x0; x <= x1; ++x) {
+        int32_t ex = 0, ey = 0;
+        EXPECT_TRUE(h.Map(x, y, &ex, &ey));
+        worst = std::max<int64_t>(worst, std::abs(int64_t{xq[x - x0]} - ex));
+        worst = std::max<int64_t>(worst, std::abs(int64_t{yq[x - x0]} - ey));
+      }
+    }
+  }
+  return static_cast<double>(worst) / 65536.0;
+}
+
+// Stated bound (warp_cost.h): rotations up to 2 degrees, translations up to 2 % of the depth,
+// at 640x480 (f = 0.8 w and the synthetic scene's 65 degree field of view): chord error
+// 16^2 / 8 * 2 * sin(2 deg) / f / D <= 1/215 px, plus the Q16 rounding of the anchors. The
+// planes are the ones a 2 % translation gives from 0.05 to 1 of the depth's inverse (where the
+// plane term rho t is largest). A pure translation is affine along rows: exact to 1 Q16 step.
+TEST(WarpCostTest, AnchorInterpolationIsWithinBoundOfTheExactMap) {
+  std::mt19937 rng(7);
+  double worst = 0;
+  for (const double f : {512.0, 502.2}) {
+    const CameraIntrinsics k{f, f, 320, 240};
+    for (int32_t i = 0; i < 6; ++i) {
+      const ViewMotion m = RandomMotion(rng, 2.0, 0.02);
+      for (const double rho : {0.05, 0.5, 1.0}) {
+        worst = std::max(worst, WorstAnchorError(MakePlaneHomography(k, m, rho), 640, 480, 23));
+      }
+    }
+    const ViewMotion shift = RandomMotion(rng, 0.0, 0.02);
+    EXPECT_LE(WorstAnchorError(MakePlaneHomography(k, shift, 1.0), 640, 480, 31), 1.0 / 65536);
+  }
+  std::printf("anchor interpolation: worst %.5f px (1/%.0f) over 2 degree, 2 %% motions\n", worst,
+              1 / worst);
+  EXPECT_LE(worst, 1.0 / 200);
+}
+
+std::vector<uint32_t> Census(const ConstImageU8& img) {
+  const int32_t w = img.width, h = img.height;
+  auto luma = [&](int32_t x, int32_t y) {
+    const uint8_t* p = img.At(std::clamp(x, 0, w - 1), std::clamp(y, 0, h - 1));
+    return (77 * p[0] + 150 * p[1] + 29 * p[2] + 128) >> 8;
+  };
+  std::vector<uint32_t> out(static_cast<size_t>(w) * h);
+  for (int32_t y = 0; y < h; ++y) {
+    for (int32_t x = 0; x < w; ++x) {
+      uint32_t bits = 0;
+      for (int32_t dy = -2; dy <= 2; ++dy) {
+        for (int32_t dx = -2; dx <= 2; ++dx) {
+          if (dx != 0 || dy != 0) bits = (bits << 1) | (luma(x + dx, y + dy) < luma(x, y) ? 1 : 0);
+        }
+      }
+      out[y * w + x] = bits;
+    }
+  }
+  return out;
+}
+
+// D from its definition at the exact positions (nominal), and the interval the fixed-point D
+// must lie in when its positions are off the exact ones by up to `delta` px per axis: a sample's
+// colour then moves by at most 2 delta G + 0.5 per channel (G: the largest step between
+// neighbours in the 4x4 taps around it, the 0.5 the rounding), the nearest census tap may be
+// either neighbour when the position is within delta of a half pixel, and a sample within delta
+// of a view's edge may be valid or not (cost 0..invalid). Window sums and order statistics are
+// monotone, so the bounds go through the window and the best-half mean as they are.
+struct Reference {
+  std::vector<float> d, lo, hi;
+};
+
+struct SampleCost {
+  float nominal, lo, hi;
+};
+
+// Per view, computed once: the census and each pixel's largest channel step to its right and
+// lower neighbours.
+struct ViewData {
+  std::vector<uint32_t> census;
+  std::vector<int32_t> step;
+};
+
+ViewData Prepare(const ConstImageU8& v) {
+  const int32_t w = v.width, h = v.height;
+  ViewData d{Census(v), std::vector<int32_t>(static_cast<size_t>(w) * h, 0)};
+  for (int32_t y = 0; y < h; ++y) {
+    for (int32_t x = 0; x < w; ++x) {
+      for (int32_t c = 0; c < 3; ++c) {
+        int32_t& g = d.step[y * w + x];
+        if (x + 1 < w) g = std::max(g, std::abs(v.At(x, y)[c] - v.At(x + 1, y)[c]));
+        if (y + 1 < h) g = std::max(g, std::abs(v.At(x, y)[c] - v.At(x, y + 1)[c]));
+      }
+    }
+  }
+  return d;
+}
+
+SampleCost Sample(const ConstImageU8& view, const ViewData& data, const uint8_t* ref_rgb,
+                  uint32_t cref, double vx, double vy, const DataTermParams& prm, double delta) {
+  const uint32_t* census = data.census.data();
+  const int32_t w = view.width, h = view.height;
+  const float invalid =
+      std::min(255.0f, static_cast<float>(prm.color_trunc + 24 * prm.census_weight));
+  auto edge = [&](double p, int32_t size) {
+    return std::fabs(p) <= delta || std::fabs(p - (size - 1)) <= delta;
+  };
+  const bool valid = vx >= 0 && vy >= 0 && vx <= w - 1 && vy <= h - 1;
+  const bool unsure = edge(vx, w) || edge(vy, h);
+  if (!valid) return {invalid, unsure ? 0 : invalid, invalid};
+  const int32_t ix = static_cast<int32_t>(vx), iy = static_cast<int32_t>(vy);
+  const float fx = static_cast<float>(vx - ix), fy = static_cast<float>(vy - iy);
+  const int32_t ix1 = std::min(ix + 1, w - 1), iy1 = std::min(iy + 1, h - 1);
+  const float wt[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+  const int32_t tx[4] = {ix, ix1, ix, ix1}, ty[4] = {iy, iy, iy1, iy1};
+  int32_t g = 0;
+  for (int32_t y = std::max(0, iy - 1); y <= std::min(h - 1, iy + 2); ++y) {
+    for (int32_t x = std::max(0, ix - 1); x <= std::min(w - 1, ix + 2); ++x) {
+      g = std::max(g, data.step[y * w + x]);
+    }
+  }
+  float ad = 0;
+  for (int32_t c = 0; c < 3; ++c) {
+    float s = 0;
+    for (int t = 0; t < 4; ++t) s += wt[t] * view.At(tx[t], ty[t])[c];
+    ad += std::fabs(ref_rgb[c] - s);
+  }
+  const float trunc = static_cast<float>(prm.color_trunc);
+  const float e = static_cast<float>(3 * (0.5 + 2 * delta * g));
+  const float a = std::min(ad, trunc);
+  const float a_lo = std::max(0.0f, std::min(ad - e, trunc)), a_hi = std::min(ad + e, trunc);
+  // Nearest census tap, rounded half up; either neighbour when within delta of the half.
+  auto taps = [&](float f, int32_t i0, int32_t i1, int32_t* lo, int32_t* hi) {
+    *lo = *hi = f >= 0.5f ? i1 : i0;
+    if (std::fabs(f - 0.5f) <= delta) {
+      *lo = i0;
+      *hi = i1;
+    }
+  };
+  int32_t x_lo, x_hi, y_lo, y_hi;
+  taps(fx, ix, ix1, &x_lo, &x_hi);
+  taps(fy, iy, iy1, &y_lo, &y_hi);
+  int32_t h_min = 24, h_max = 0;
+  for (int32_t y = y_lo; y <= y_hi; ++y) {
+    for (int32_t x = x_lo; x <= x_hi; ++x) {
+      const int32_t ham = __builtin_popcount(cref ^ census[y * w + x]);
+      h_min = std::min(h_min, ham);
+      h_max = std::max(h_max, ham);
+    }
+  }
+  const int32_t nx = fx >= 0.5f ? ix1 : ix, ny = fy >= 0.5f ? iy1 : iy;
+  const float cw = static_cast<float>(prm.census_weight);
+  const float ham = static_cast<float>(__builtin_popcount(cref ^ census[ny * w + nx]));
+  SampleCost out{std::min(255.0f, a + cw * ham), std::min(255.0f, a_lo + cw * h_min),
+                 std::min(255.0f, a_hi + cw * h_max)};
+  if (unsure) out.lo = 0, out.hi = invalid;
+  return out;
+}
+
+Reference ReferenceTerm(const motiontest::Burst& b, const std::vector<ViewData>& data,
+                        const DataTermParams& prm, double rho, double delta) {
+  const int32_t w = b.scene.width(), h = b.scene.height(), ref = b.scene.reference();
+  std::vector<std::vector<SampleCost>> cost;  // per other view
+  for (int32_t v = 0; v < b.scene.views(); ++v) {
+    if (v == ref) continue;
+    const Pose& pose = b.scene.pose(v);
+    ViewMotion m;
+    std::copy(&pose.rotation[0][0], &pose.rotation[0][0] + 9, &m.rotation[0][0]);
+    std::copy(pose.translation, pose.translation + 3, m.translation);
+    std::vector<SampleCost> c(static_cast<size_t>(w) * h);
+    for (int32_t y = 0; y < h; ++y) {
+      for (int32_t x = 0; x < w; ++x) {
+        double vx = 0, vy = 0;
+        ProjectPlane(b.intrinsics, m, rho, x + 0.5, y + 0.5, &vx, &vy);
+        c[y * w + x] = Sample(b.views[v], data[v], b.views[ref].At(x, y),
+                              data[ref].census[y * w + x], vx - 0.5, vy - 0.5, prm, delta);
+      }
+    }
+    cost.push_back(std::move(c));
+  }
+  const size_t keep = (cost.size() + 1) / 2;
+  Reference out;
+  out.d.resize(static_cast<size_t>(w) * h);
+  out.lo.resize(out.d.size());
+  out.hi.resize(out.d.size());
+  for (int32_t y = 0; y < h; ++y) {
+    for (int32_t x = 0; x < w; ++x) {
+      float sums[3][16];
+      for (size_t v = 0; v < cost.size(); ++v) {
+        const std::vector<SampleCost>& c = cost[v];
+        float s[3] = {0, 0, 0};
+        for (int32_t dy = -1; dy <= 1; ++dy) {
+          for (int32_t dx = -1; dx <= 1; ++dx) {
+            const SampleCost& q =
+                c[std::clamp(y + dy, 0, h - 1) * w + std::clamp(x + dx, 0, w - 1)];
+            s[0] += q.nominal;
+            s[1] += q.lo;
+            s[2] += q.hi;
+          }
+        }
+        for (int i = 0; i < 3; ++i) sums[i][v] = s[i];
+      }
+      float mean[3] = {0, 0, 0};
+      for (int i = 0; i < 3; ++i) {
+        std::sort(sums[i], sums[i] + cost.size());
+        for (size_t k = 0; k < keep; ++k) mean[i] += sums[i][k] / static_cast<float>(keep);
+      }
+      out.d[y * w + x] = mean[0];
+      out.lo[y * w + x] = mean[1];
+      out.hi[y * w + x] = mean[2];
+    }
+  }
+  return out;
+}
+
+struct Fixed {
+  std::vector<uint8_t> memory;
+  DataTerm term;
+};
+
+void PrepareTerm(Fixed& f, const motiontest::Burst& b, const DataTermParams& params) {
+  const int32_t w = b.scene.width(), h = b.scene.height(), n = b.scene.views();
+  Arena plan;
+  DataTerm planner;
+  planner.Carve(plan, w, h, n);
+  f.memory.assign(plan.used() + Arena::kAlign, 0);
+  const uintptr_t base = (reinterpret_cast<uintptr_t>(f.memory.data()) + Arena::kAlign - 1) &
+                         ~uintptr_t{Arena::kAlign - 1};
+  Arena arena(reinterpret_cast<void*>(base), plan.used());
+  f.term.Carve(arena, w, h, n);
+  ASSERT_FALSE(arena.overflowed());
+  f.term.SetParams(params, b.scene.reference());
+  f.term.Prepare(b.views.data());
+}
+
+// Stated tolerance: every fixed-point D lies within the reference's interval (above) for a
+// position error delta = 1/512 (Q8 weights) + 2^-16 (Map) + the anchors' chord bound for this
+// focal length and the burst's rotations of at most 1 degree (warp_cost.h; 1/109 px at
+// f ~ 125 px), widened by 1 for the Q15 mean. Against the nominal (exact-position) reference the
+// mean difference must stay below 4 of D's 0..2295 (measured 1.0 .. 3.4): the nearest census tap
+// flips, by up to 24 census weights, where a position lies within delta of a half pixel.
+TEST(WarpCostTest, FixedPointAgreesWithFloatReference) {
+  motiontest::Burst b;
+  ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(3), 160, 120, 4, &b));
+  const int32_t w = b.scene.width(), h = b.scene.height(), views = b.scene.views();
+  const double rho_min = b.scene.inverse_depth_min_q12() / 4096.0;
+  const double rho_max = b.scene.inverse_depth_max_q12() / 4096.0;
+  const double chord =
+      kAnchorStep * kAnchorStep / 8.0 * 2 * std::sin(M_PI / 180) / b.intrinsics.fx / 0.97;
+  const double delta = 1.0 / 512 + 1.0 / 65536 + chord;
+  std::vector<ViewData> data;
+  for (const ConstImageU8& v : b.views) data.push_back(Prepare(v));
+  for (const DataTermParams params : {DataTermParams{}, DataTermParams{200, 10}}) {
+    Fixed f;
+    PrepareTerm(f, b, params);
+    for (const double t : {0.0, 0.3, 0.7, 1.0}) {
+      const double rho = rho_min + t * (rho_max - rho_min);
+      std::vector<PlaneHomography> planes(views);
+      for (int32_t v = 0; v < views; ++v) {
+        const Pose& pose = b.scene.pose(v);
+        ViewMotion m;
+        std::copy(&pose.rotation[0][0], &pose.rotation[0][0] + 9, &m.rotation[0][0]);
+        std::copy(pose.translation, pose.translation + 3, m.translation);
+        planes[v] = MakePlaneHomography(b.intrinsics, m, rho);
+      }
+      f.term.SetPlanes(planes.data());
+      std::vector<uint16_t> fixed(static_cast<size_t>(w) * h);
+      f.term.ComputeRows(0, 0, h, fixed.data(), w);
+      const Reference expect = ReferenceTerm(b, data, params, rho, delta);
+      double sum = 0, worst = 0, width = 0;
+      int32_t outside = 0;
+      for (size_t i = 0; i < fixed.size(); ++i) {
+        const double d = std::fabs(fixed[i] - expect.d[i]);
+        sum += d;
+        worst = std::max(worst, d);
+        width += expect.hi[i] - expect.lo[i];
+        outside += fixed[i] < expect.lo[i] - 1 || fixed[i] > expect.hi[i] + 1;
+      }
+      const double n = static_cast<double>(fixed.size());
+      std::printf("rho %.3f: |fixed - float| mean %.3f worst %.1f; interval width mean %.1f\n", rho,
+                  sum / n, worst, width / n);
+      EXPECT_EQ(outside, 0) << "rho " << rho;
+      EXPECT_LT(sum / n, 4.0) << "rho " << rho;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace lb
