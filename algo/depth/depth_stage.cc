@@ -116,6 +116,15 @@ Status DepthStage::SetPlanes(const PlaneHomography* homographies) {
   return Status::Ok();
 }
 
+Status DepthStage::SetDisparityRange(int32_t disp_min_q8, int32_t disp_max_q8) {
+  DepthConfig c = config_;
+  c.disp_min_q8 = disp_min_q8;
+  c.disp_max_q8 = disp_max_q8;
+  LB_RETURN_IF_ERROR(Validate(c));
+  config_ = c;
+  return Status::Ok();
+}
+
 void DepthStage::LabelCosts(int32_t label, uint16_t* out) {
   if (config_.geometry == DepthGeometry::kPlanes) data_.SetPlanes(planes_ + label * config_.views);
   data_.ComputeRows(LabelDispQ8(label), 0, config_.height, out, config_.width);

@@ -77,6 +77,9 @@ class DepthStage {
   // burst cannot run on the last one's poses): homographies[v * labels + l] is label l's plane
   // seen from view v (the reference's entries are ignored), copied into the arena.
   Status SetPlanes(const PlaneHomography* homographies);
+  // A new label range for the next bursts (kPlanes: each burst's own, from its tracked points),
+  // within Validate's limits; the memory does not depend on it.
+  Status SetDisparityRange(int32_t disp_min_q8, int32_t disp_max_q8);
 
   // `views[i]` are RGB8 working-resolution images, left to right. Writes dispQ8 for every pixel
   // of the reference view into `disp_q8` (width x height, one channel).

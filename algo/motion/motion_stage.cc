@@ -47,9 +47,10 @@ Status MotionStage::Validate(const MotionConfig& c) {
     return Status(Code::kInvalidArgument, "motion: %d views (2..%d)", c.views,
                   MotionConfig::kMaxViews);
   }
-  if (c.width < 64 || c.height < 64 || c.width > 8192 || c.height > 8192) {
-    return Status(Code::kInvalidArgument, "motion: %dx%d working resolution (64..8192)", c.width,
-                  c.height);
+  if (c.width < MotionConfig::kMinSize || c.height < MotionConfig::kMinSize || c.width > 8192 ||
+      c.height > 8192) {
+    return Status(Code::kInvalidArgument, "motion: %dx%d working resolution (%d..8192)", c.width,
+                  c.height, MotionConfig::kMinSize);
   }
   if (c.min_features < 8 || c.bundle_iterations < 1 || c.bundle_rounds < 1 ||
       c.bundle_rounds > 10 || !(c.huber_px > 0) || !(c.outlier_px > 0) ||

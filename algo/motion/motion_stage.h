@@ -35,6 +35,7 @@ namespace lb {
 
 struct MotionConfig {
   static constexpr int32_t kMaxViews = Bundle::kMaxViews;
+  static constexpr int32_t kMinSize = 64;  // smallest working width and height
 
   int32_t width = 0;  // working resolution
   int32_t height = 0;

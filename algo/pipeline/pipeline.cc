@@ -3,6 +3,8 @@
 #include <cstring>
 
 #include "algo/core/color.h"
+#include "algo/depth/planes.h"
+#include "algo/pipeline/auto_geometry.h"
 
 namespace lb {
 
@@ -21,7 +23,27 @@ static DepthConfig MakeDepthConfig(const PipelineConfig& c, int32_t w, int32_t h
   d.labels = c.labels;
   d.disp_min_q8 = c.disp_min_q8;
   d.disp_max_q8 = c.disp_max_q8;
+  if (c.geometry == Geometry::kAuto) {
+    d.geometry = DepthGeometry::kPlanes;
+    // Placeholder range for sizing; every burst sets its own (auto_geometry.h).
+    d.disp_min_q8 = 0;
+    d.disp_max_q8 = 16 << 8;
+  }
   return d;
+}
+
+// Frames too small to follow get no motion stage: ComputeDepth reports them as degenerate.
+static bool UsesMotion(const PipelineConfig& c, int32_t work_w, int32_t work_h) {
+  return c.geometry == Geometry::kAuto && work_w >= MotionConfig::kMinSize &&
+         work_h >= MotionConfig::kMinSize;
+}
+
+static MotionConfig MakeMotionConfig(const PipelineConfig& c, int32_t w, int32_t h) {
+  MotionConfig m;
+  m.width = w;
+  m.height = h;
+  m.views = c.frames;
+  return m;
 }
 
 static RenderConfig MakeRenderConfig(const PipelineConfig& c, int32_t s, int32_t w, int32_t h) {
@@ -54,6 +76,12 @@ Status Pipeline::RequiredBytes(const PipelineConfig& c, size_t* bytes) {
   const Layout l = Plan(c);
   LB_RETURN_IF_ERROR(DepthStage::Validate(MakeDepthConfig(c, l.work_w, l.work_h)));
   LB_RETURN_IF_ERROR(RenderStage::Validate(MakeRenderConfig(c, l.scale, l.work_w, l.work_h)));
+  if (UsesMotion(c, l.work_w, l.work_h)) {
+    LB_RETURN_IF_ERROR(MotionStage::Validate(MakeMotionConfig(c, l.work_w, l.work_h)));
+    if (!(c.focal_px >= 0)) {
+      return Status(Code::kInvalidArgument, "focal length %g px is negative", c.focal_px);
+    }
+  }
   Pipeline planner;
   planner.config_ = c;
   planner.scale_ = l.scale;
@@ -77,14 +105,24 @@ Status Pipeline::Carve(Arena& arena) {
   rgb_rows_[0] = arena.Allocate<uint8_t>(static_cast<size_t>(c.width) * 3);
   rgb_rows_[1] = arena.Allocate<uint8_t>(static_cast<size_t>(c.width) * 3);
   acc_ = arena.Allocate<uint32_t>(static_cast<size_t>(work_w_) * 3);
+  const bool auto_geometry = c.geometry == Geometry::kAuto;
+  if (auto_geometry) {
+    planes_ = arena.Allocate<PlaneHomography>(static_cast<size_t>(c.frames) * c.labels);
+  }
   if (arena.planning()) {
     (void)arena.AllocateBytes(DepthStage::RequiredBytes(MakeDepthConfig(c, work_w_, work_h_)));
     (void)arena.AllocateBytes(
         RenderStage::RequiredBytes(MakeRenderConfig(c, scale_, work_w_, work_h_)));
+    if (UsesMotion(c, work_w_, work_h_)) {
+      (void)arena.AllocateBytes(MotionStage::RequiredBytes(MakeMotionConfig(c, work_w_, work_h_)));
+    }
     return Status::Ok();
   }
   LB_RETURN_IF_ERROR(depth_.Configure(MakeDepthConfig(c, work_w_, work_h_), arena));
   LB_RETURN_IF_ERROR(render_.Configure(MakeRenderConfig(c, scale_, work_w_, work_h_), arena));
+  if (UsesMotion(c, work_w_, work_h_)) {
+    LB_RETURN_IF_ERROR(motion_.Configure(MakeMotionConfig(c, work_w_, work_h_), arena));
+  }
   if (arena.overflowed()) {
     return Status(Code::kOutOfMemory, "pipeline arena of %zu bytes is too small (needs %zu)",
                   arena.size(), arena.used());
@@ -113,6 +151,7 @@ Status Pipeline::Configure(const PipelineConfig& config, void* arena, size_t byt
 }
 
 void Pipeline::ResetBurst() {
+  depth_warning_ = Status::Ok();
   received_mask_ = 0;
   in_frame_ = false;
   depth_ready_ = false;
@@ -226,9 +265,46 @@ Status Pipeline::ComputeDepth() {
   }
   ConstImageU8 views[PipelineConfig::kMaxFrames];
   for (int32_t i = 0; i < config_.frames; ++i) views[i] = working_[i].AsConst();
+  depth_warning_ = Status::Ok();
+  disp_min_q8_ = config_.disp_min_q8;
+  disp_max_q8_ = config_.disp_max_q8;
+  if (config_.geometry == Geometry::kAuto) {
+    const Status geometry = EstimateGeometry(views);
+    if (geometry.code() == Code::kDegenerate) {
+      // Everything at one depth: the render keeps the whole picture sharp.
+      depth_warning_ = geometry;
+      for (int32_t y = 0; y < work_h_; ++y) {
+        uint16_t* row = disp_q8_.Row(y);
+        for (int32_t x = 0; x < work_w_; ++x) row[x] = static_cast<uint16_t>(disp_min_q8_);
+      }
+      depth_ready_ = true;
+      return Status::Ok();
+    }
+    LB_RETURN_IF_ERROR(geometry);
+  }
   LB_RETURN_IF_ERROR(depth_.Compute(views, disp_q8_));
   depth_ready_ = true;
   return Status::Ok();
+}
+
+// Poses, then the burst's label range and the planes' homographies for the depth stage.
+Status Pipeline::EstimateGeometry(const ConstImageU8* views) {
+  if (!UsesMotion(config_, work_w_, work_h_)) {
+    return Status(Code::kDegenerate,
+                  "frames of %dx%d are too small to follow the camera's motion (at least %dx%d "
+                  "at the working resolution): take the burst at a higher resolution",
+                  config_.width, config_.height, MotionConfig::kMinSize, MotionConfig::kMinSize);
+  }
+  CameraIntrinsics k = DefaultIntrinsics(work_w_, work_h_);
+  if (config_.focal_px > 0) k.fx = k.fy = config_.focal_px / scale_;
+  LB_RETURN_IF_ERROR(motion_.Estimate(views, config_.reference, k, &motion_result_));
+  LabelRange range;
+  LB_RETURN_IF_ERROR(PlanLabelRange(motion_result_, config_.labels, &range));
+  disp_min_q8_ = range.disp_min_q8;
+  disp_max_q8_ = range.disp_max_q8;
+  LB_RETURN_IF_ERROR(depth_.SetDisparityRange(disp_min_q8_, disp_max_q8_));
+  MakeLabelPlanes(motion_result_, depth_.config(), range.px_per_inv_depth, planes_);
+  return depth_.SetPlanes(planes_);
 }
 
 Status Pipeline::BeginRender(const RenderParams& params) {

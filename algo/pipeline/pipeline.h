@@ -6,7 +6,8 @@
 //   Status s = Pipeline::RequiredBytes(config, &bytes);   // validates too
 //   Pipeline p;  s = p.Configure(config, block, bytes);  // block: 64-byte aligned
 //   sensor.CaptureBurst(p)  // p is a FrameSink: BeginFrame / Rows... / EndFrame per frame
-//   s = p.ComputeDepth();
+//   s = p.ComputeDepth();   // Ok with p.depth_warning() set when the burst gave no depth
+
 //   s = p.BeginRender(params);  while (p.NextStrip(&strip, &y0, &rows), rows > 0) encode(strip);
 #pragma once
 
@@ -18,9 +19,16 @@
 #include "algo/core/image.h"
 #include "algo/core/status.h"
 #include "algo/depth/depth_stage.h"
+#include "algo/motion/motion_stage.h"
 #include "algo/render/render_stage.h"
 
 namespace lb {
+
+// How the frames of a burst relate to each other.
+enum class Geometry : uint8_t {
+  kRectified,  // a rectified, equally spaced rig, left to right (laboratory data)
+  kAuto,       // a handheld burst: the motion stage recovers every frame's pose
+};
 
 struct PipelineConfig {
   static constexpr int32_t kMaxFrames = DepthConfig::kMaxViews;
@@ -36,9 +44,13 @@ struct PipelineConfig {
   int32_t max_working_width = 640;
   int32_t max_working_height = 480;
   int32_t labels = 64;
-  // Disparity range of the labels, in working-resolution px per view step, Q8.8.
+  Geometry geometry = Geometry::kRectified;
+  // Disparity range of the labels, in working-resolution px per view step, Q8.8 (kRectified;
+  // kAuto sets it from the tracked points, see auto_geometry.h).
   int32_t disp_min_q8 = 0;
   int32_t disp_max_q8 = 16 << 8;
+  // Focal length in full-resolution px (kAuto); 0 assumes DefaultIntrinsics' field of view.
+  double focal_px = 0;
   int32_t max_blur_radius = 32;  // full-resolution px
 };
 
@@ -61,7 +73,15 @@ class Pipeline : public FrameSink {
   // Forgets the frames ingested so far; the configuration stays.
   void ResetBurst();
 
+  // Depth for the burst. With kAuto, a burst that cannot give depth (the camera did not move,
+  // only turned, or a frame is blurred: see MotionDiagnosis) is not an error: the disparity is
+  // flat, so the render keeps everything sharp, and depth_warning() says what to do.
   Status ComputeDepth();
+  const Status& depth_warning() const { return depth_warning_; }
+  // The labels' disparity range of the last ComputeDepth (the configured one for kRectified).
+  int32_t disp_min_q8() const { return disp_min_q8_; }
+  int32_t disp_max_q8() const { return disp_max_q8_; }
+  const MotionResult& motion() const { return motion_result_; }
   Status BeginRender(const RenderParams& params);
   Status NextStrip(ConstPlanarU8* strip, int32_t* y0, int32_t* rows);
 
@@ -81,6 +101,7 @@ class Pipeline : public FrameSink {
   };
   static Layout Plan(const PipelineConfig& config);
   Status Carve(Arena& arena);
+  Status EstimateGeometry(const ConstImageU8* views);
   void IngestRow(const uint8_t* src, const uint8_t* uv, int32_t y);
   void FlushChroma(int32_t y);
 
@@ -94,6 +115,11 @@ class Pipeline : public FrameSink {
   uint32_t* acc_ = nullptr;                      // box-downscale accumulator, working row x 3
   DepthStage depth_;
   RenderStage render_;
+  MotionStage motion_;  // kAuto only
+  MotionResult motion_result_;
+  PlaneHomography* planes_ = nullptr;  // kAuto: frames x labels, view-major
+  int32_t disp_min_q8_ = 0, disp_max_q8_ = 0;
+  Status depth_warning_;
 
   // Burst state.
   uint32_t received_mask_ = 0;

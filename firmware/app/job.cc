@@ -25,6 +25,12 @@ void FormatExifTime(char* out, size_t size) {
   strftime(out, size, "%Y:%m:%d %H:%M:%S", &local);
 }
 
+// The frame's diagonal in px: the 35 mm equivalent focal length is defined on the 43.27 mm
+// diagonal of a 36 x 24 mm frame (see sim/files/exif_focal.h).
+double Diagonal(const SensorMode& mode) {
+  return std::hypot(static_cast<double>(mode.width), static_cast<double>(mode.height));
+}
+
 }  // namespace
 
 void Job::FreeDeleter::operator()(void* p) const { free(p); }
@@ -40,6 +46,10 @@ Status Job::Configure(Sensor* sensor, const JobOptions& options) {
   pc.width = mode_.width;
   pc.height = mode_.height;
   pc.frames = mode_.frames;
+  if (mode_.focal_px == 0 && options.focal_35mm > 0) {
+    mode_.focal_px = options.focal_35mm * Diagonal(mode_) / 43.27;
+  }
+  if (pc.focal_px == 0) pc.focal_px = mode_.focal_px;
   if (pc.reference < 0 || pc.reference >= pc.frames) pc.reference = pc.frames / 2;
   size_t bytes = 0;
   LB_RETURN_IF_ERROR(Pipeline::RequiredBytes(pc, &bytes));
@@ -71,6 +81,7 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
   LB_RETURN_IF_ERROR(p.ComputeDepth());
   double t2 = Now();
   r.depth_s = t2 - t1;
+  r.warning = p.depth_warning();
 
   LB_RETURN_IF_ERROR(p.BeginRender(options_.render));
   r.focus_disp_q8 = p.render().focus_disp_q8();
@@ -85,16 +96,14 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
   meta.f_number = options_.render.f_number;
   if (mode_.focal_px > 0) {
     // The 35 mm equivalent is defined on the 43.27 mm diagonal (see sim/files/exif_focal.h).
-    const double diagonal = std::hypot(double{1} * mode_.width, double{1} * mode_.height);
-    meta.focal_35mm = static_cast<int32_t>(mode_.focal_px * 43.27 / diagonal + 0.5);
+    meta.focal_35mm = static_cast<int32_t>(mode_.focal_px * 43.27 / Diagonal(mode_) + 0.5);
   }
   if (options_.refocusable) {
     // The XMP precedes the image data, so it is built before the first strip is encoded.
     std::vector<uint8_t> original;
     LB_RETURN_IF_ERROR(EncodeYCbCr420(p.reference(), options_.quality, &original));
-    const PipelineConfig& pc = p.config();
     LB_RETURN_IF_ERROR(
-        BuildRefocusableSegments(p.disparity_q8(), {pc.disp_min_q8, pc.disp_max_q8}, original,
+        BuildRefocusableSegments(p.disparity_q8(), {p.disp_min_q8(), p.disp_max_q8()}, original,
                                  FocusOf(p.render(), options_.render, mode_.width, mode_.height),
                                  mode_.width, &meta.extra_segments));
   }

@@ -18,6 +18,9 @@ struct JobOptions {
   PipelineConfig pipeline;  // width/height/frames are taken from the sensor's mode
   RenderParams render;
   int quality = 92;
+  // The lens as a 35 mm equivalent focal length, mm, when the sensor does not report one
+  // (0 = unknown: the pipeline assumes a typical field of view).
+  int32_t focal_35mm = 0;
   // Embed the depth map, the all-in-focus original and the focus (GDepth/GImage/GFocus XMP) so
   // the photo can be refocused later (`refocus rerender`, Google Photos and other viewers).
   bool refocusable = true;
@@ -31,6 +34,9 @@ struct JobReport {
   size_t arena_bytes = 0;
   int32_t focus_disp_q8 = 0;
   int32_t width = 0, height = 0;
+  // Not ok when the burst gave no depth (kDegenerate, with what to do): the photo was saved
+  // unblurred.
+  Status warning;
 };
 
 // Receives each rendered strip as the encoder does (tests use it to checksum the output).

@@ -1,5 +1,8 @@
-// refocus depth: rectified, equally spaced views (left to right) -> the reference view's
-// disparity in px per view step as a PFM, and optionally a colour-mapped PNG preview.
+// refocus depth: the views of a burst -> the reference view's disparity in px per view step as a
+// PFM, and optionally a colour-mapped PNG preview. With --geometry auto (the default) the camera
+// motion is estimated from the views; with rectified they are taken as equally spaced, left to
+// right.
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -7,9 +10,13 @@
 
 #include "algo/core/color.h"
 #include "algo/depth/depth_stage.h"
+#include "algo/depth/planes.h"
+#include "algo/motion/motion_stage.h"
+#include "algo/pipeline/auto_geometry.h"
 #include "firmware/cli/commands.h"
 #include "firmware/cli/options.h"
 #include "firmware/depth_out/depth_out.h"
+#include "sim/files/exif_focal.h"
 #include "sim/files/image_file.h"
 
 namespace lb::cli {
@@ -18,14 +25,18 @@ namespace {
 const char kUsage[] =
     "usage: refocus depth --views F1 F2 ... --disparity-out D.pfm [options]\n"
     "\n"
-    "  --views F1 F2 ...      the views, left to right, rectified and equally spaced\n"
-    "                         (PPM, PGM, PNG or JPEG, all the same size)\n"
+    "  --views F1 F2 ...      the views, in the order they were taken (PPM, PGM, PNG or JPEG,\n"
+    "                         all the same size)\n"
+    "  --geometry G           auto: handheld, the camera motion is estimated from the views\n"
+    "                         (default); rectified: equally spaced views, left to right\n"
+    "  --focal-35mm F         the lens as a 35 mm equivalent focal length, for auto geometry\n"
+    "                         (default: the first file's EXIF, else a ~64 degree field of view)\n"
     "  --ref K                reference view, 0-based (default: the middle one)\n"
     "  --disparity-out D.pfm  disparity of the reference view, px per view step (PFM)\n"
     "  --preview P.png        colour-mapped preview (blue far .. red near)\n"
     "  --labels N             disparity labels, 2..256 (default 64)\n"
-    "  --disparity MIN,MAX    label range in px per view step (default 0 and (N-1)/4:\n"
-    "                         quarter-pixel labels)\n"
+    "  --disparity MIN,MAX    label range in px per view step (rectified default 0 and\n"
+    "                         (N-1)/4: quarter-pixel labels; auto: from the tracked points)\n"
     "  --smoothness W         smoothness weight, 0..4096 (default %d)\n"
     "  --cycles N             expansion cycle cap, 0..32 (default %d)\n"
     "  --subpixel             write the sub-label refinement the renderer uses (default: the\n"
@@ -54,6 +65,37 @@ Status ReadRgb(const char* path, int32_t* width, int32_t* height, std::vector<ui
   return Status::Ok();
 }
 
+// Auto geometry: the views' motion, then (unless the range was given) the label range from the
+// tracked points, and the planes' homographies. Updates `c` to the range used.
+Status EstimatePlanes(const std::vector<ConstImageU8>& views, double focal_px, bool range_given,
+                      DepthStage* stage, DepthConfig* c) {
+  MotionConfig mc;
+  mc.width = c->width;
+  mc.height = c->height;
+  mc.views = c->views;
+  LB_RETURN_IF_ERROR(MotionStage::Validate(mc));
+  std::vector<uint8_t> memory(MotionStage::RequiredBytes(mc) + Arena::kAlign);
+  const uintptr_t base = (reinterpret_cast<uintptr_t>(memory.data()) + Arena::kAlign - 1) &
+                         ~uintptr_t{Arena::kAlign - 1};
+  Arena arena(reinterpret_cast<void*>(base), memory.size() - Arena::kAlign);
+  MotionStage motion;
+  LB_RETURN_IF_ERROR(motion.Configure(mc, arena));
+  CameraIntrinsics k = DefaultIntrinsics(c->width, c->height);
+  if (focal_px > 0) k.fx = k.fy = focal_px;
+  MotionResult m;
+  LB_RETURN_IF_ERROR(motion.Estimate(views.data(), c->reference, k, &m));
+  LabelRange range;
+  LB_RETURN_IF_ERROR(PlanLabelRange(m, c->labels, &range));
+  if (!range_given) {
+    c->disp_min_q8 = range.disp_min_q8;
+    c->disp_max_q8 = range.disp_max_q8;
+  }
+  LB_RETURN_IF_ERROR(stage->SetDisparityRange(c->disp_min_q8, c->disp_max_q8));
+  std::vector<PlaneHomography> planes(static_cast<size_t>(c->views) * c->labels);
+  MakeLabelPlanes(m, stage->config(), range.px_per_inv_depth, planes.data());
+  return stage->SetPlanes(planes.data());
+}
+
 }  // namespace
 
 int DepthCommand(int argc, char** argv) {
@@ -65,6 +107,8 @@ int DepthCommand(int argc, char** argv) {
   c.labels = 64;
   c.subpixel = false;
   float disp_min = 0, disp_max = -1;
+  Geometry geometry = Geometry::kAuto;
+  int32_t focal_35mm = 0;
   std::string error;
   for (int i = 1; i < argc; ++i) {  // argv[0] is the subcommand's name
     const char* a = argv[i];
@@ -86,6 +130,10 @@ int DepthCommand(int argc, char** argv) {
       ok = need() && (pfm = argv[++i]);
     } else if (!strcmp(a, "--preview")) {
       ok = need() && (preview = argv[++i]);
+    } else if (!strcmp(a, "--geometry")) {
+      ok = need() && ParseGeometry(argv[++i], &geometry, &error);
+    } else if (!strcmp(a, "--focal-35mm")) {
+      ok = need() && ParseInt(argv[++i], 8, 2000, &focal_35mm, &error);
     } else if (!strcmp(a, "--ref")) {
       ok = need() && ParseInt(argv[++i], 0, DepthConfig::kMaxViews - 1, &ref, &error);
     } else if (!strcmp(a, "--labels")) {
@@ -122,7 +170,8 @@ int DepthCommand(int argc, char** argv) {
   c.views = static_cast<int32_t>(files.size());
   c.reference = ref < 0 ? c.views / 2 : ref;
   if (c.reference >= c.views) return Usage("--ref is past the last view");
-  if (disp_max < 0) disp_max = static_cast<float>(c.labels - 1) / 4.0f;
+  const bool range_given = disp_max >= 0;
+  if (!range_given) disp_max = static_cast<float>(c.labels - 1) / 4.0f;
   c.disp_min_q8 = static_cast<int32_t>(disp_min * 256.0f + 0.5f);
   c.disp_max_q8 = static_cast<int32_t>(disp_max * 256.0f + 0.5f);
 
@@ -141,6 +190,7 @@ int DepthCommand(int argc, char** argv) {
       return Fail(msg);
     }
   }
+  if (geometry == Geometry::kAuto) c.geometry = DepthGeometry::kPlanes;
   const Status valid = DepthStage::Validate(c);
   if (!valid.ok()) return Fail(valid.message());
 
@@ -154,6 +204,13 @@ int DepthCommand(int argc, char** argv) {
   if (!s.ok()) return Fail(s.message());
   std::vector<ConstImageU8> views;
   for (const auto& p : pixels) views.push_back(MakeView(p.data(), c.width, c.height, 3));
+  if (geometry == Geometry::kAuto) {
+    double focal = focal_35mm > 0
+                       ? focal_35mm * std::hypot(double{1} * c.width, double{1} * c.height) / 43.27
+                       : ExifFocalPx(files[0], c.width, c.height);
+    s = EstimatePlanes(views, focal, range_given, &stage, &c);
+    if (!s.ok()) return Fail(s.message());
+  }
   std::vector<uint16_t> disp(static_cast<size_t>(c.width) * c.height);
   const ImageU16 out = MakeView(disp.data(), c.width, c.height);
   s = stage.Compute(views.data(), out);

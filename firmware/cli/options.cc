@@ -106,6 +106,18 @@ bool ParseAperture(const char* text, Aperture* out, std::string* error) {
   return true;
 }
 
+bool ParseGeometry(const char* text, Geometry* out, std::string* error) {
+  if (strcmp(text, "auto") == 0) {
+    *out = Geometry::kAuto;
+  } else if (strcmp(text, "rectified") == 0) {
+    *out = Geometry::kRectified;
+  } else {
+    *error = Printf("geometry '%s' is neither auto nor rectified", text);
+    return false;
+  }
+  return true;
+}
+
 bool ParseSize(const char* text, int32_t* width, int32_t* height, std::string* error) {
   int w = 0, h = 0;
   char tail = 0;

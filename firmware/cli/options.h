@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "algo/pipeline/pipeline.h"
 #include "algo/render/render_stage.h"
 
 namespace lb::cli {
@@ -18,6 +19,8 @@ bool ParseFloat(const char* text, float lo, float hi, float* out, std::string* e
 bool ParseFocus(const char* text, FocusRegion* out, std::string* error);
 // "disc" or "N-blade" / "polygon:N", e.g. "6-blade", "polygon:9".
 bool ParseAperture(const char* text, Aperture* out, std::string* error);
+// "auto" or "rectified".
+bool ParseGeometry(const char* text, Geometry* out, std::string* error);
 // "WxH".
 bool ParseSize(const char* text, int32_t* width, int32_t* height, std::string* error);
 

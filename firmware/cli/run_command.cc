@@ -2,6 +2,7 @@
 #include <getopt.h>
 
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -25,10 +26,18 @@ const char kUsage[] =
     "  --size WxH             synthetic frame size (default 1280x960, up to 4056x3040)\n"
     "  --frames N             synthetic burst length (default 5)\n"
     "  --seed S               synthetic scene seed (default 1)\n"
+    "  --motion M             synthetic camera motion: handheld or rectified (default: handheld\n"
+    "                         with --geometry auto, rectified with --geometry rectified)\n"
     "Depth:\n"
+    "  --geometry G           auto: a handheld burst, the camera motion is estimated from the\n"
+    "                         frames (default); rectified: equally spaced views, left to right\n"
+    "  --focal-35mm F         the lens as a 35 mm equivalent focal length (auto geometry; "
+    "default:\n"
+    "                         the sensor's or the files' EXIF, else a ~64 degree field of view)\n"
     "  --ref K                reference frame, 0-based (default: the middle one)\n"
     "  --labels N             depth labels (default 64)\n"
-    "  --disparity MIN,MAX    label range, working px per view step (files; default 0,16)\n"
+    "  --disparity MIN,MAX    label range, working px per view step (rectified geometry with\n"
+    "                         files; default 0,16; auto geometry finds its own)\n"
     "  --working-size WxH     largest working resolution for depth (default 640x480)\n"
     "Output:\n"
     "  --out OUT.jpg          written atomically: the name holds a whole JPEG or nothing\n";
@@ -39,6 +48,9 @@ enum Opt {
   kSize,
   kFrames,
   kSeed,
+  kMotion,
+  kGeometry,
+  kFocal,
   kRef,
   kLabels,
   kDisparity,
@@ -73,6 +85,8 @@ int RunCommand(int argc, char** argv) {
   job.pipeline.reference = -1;  // the middle frame
   std::string input_dir, out_path, error;
   bool synthetic = false, range_given = false;
+  const char* motion = nullptr;
+  job.pipeline.geometry = Geometry::kAuto;
   SceneParams scene;
   int32_t seed = 1;
 
@@ -82,6 +96,9 @@ int RunCommand(int argc, char** argv) {
       {"size", required_argument, nullptr, kSize},
       {"frames", required_argument, nullptr, kFrames},
       {"seed", required_argument, nullptr, kSeed},
+      {"motion", required_argument, nullptr, kMotion},
+      {"geometry", required_argument, nullptr, kGeometry},
+      {"focal-35mm", required_argument, nullptr, kFocal},
       {"ref", required_argument, nullptr, kRef},
       {"labels", required_argument, nullptr, kLabels},
       {"disparity", required_argument, nullptr, kDisparity},
@@ -108,6 +125,17 @@ int RunCommand(int argc, char** argv) {
         break;
       case kSeed:
         ok = ParseInt(optarg, 0, INT32_MAX, &seed, &error);
+        break;
+      case kMotion:
+        motion = optarg;
+        ok = !strcmp(optarg, "handheld") || !strcmp(optarg, "rectified");
+        if (!ok) error = std::string("motion '") + optarg + "' is neither handheld nor rectified";
+        break;
+      case kGeometry:
+        ok = ParseGeometry(optarg, &job.pipeline.geometry, &error);
+        break;
+      case kFocal:
+        ok = ParseInt(optarg, 8, 2000, &job.focal_35mm, &error);
         break;
       case kRef:
         ok = ParseInt(optarg, 0, 15, &job.pipeline.reference, &error);
@@ -156,6 +184,9 @@ int RunCommand(int argc, char** argv) {
     job.model = "Image files";
   } else {
     scene.seed = static_cast<uint64_t>(seed);
+    const bool handheld =
+        motion ? !strcmp(motion, "handheld") : job.pipeline.geometry == Geometry::kAuto;
+    scene.motion = handheld ? CameraMotion::kHandheld : CameraMotion::kRectified;
     if (job.pipeline.reference >= 0) scene.reference = job.pipeline.reference;
     auto synth = std::make_unique<SyntheticSensor>(scene);
     SensorMode mode;
@@ -163,7 +194,7 @@ int RunCommand(int argc, char** argv) {
     if (!s.ok()) return Fail(s.message());
     const Scene& sc = synth->scene();
     job.pipeline.reference = sc.reference();
-    if (!range_given) {
+    if (!range_given && job.pipeline.geometry == Geometry::kRectified) {
       // The scene knows its depth range: pad it by one label step on each side.
       PipelineConfig probe = job.pipeline;
       probe.width = mode.width;
@@ -183,6 +214,10 @@ int RunCommand(int argc, char** argv) {
   JobReport report;
   s = runner.Run(out_path.c_str(), &report);
   if (!s.ok()) return Fail(s.message());
+  if (!report.warning.ok()) {
+    fprintf(stderr, "refocus: warning: no depth from this burst, the photo is not blurred: %s\n",
+            report.warning.message());
+  }
   printf(
       "wrote %s: %dx%d, %d frames, focus disparity %.2f px; capture %.2f s, depth %.2f s, "
       "render+encode %.2f s, arena %.1f MiB\n",

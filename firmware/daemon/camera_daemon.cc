@@ -252,6 +252,10 @@ void CameraDaemon::TakePhoto(int32_t number) {
     return;
   }
   namer_.Used();
+  if (!report.warning.ok()) {
+    log_->Printf(LogLevel::kWarning, "photo %d: not blurred (no depth from this burst): %s", number,
+                 report.warning.message());
+  }
   log_->Printf(LogLevel::kInfo,
                "photo %d: saved %s (%dx%d; capture %.2f s, depth %.2f s, render and save %.2f s)",
                number, path, report.width, report.height, report.capture_s, report.depth_s,

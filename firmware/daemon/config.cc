@@ -179,6 +179,23 @@ const Key kKeys[] = {
     {"model", [](const char* v, DaemonConfig* c, Why* why) { return Text(v, &c->model, why); }},
     {"labels",
      [](const char* v, DaemonConfig* c, Why* why) { return Int32(v, 2, 256, &c->labels, why); }},
+    {"geometry",
+     [](const char* v, DaemonConfig* c, Why* why) {
+       if (strcmp(v, "auto") == 0) {
+         c->geometry = Geometry::kAuto;
+       } else if (strcmp(v, "rectified") == 0) {
+         c->geometry = Geometry::kRectified;
+       } else {
+         return Fail(why, "'%s' is neither auto nor rectified", v);
+       }
+       return true;
+     }},
+    {"focal_35mm",
+     [](const char* v, DaemonConfig* c, Why* why) {
+       const bool ok = Int32(v, 0, 2000, &c->focal_35mm, why);
+       if (ok && c->focal_35mm != 0 && c->focal_35mm < 8) return Fail(why, "%s mm is no lens", v);
+       return ok;
+     }},
     {"working_size", [](const char* v, DaemonConfig* c,
                         Why* why) { return Size(v, &c->working_width, &c->working_height, why); }},
     {"focus",
@@ -323,6 +340,8 @@ JobOptions MakeJobOptions(const DaemonConfig& config) {
   o.sensor.timeout_ms = config.frame_timeout_ms;
   o.pipeline.reference = -1;  // the middle frame
   o.pipeline.labels = config.labels;
+  o.pipeline.geometry = config.geometry;
+  o.focal_35mm = config.focal_35mm;
   o.pipeline.max_working_width = config.working_width;
   o.pipeline.max_working_height = config.working_height;
   o.pipeline.max_blur_radius = config.max_blur_radius;

@@ -38,6 +38,8 @@ struct DaemonConfig {
   std::string make = "LensBlur", model = "LensBlur camera";
   // Depth and lens.
   int32_t labels = 32;
+  Geometry geometry = Geometry::kAuto;
+  int32_t focal_35mm = 0;  // 35 mm equivalent focal length of the lens, mm; 0 = unknown
   int32_t working_width = 640, working_height = 480;
   RenderParams render;  // focus, f-number, aperture
   int32_t max_blur_radius = 32;

@@ -109,11 +109,31 @@ TEST_F(Cli, SyntheticRunWritesAJpegOfTheConfiguredSize) {
 }
 
 TEST_F(Cli, FileBurstRuns) {
-  std::vector<std::string> args = {"run", "--labels", "8", "--disparity", "0,4", "--out", Out()};
+  std::vector<std::string> args = {"run",         "--geometry", "rectified", "--labels", "8",
+                                   "--disparity", "0,4",        "--out",     Out()};
   for (const auto& p : PpmBurst(3, 64, 48)) args.push_back(p);
   Result r = Run(args);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_GT(Slurp(Out()).size(), 100u);
+}
+
+TEST_F(Cli, HandheldSyntheticBurstIsTheDefault) {
+  Result r = Run({"run", "--size", "320x240", "--labels", "16", "--out", Out()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "") << "a handheld burst with motion gives depth, not a warning";
+  EXPECT_GT(Slurp(Out()).size(), 1000u);
+}
+
+TEST_F(Cli, BurstWithoutMotionSavesAnUnblurredPhotoAndSaysWhy) {
+  std::vector<std::string> args = {"run", "--labels", "8", "--out", Out()};
+  const std::vector<std::string> frame = PpmBurst(1, 160, 120);
+  for (int i = 0; i < 5; ++i) args.push_back(frame[0]);  // the camera never moved
+  Result r = Run(args);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("warning"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("not blurred"), std::string::npos) << r.err;
+  EXPECT_GT(Slurp(Out()).size(), 1000u);
 }
 
 TEST_F(Cli, TruncatedPpm) {
@@ -189,7 +209,7 @@ TEST_F(Cli, UnwritableOutputDirectory) {
   // Running as root ignores permission bits, so the "directory" is a regular file.
   const std::string not_dir = dir_ + "/file";
   ASSERT_TRUE(test::WriteFile(not_dir, Bytes{1, 2, 3}));
-  Result r = Run({"run", "--synthetic", "--size", "64x48", "--out", not_dir + "/photo.jpg"});
+  Result r = Run({"run", "--synthetic", "--size", "160x120", "--out", not_dir + "/photo.jpg"});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find(not_dir), std::string::npos) << r.err;
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
