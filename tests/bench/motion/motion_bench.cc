@@ -1,11 +1,15 @@
 // The motion stage on a synthetic handheld burst: 7 frames at the working resolution 640x480,
-// one thread (pyramids, corners, tracking, bundle adjustment and checks).
+// one thread (pyramids, corners, tracking, bundle adjustment and checks), and beside it the whole
+// pipeline on the same burst with auto geometry (ingest, motion, depth, render), so the motion
+// stage's share of a run is a ratio of two figures from one process.
 //   build/host/tests/bench/motion/motion_bench
 #include <benchmark/benchmark.h>
 
 #include <vector>
 
 #include "algo/motion/motion_stage.h"
+#include "algo/pipeline/pipeline.h"
+#include "sim/synthetic/synthetic_sensor.h"
 #include "tests/algo/motion/burst.h"
 
 namespace lb {
@@ -38,6 +42,57 @@ void BM_MotionStage7x640x480(benchmark::State& state) {
   state.counters["arena_MB"] = static_cast<double>(memory.size()) / (1 << 20);
 }
 BENCHMARK(BM_MotionStage7x640x480)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+// Whole run, 640x480 frames (working resolution = full resolution), 7 frames, 64 labels.
+void BM_PipelineAuto7x640x480(benchmark::State& state) {
+  SyntheticSensor sensor(motiontest::Handheld(1));
+  SensorConfig sc;
+  sc.width = 640;
+  sc.height = 480;
+  sc.frames = 7;
+  SensorMode mode;
+  if (!sensor.Configure(sc, &mode).ok()) {
+    state.SkipWithError("sensor");
+    return;
+  }
+  PipelineConfig c;
+  c.width = mode.width;
+  c.height = mode.height;
+  c.frames = mode.frames;
+  c.reference = sensor.scene().reference();
+  c.geometry = Geometry::kAuto;
+  c.focal_px = mode.focal_px;
+  size_t bytes = 0;
+  if (!Pipeline::RequiredBytes(c, &bytes).ok()) {
+    state.SkipWithError("config");
+    return;
+  }
+  std::vector<uint8_t> memory(bytes + Arena::kAlign);
+  void* base =
+      reinterpret_cast<void*>((reinterpret_cast<uintptr_t>(memory.data()) + Arena::kAlign - 1) &
+                              ~uintptr_t{Arena::kAlign - 1});
+  Pipeline p;
+  if (!p.Configure(c, base, bytes).ok()) {
+    state.SkipWithError("configure");
+    return;
+  }
+  RenderParams render;
+  for (auto _ : state) {
+    p.ResetBurst();
+    Status s = sensor.CaptureBurst(p);
+    if (s.ok()) s = p.ComputeDepth();
+    if (s.ok()) s = p.BeginRender(render);
+    for (int32_t rows = 1; s.ok() && rows > 0;) {
+      ConstPlanarU8 strip;
+      int32_t y0 = 0;
+      s = p.NextStrip(&strip, &y0, &rows);
+    }
+    if (!s.ok()) state.SkipWithError(s.message());
+    if (!p.depth_warning().ok()) state.SkipWithError(p.depth_warning().message());
+  }
+  state.counters["arena_MB"] = static_cast<double>(bytes) / (1 << 20);
+}
+BENCHMARK(BM_PipelineAuto7x640x480)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 }  // namespace
 }  // namespace lb
