@@ -1,0 +1,243 @@
+#include "algo/depth/data_term_kernels.h"
+
+#if defined(__x86_64__)
+#include <immintrin.h>
+#define LB_AVX2 __attribute__((target("avx2")))
+
+namespace lb::dtk {
+namespace {
+
+// ---- AVX2 kernels (x86-64, run-time dispatch): the last step of a row overlaps the one
+// before (every output depends on its inputs only: the same bytes again); rows shorter than a
+// step take the C reference ----
+
+LB_AVX2 inline __m256i Load(const void* p) {
+  return _mm256_loadu_si256(static_cast<const __m256i*>(p));
+}
+LB_AVX2 inline void Store(void* p, __m256i v) { _mm256_storeu_si256(static_cast<__m256i*>(p), v); }
+
+LB_AVX2 void CensusRowAvx2(const uint8_t* const* rows, int32_t x0, int32_t x1, int32_t w,
+                           uint8_t* out) {
+  if (x1 - x0 < 32) return CensusRowC(rows, x0, x1, w, out);
+  for (int32_t step = x0; step < x1; step += 32) {
+    const int32_t x = step + 32 <= x1 ? step : x1 - 32;
+    const __m256i c = Load(rows[2] + x);
+    __m256i plane = _mm256_setzero_si256();
+    int32_t bit = 0;
+    for (int32_t dy = 0; dy < 5; ++dy) {
+      for (int32_t dx = -2; dx <= 2; ++dx) {
+        if (dy == 2 && dx == 0) continue;
+        // Shift in one bit per neighbour: the compare mask is -1 where it is darker.
+        plane = _mm256_sub_epi8(_mm256_add_epi8(plane, plane),
+                                _mm256_cmpgt_epi8(c, Load(rows[dy] + x + dx)));
+        if (++bit % 8 == 0) {
+          Store(out + (bit / 8 - 1) * w + x, plane);
+          plane = _mm256_setzero_si256();
+        }
+      }
+    }
+  }
+}
+
+// (a * (256 - f) + b * f + 128) >> 8 per byte = a + ((b - a) * f + 128) >> 8 (floor), in even
+// and odd 16-bit lanes; mulhrs by f * 128 is (d * f * 128 + 2^14) >> 15, the same for
+// |d| <= 255. Range 0..255, so the halves recombine without carries.
+LB_AVX2 inline __m256i Lerp(__m256i a, __m256i b, __m256i f128) {
+  const __m256i low = _mm256_set1_epi16(0x00ff);
+  const __m256i ae = _mm256_and_si256(a, low), be = _mm256_and_si256(b, low);
+  const __m256i ao = _mm256_srli_epi16(a, 8), bo = _mm256_srli_epi16(b, 8);
+  const __m256i re = _mm256_add_epi16(ae, _mm256_mulhrs_epi16(_mm256_sub_epi16(be, ae), f128));
+  const __m256i ro = _mm256_add_epi16(ao, _mm256_mulhrs_epi16(_mm256_sub_epi16(bo, ao), f128));
+  return _mm256_or_si256(re, _mm256_slli_epi16(ro, 8));
+}
+
+// Census weight times the bit count of each byte (<= 80): nibble table lookups.
+LB_AVX2 inline __m256i WeightedBits(__m256i v, __m256i lut) {
+  const __m256i nib = _mm256_set1_epi8(0x0f);
+  const __m256i lo = _mm256_shuffle_epi8(lut, _mm256_and_si256(v, nib));
+  const __m256i hi = _mm256_shuffle_epi8(lut, _mm256_and_si256(_mm256_srli_epi16(v, 4), nib));
+  return _mm256_add_epi8(lo, hi);
+}
+
+// Three census planes: cw * Hamming distance <= 240.
+LB_AVX2 inline __m256i WeightedHamming(const uint8_t* a, const uint8_t* b, ptrdiff_t plane,
+                                       __m256i lut) {
+  __m256i h = WeightedBits(_mm256_xor_si256(Load(a), Load(b)), lut);
+  h = _mm256_add_epi8(h, WeightedBits(_mm256_xor_si256(Load(a + plane), Load(b + plane)), lut));
+  return _mm256_add_epi8(
+      h, WeightedBits(_mm256_xor_si256(Load(a + 2 * plane), Load(b + 2 * plane)), lut));
+}
+
+// 32 RGB pixels as three vectors whose 128-bit lanes hold pixels 0-15 and 16-31, so the
+// in-lane byte shuffles below see 16 whole pixels.
+struct Rgb32 {
+  __m256i v[3];
+};
+LB_AVX2 inline Rgb32 LoadRgb32(const uint8_t* p) {
+  Rgb32 r;
+  for (int32_t k = 0; k < 3; ++k) {
+    const __m128i lo = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + 16 * k));
+    const __m128i hi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(p + 48 + 16 * k));
+    r.v[k] = _mm256_inserti128_si256(_mm256_castsi128_si256(lo), hi, 1);
+  }
+  return r;
+}
+
+// Shuffle masks: byte x of (mask k, channel c) picks byte 3x + c of the lane's 48 bytes when
+// that lies in vector k, else zero.
+struct GatherMasks {
+  alignas(32) int8_t m[3][3][32];
+  constexpr GatherMasks() : m() {
+    for (int32_t k = 0; k < 3; ++k)
+      for (int32_t c = 0; c < 3; ++c)
+        for (int32_t i = 0; i < 32; ++i) {
+          const int32_t src = 3 * (i % 16) + c - 16 * k;
+          m[k][c][i] = static_cast<int8_t>(src >= 0 && src < 16 ? src : -128);
+        }
+  }
+};
+constexpr GatherMasks kGather;
+
+// Sum of the three channel differences, saturated at 255: above that the cost is 255 anyway
+// (cost = min(min(ad, trunc) + ham, 255) = min(min(ad, 255, trunc) + ham, 255)).
+LB_AVX2 inline __m256i ChannelSum(const __m256i* d) {
+  __m256i sum = _mm256_setzero_si256();
+  for (int32_t c = 0; c < 3; ++c) {
+    __m256i g = _mm256_shuffle_epi8(d[0], Load(kGather.m[0][c]));
+    g = _mm256_or_si256(g, _mm256_shuffle_epi8(d[1], Load(kGather.m[1][c])));
+    g = _mm256_or_si256(g, _mm256_shuffle_epi8(d[2], Load(kGather.m[2][c])));
+    sum = _mm256_adds_epu8(sum, g);
+  }
+  return sum;
+}
+
+LB_AVX2 inline __m256i AbsDiff(__m256i a, __m256i b) {
+  return _mm256_sub_epi8(_mm256_max_epu8(a, b), _mm256_min_epu8(a, b));
+}
+
+// 32 pixels per step, all in bytes: the interpolated Hamming cost is Lerp of cw * h0 and cw * h1
+// ((h0 * g + h1 * f) * cw = (cw h0) g + (cw h1) f exactly).
+template <bool kFrac>
+LB_AVX2 void CostRowAvx2T(const uint8_t* ref, const uint8_t* img, const uint8_t* cref,
+                          const uint8_t* cimg, ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc,
+                          int32_t cw, uint8_t* out) {
+  int8_t table[16];
+  for (int32_t i = 0; i < 16; ++i) table[i] = static_cast<int8_t>(cw * __builtin_popcount(i));
+  const __m256i lut =
+      _mm256_broadcastsi128_si256(_mm_loadu_si128(reinterpret_cast<const __m128i*>(table)));
+  const __m256i f128 = _mm256_set1_epi16(static_cast<int16_t>(f * 128));
+  const __m256i trunc8 = _mm256_set1_epi8(static_cast<char>(trunc < 255 ? trunc : 255));
+  if (n < 32) return CostRowC(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+  for (int32_t step = 0; step < n; step += 32) {
+    const int32_t x = step + 32 <= n ? step : n - 32;
+    const Rgb32 r = LoadRgb32(ref + 3 * x);
+    const Rgb32 a = LoadRgb32(img + 3 * x);
+    __m256i d[3];
+    __m256i ham = WeightedHamming(cref + x, cimg + x, plane, lut);
+    if (kFrac) {
+      const Rgb32 b = LoadRgb32(img + 3 * x + 3);
+      for (int32_t k = 0; k < 3; ++k) d[k] = AbsDiff(r.v[k], Lerp(a.v[k], b.v[k], f128));
+      ham = Lerp(ham, WeightedHamming(cref + x, cimg + x + 1, plane, lut), f128);
+    } else {
+      for (int32_t k = 0; k < 3; ++k) d[k] = AbsDiff(r.v[k], a.v[k]);
+    }
+    const __m256i ad = _mm256_min_epu8(ChannelSum(d), trunc8);
+    Store(out + x, _mm256_adds_epu8(ad, ham));
+  }
+}
+
+LB_AVX2 void CostRowAvx2(const uint8_t* ref, const uint8_t* img, const uint8_t* cref,
+                         const uint8_t* cimg, ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc,
+                         int32_t cw, uint8_t* out) {
+  if (f == 0) {
+    CostRowAvx2T<false>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+  } else {
+    CostRowAvx2T<true>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+  }
+}
+
+LB_AVX2 inline __m256i Widen16(const uint8_t* p) {
+  return _mm256_cvtepu8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
+}
+
+LB_AVX2 void HSumRowAvx2(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum) {
+  if (x1 - x0 < 16) return HSumRowC(cost, x0, x1, hsum);
+  for (int32_t step = x0; step < x1; step += 16) {
+    const int32_t x = step + 16 <= x1 ? step : x1 - 16;
+    const __m256i s = _mm256_add_epi16(Widen16(cost + x - 1), Widen16(cost + x));
+    Store(hsum + x, _mm256_add_epi16(s, Widen16(cost + x + 1)));
+  }
+}
+
+// Signed 16-bit lanes (window sums <= 2295): a sorted list of the kKeep smallest in registers,
+// one insertion (min/max chain) per view; kept sum <= 18360, then mulhrs by the Q15 reciprocal
+// is (sum * recip + 2^14) >> 15, as in the reference.
+LB_AVX2 inline __m256i Window(const uint16_t* const* rows, int32_t j, int32_t x) {
+  return _mm256_add_epi16(_mm256_add_epi16(Load(rows[3 * j] + x), Load(rows[3 * j + 1] + x)),
+                          Load(rows[3 * j + 2] + x));
+}
+
+template <int32_t kKeep>
+LB_AVX2 void SelectRowAvx2T(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
+                            uint16_t* out) {
+  const __m256i recip = _mm256_set1_epi16(static_cast<int16_t>(RecipQ15(kKeep)));
+  if (x1 - x0 < 16) return SelectRowC(rows, others, x0, x1, out);
+  for (int32_t step = x0; step < x1; step += 16) {
+    const int32_t x = step + 16 <= x1 ? step : x1 - 16;
+    __m256i best[kKeep];
+    for (int32_t j = 0; j < kKeep; ++j) {
+      __m256i a = Window(rows, j, x);
+      for (int32_t i = 0; i < j; ++i) {
+        const __m256i lo = _mm256_min_epi16(best[i], a);
+        a = _mm256_max_epi16(best[i], a);
+        best[i] = lo;
+      }
+      best[j] = a;
+    }
+    for (int32_t j = kKeep; j < others; ++j) {
+      __m256i a = Window(rows, j, x);
+      for (int32_t i = 0; i < kKeep - 1; ++i) {
+        const __m256i lo = _mm256_min_epi16(best[i], a);
+        a = _mm256_max_epi16(best[i], a);
+        best[i] = lo;
+      }
+      best[kKeep - 1] = _mm256_min_epi16(best[kKeep - 1], a);
+    }
+    __m256i sum = best[0];
+    for (int32_t i = 1; i < kKeep; ++i) sum = _mm256_add_epi16(sum, best[i]);
+    Store(out + x, kKeep == 1 ? sum : _mm256_mulhrs_epi16(sum, recip));
+  }
+}
+
+LB_AVX2 void SelectRowAvx2(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
+                           uint16_t* out) {
+  switch ((others + 1) / 2) {
+    case 1:
+      return SelectRowAvx2T<1>(rows, others, x0, x1, out);
+    case 2:
+      return SelectRowAvx2T<2>(rows, others, x0, x1, out);
+    case 3:
+      return SelectRowAvx2T<3>(rows, others, x0, x1, out);
+    case 4:
+      return SelectRowAvx2T<4>(rows, others, x0, x1, out);
+    case 5:
+      return SelectRowAvx2T<5>(rows, others, x0, x1, out);
+    case 6:
+      return SelectRowAvx2T<6>(rows, others, x0, x1, out);
+    case 7:
+      return SelectRowAvx2T<7>(rows, others, x0, x1, out);
+    default:
+      return SelectRowAvx2T<8>(rows, others, x0, x1, out);
+  }
+}
+
+}  // namespace
+
+const DataTerm::Kernels* SimdKernels() {
+  static constexpr DataTerm::Kernels kAvx2 = {CensusRowAvx2, CostRowAvx2, HSumRowAvx2,
+                                              SelectRowAvx2};
+  return __builtin_cpu_supports("avx2") ? &kAvx2 : nullptr;
+}
+
+}  // namespace lb::dtk
+#endif

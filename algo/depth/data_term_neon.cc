@@ -1,0 +1,174 @@
+#include "algo/depth/data_term_kernels.h"
+
+#if defined(__ARM_NEON)
+#include <arm_neon.h>
+
+namespace lb::dtk {
+namespace {
+
+// ---- NEON kernels (aarch64; armhf when built with NEON), 16 pixels a step, the last step
+// overlapping the one before (the same bytes again); ARMv7 intrinsics only ----
+
+void CensusRowNeon(const uint8_t* const* rows, int32_t x0, int32_t x1, int32_t w, uint8_t* out) {
+  if (x1 - x0 < 16) return CensusRowC(rows, x0, x1, w, out);
+  for (int32_t step = x0; step < x1; step += 16) {
+    const int32_t x = step + 16 <= x1 ? step : x1 - 16;
+    const int8x16_t c = vreinterpretq_s8_u8(vld1q_u8(rows[2] + x));
+    uint8x16_t plane = vdupq_n_u8(0);
+    int32_t bit = 0;
+    for (int32_t dy = 0; dy < 5; ++dy) {
+      for (int32_t dx = -2; dx <= 2; ++dx) {
+        if (dy == 2 && dx == 0) continue;
+        // Shift in one bit per neighbour: the compare mask is all ones where it is darker.
+        const int8x16_t nb = vreinterpretq_s8_u8(vld1q_u8(rows[dy] + x + dx));
+        plane = vsubq_u8(vaddq_u8(plane, plane), vcltq_s8(nb, c));
+        if (++bit % 8 == 0) {
+          vst1q_u8(out + (bit / 8 - 1) * w + x, plane);
+          plane = vdupq_n_u8(0);
+        }
+      }
+    }
+  }
+}
+
+// Hamming distance over the three census planes, 0..24.
+inline uint8x16_t Hamming(const uint8_t* a, const uint8_t* b, ptrdiff_t plane) {
+  uint8x16_t h = vcntq_u8(veorq_u8(vld1q_u8(a), vld1q_u8(b)));
+  h = vaddq_u8(h, vcntq_u8(veorq_u8(vld1q_u8(a + plane), vld1q_u8(b + plane))));
+  return vaddq_u8(h, vcntq_u8(veorq_u8(vld1q_u8(a + 2 * plane), vld1q_u8(b + 2 * plane))));
+}
+
+// a * g + b * f in 16-bit lanes (<= 65280 for bytes, <= 6144 for distances), low and high half.
+inline uint16x8_t Mix(uint8x8_t a, uint8x8_t b, uint8x8_t g, uint8x8_t f) {
+  return vmlal_u8(vmull_u8(a, g), b, f);
+}
+
+// (a * g + b * f + 128) >> 8: the rounding narrow shift, exact below 65408.
+inline uint8x16_t Lerp(uint8x16_t a, uint8x16_t b, uint8x8_t g, uint8x8_t f) {
+  return vcombine_u8(vrshrn_n_u16(Mix(vget_low_u8(a), vget_low_u8(b), g, f), 8),
+                     vrshrn_n_u16(Mix(vget_high_u8(a), vget_high_u8(b), g, f), 8));
+}
+
+// vld3 de-interleaves the colours; channel sums saturate at 255 as in the AVX2 kernel.
+template <bool kFrac>
+void CostRowNeonT(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, const uint8_t* cimg,
+                  ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc, int32_t cw, uint8_t* out) {
+  if (n < 16) return CostRowC(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+  const uint8x8_t g8 = vdup_n_u8(static_cast<uint8_t>(kFrac ? 256 - f : 0));
+  const uint8x8_t f8 = vdup_n_u8(static_cast<uint8_t>(f));
+  const uint16_t cw16 = static_cast<uint16_t>(cw);
+  const uint8x16_t trunc8 = vdupq_n_u8(static_cast<uint8_t>(trunc < 255 ? trunc : 255));
+  for (int32_t step = 0; step < n; step += 16) {
+    const int32_t x = step + 16 <= n ? step : n - 16;
+    const uint8x16x3_t r = vld3q_u8(ref + 3 * x);
+    const uint8x16x3_t a = vld3q_u8(img + 3 * x);
+    const uint8x16_t h0 = Hamming(cref + x, cimg + x, plane);
+    uint8x16_t sum = vdupq_n_u8(0), ham;
+    if (kFrac) {
+      const uint8x16x3_t b = vld3q_u8(img + 3 * x + 3);
+      for (int32_t c = 0; c < 3; ++c) {
+        sum = vqaddq_u8(sum, vabdq_u8(r.val[c], Lerp(a.val[c], b.val[c], g8, f8)));
+      }
+      // ((h0 * g + h1 * f) * cw + 128) >> 8, <= 61568 before the shift.
+      const uint8x16_t h1 = Hamming(cref + x, cimg + x + 1, plane);
+      const uint16x8_t lo = vmulq_n_u16(Mix(vget_low_u8(h0), vget_low_u8(h1), g8, f8), cw16);
+      const uint16x8_t hi = vmulq_n_u16(Mix(vget_high_u8(h0), vget_high_u8(h1), g8, f8), cw16);
+      ham = vcombine_u8(vrshrn_n_u16(lo, 8), vrshrn_n_u16(hi, 8));
+    } else {
+      for (int32_t c = 0; c < 3; ++c) sum = vqaddq_u8(sum, vabdq_u8(r.val[c], a.val[c]));
+      ham = vmulq_u8(h0, vdupq_n_u8(static_cast<uint8_t>(cw)));  // <= 240
+    }
+    vst1q_u8(out + x, vqaddq_u8(vminq_u8(sum, trunc8), ham));
+  }
+}
+
+void CostRowNeon(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, const uint8_t* cimg,
+                 ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc, int32_t cw, uint8_t* out) {
+  if (f == 0) {
+    CostRowNeonT<false>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+  } else {
+    CostRowNeonT<true>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+  }
+}
+
+void HSumRowNeon(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum) {
+  if (x1 - x0 < 16) return HSumRowC(cost, x0, x1, hsum);
+  for (int32_t step = x0; step < x1; step += 16) {
+    const int32_t x = step + 16 <= x1 ? step : x1 - 16;
+    const uint8x16_t a = vld1q_u8(cost + x - 1), b = vld1q_u8(cost + x), c = vld1q_u8(cost + x + 1);
+    vst1q_u16(hsum + x, vaddw_u8(vaddl_u8(vget_low_u8(a), vget_low_u8(b)), vget_low_u8(c)));
+    vst1q_u16(hsum + x + 8, vaddw_u8(vaddl_u8(vget_high_u8(a), vget_high_u8(b)), vget_high_u8(c)));
+  }
+}
+
+inline int16x8_t Window(const uint16_t* const* rows, int32_t j, int32_t x) {
+  return vreinterpretq_s16_u16(
+      vaddq_u16(vaddq_u16(vld1q_u16(rows[3 * j] + x), vld1q_u16(rows[3 * j + 1] + x)),
+                vld1q_u16(rows[3 * j + 2] + x)));
+}
+
+// As the AVX2 kernel; vqrdmulh is (2 * sum * recip + 2^15) >> 16 = (sum * recip + 2^14) >> 15.
+template <int32_t kKeep>
+void SelectRowNeonT(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
+                    uint16_t* out) {
+  if (x1 - x0 < 8) return SelectRowC(rows, others, x0, x1, out);
+  const int16x8_t recip = vdupq_n_s16(static_cast<int16_t>(kKeep == 1 ? 0 : RecipQ15(kKeep)));
+  for (int32_t step = x0; step < x1; step += 8) {
+    const int32_t x = step + 8 <= x1 ? step : x1 - 8;
+    int16x8_t best[kKeep];
+    for (int32_t j = 0; j < kKeep; ++j) {
+      int16x8_t a = Window(rows, j, x);
+      for (int32_t i = 0; i < j; ++i) {
+        const int16x8_t lo = vminq_s16(best[i], a);
+        a = vmaxq_s16(best[i], a);
+        best[i] = lo;
+      }
+      best[j] = a;
+    }
+    for (int32_t j = kKeep; j < others; ++j) {
+      int16x8_t a = Window(rows, j, x);
+      for (int32_t i = 0; i < kKeep - 1; ++i) {
+        const int16x8_t lo = vminq_s16(best[i], a);
+        a = vmaxq_s16(best[i], a);
+        best[i] = lo;
+      }
+      best[kKeep - 1] = vminq_s16(best[kKeep - 1], a);
+    }
+    int16x8_t sum = best[0];
+    for (int32_t i = 1; i < kKeep; ++i) sum = vaddq_s16(sum, best[i]);
+    vst1q_u16(out + x, vreinterpretq_u16_s16(kKeep == 1 ? sum : vqrdmulhq_s16(sum, recip)));
+  }
+}
+
+void SelectRowNeon(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
+                   uint16_t* out) {
+  switch ((others + 1) / 2) {
+    case 1:
+      return SelectRowNeonT<1>(rows, others, x0, x1, out);
+    case 2:
+      return SelectRowNeonT<2>(rows, others, x0, x1, out);
+    case 3:
+      return SelectRowNeonT<3>(rows, others, x0, x1, out);
+    case 4:
+      return SelectRowNeonT<4>(rows, others, x0, x1, out);
+    case 5:
+      return SelectRowNeonT<5>(rows, others, x0, x1, out);
+    case 6:
+      return SelectRowNeonT<6>(rows, others, x0, x1, out);
+    case 7:
+      return SelectRowNeonT<7>(rows, others, x0, x1, out);
+    default:
+      return SelectRowNeonT<8>(rows, others, x0, x1, out);
+  }
+}
+
+}  // namespace
+
+const DataTerm::Kernels* SimdKernels() {
+  static constexpr DataTerm::Kernels kNeon = {CensusRowNeon, CostRowNeon, HSumRowNeon,
+                                              SelectRowNeon};
+  return &kNeon;
+}
+
+}  // namespace lb::dtk
+#endif
