@@ -62,7 +62,7 @@ Status DepthStage::Carve(Arena& arena) {
   const int32_t w = config_.width, h = config_.height;
   const size_t n = static_cast<size_t>(w) * h;
   data_.Carve(arena, w, h, config_.views);
-  maxflow_.Carve(arena, w * h);
+  maxflow_.Carve(arena, w, h);
   labels_ = arena.Allocate<uint8_t>(n);
   cost_ = arena.Allocate<uint16_t>(n);
   cost_alpha_ = arena.Allocate<uint16_t>(n);

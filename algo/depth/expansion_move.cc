@@ -119,6 +119,7 @@ int32_t DepthStage::BuildMove(int32_t alpha, int32_t y_lo, int32_t y_hi) {
       if (y > 0) backward(p - w, weight_down_[p - w]);
       maxflow_.SetNode(p - base, balance, cap_right, cap_down);
     }
+    maxflow_.RowDone(y - y_lo);
   }
   return free_pixels;
 }

@@ -117,14 +117,14 @@ int64_t Solve(const Graph& g, GridMaxflow& mf) {
 
 class MaxflowTest : public ::testing::Test {
  protected:
-  static constexpr int32_t kMaxNodes = 64 * 64;
+  static constexpr int32_t kMaxSide = 64;
   MaxflowTest() : memory_(Planned()), arena_(memory_.data(), memory_.size()) {
-    mf_.Carve(arena_, kMaxNodes);
+    mf_.Carve(arena_, kMaxSide, kMaxSide);
   }
   static size_t Planned() {
     Arena plan;
     GridMaxflow mf;
-    mf.Carve(plan, kMaxNodes);
+    mf.Carve(plan, kMaxSide, kMaxSide);
     return plan.used();
   }
   std::vector<uint8_t> memory_;
