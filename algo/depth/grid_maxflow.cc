@@ -39,6 +39,12 @@ void GridMaxflow::Begin(int32_t width, int32_t height) {
   memset(static_cast<void*>(nodes_ + count_), 0, row);
 }
 
+void GridMaxflow::Truncate(int32_t height) {
+  height_ = height;
+  count_ = width_ * height;
+  memset(static_cast<void*>(nodes_ + count_), 0, sizeof(Node) * static_cast<size_t>(width_));
+}
+
 void GridMaxflow::Reset(int32_t width, int32_t height) {
   Start(width, height);
   memset(static_cast<void*>(storage_), 0, sizeof(Node) * static_cast<size_t>(count_ + 2 * width));

@@ -49,6 +49,9 @@ class GridMaxflow {
     if (y >= 2) InitRow(inited_++);
   }
 
+  // Ends the graph after its first `height` rows (all RowDone), as if it had been begun so.
+  void Truncate(int32_t height);
+
   // Adds terminal capacities source->p and p->sink (both >= 0).
   void AddTerminal(int32_t p, int32_t cap_source, int32_t cap_sink) {
     const int32_t m = cap_source < cap_sink ? cap_source : cap_sink;
