@@ -85,7 +85,7 @@ class GridMaxflow {
   struct Node {
     int32_t cap[4];  // residual capacity of the arc to each neighbour
     int32_t tcap;    // residual terminal capacity: > 0 from the source, < 0 to the sink
-    int32_t next;    // active queue link (kNotActive when not queued, self at the tail)
+    int32_t queued;  // 1 while in the active queue
     int32_t ts;      // time stamp of the last verified distance to a terminal
     uint16_t dist;   // distance to the terminal (saturating; only a heuristic)
     uint8_t parent;  // a Dir, kTerminal or kOrphan
@@ -108,11 +108,14 @@ class GridMaxflow {
   Node* storage_ = nullptr;
   Node* nodes_ = nullptr;       // storage_ + width_: the first grid node
   int32_t* orphans_ = nullptr;  // ring buffer of max_nodes_ entries
+  // FIFO of active nodes, max_nodes_ entries (a node is queued at most once): unlike a linked
+  // list, it shows the nodes to come, which are prefetched.
+  int32_t* queue_ = nullptr;
   int32_t max_nodes_ = 0, max_width_ = 0;
   int32_t width_ = 0, height_ = 0, count_ = 0;
   int32_t offset_[4] = {};           // node index step in each direction
   int32_t pushed_ = 0, inited_ = 0;  // rows whose one-arc paths / initial trees are done
-  int32_t queue_head_ = kNotActive, queue_tail_ = kNotActive;
+  int32_t queue_head_ = 0, queue_count_ = 0;
   int32_t orphan_head_ = 0, orphan_count_ = 0;
   int32_t time_ = 0;
   int64_t flow_ = 0;
