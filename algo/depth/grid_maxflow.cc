@@ -69,7 +69,10 @@ int32_t GridMaxflow::NextActive() {
     if (queue_count_ > kAhead) {
       int32_t slot = queue_head_ + kAhead;
       if (slot >= max_nodes_) slot -= max_nodes_;
-      __builtin_prefetch(nodes_ + queue_[slot]);
+      const Node* ahead = nodes_ + queue_[slot];
+      __builtin_prefetch(ahead);
+      __builtin_prefetch(ahead - width_);
+      __builtin_prefetch(ahead + width_);
     }
     queue_head_ = queue_head_ + 1 == max_nodes_ ? 0 : queue_head_ + 1;
     --queue_count_;
