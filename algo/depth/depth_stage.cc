@@ -69,7 +69,7 @@ Status DepthStage::Carve(Arena& arena) {
   weight_right_ = arena.Allocate<uint16_t>(n);
   weight_down_ = arena.Allocate<uint16_t>(n);
   state_ = arena.Allocate<uint8_t>(n);
-  move_rows_ = arena.Allocate<int32_t>(static_cast<size_t>(10 * w));
+  move_rows_ = arena.Allocate<int32_t>(10 * static_cast<size_t>(w));
   prev_alpha_ = arena.Allocate<uint16_t>(n);
   below_ = arena.Allocate<uint16_t>(n);
   above_ = arena.Allocate<uint16_t>(n);

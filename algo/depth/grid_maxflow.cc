@@ -14,7 +14,8 @@ namespace lb {
 void GridMaxflow::Carve(Arena& arena, int32_t max_width, int32_t max_height) {
   max_nodes_ = max_width * max_height;
   max_width_ = max_width;
-  storage_ = arena.Allocate<Node>(static_cast<size_t>(max_nodes_ + 2 * max_width));
+  storage_ =
+      arena.Allocate<Node>(static_cast<size_t>(max_nodes_) + 2 * static_cast<size_t>(max_width));
   orphans_ = arena.Allocate<int32_t>(static_cast<size_t>(max_nodes_));
   queue_ = arena.Allocate<int32_t>(static_cast<size_t>(max_nodes_));
 }
