@@ -65,14 +65,14 @@ Status DepthStage::Carve(Arena& arena) {
   const int32_t w = config_.width, h = config_.height;
   const size_t n = static_cast<size_t>(w) * h;
   data_.Carve(arena, w, h, config_.views);
-  maxflow_.Carve(arena, w * h);
+  maxflow_.Carve(arena, w, h);
   labels_ = arena.Allocate<uint8_t>(n);
   cost_ = arena.Allocate<uint16_t>(n);
   cost_alpha_ = arena.Allocate<uint16_t>(n);
   weight_right_ = arena.Allocate<uint16_t>(n);
   weight_down_ = arena.Allocate<uint16_t>(n);
   state_ = arena.Allocate<uint8_t>(n);
-  sum_w_ = arena.Allocate<uint16_t>(static_cast<size_t>(w));
+  move_rows_ = arena.Allocate<int32_t>(10 * static_cast<size_t>(w));
   prev_alpha_ = arena.Allocate<uint16_t>(n);
   below_ = arena.Allocate<uint16_t>(n);
   above_ = arena.Allocate<uint16_t>(n);

@@ -106,8 +106,12 @@ class DepthStage {
   void WinnerTakeAll();
   // One alpha-expansion move (expansion_move.cc); returns true when it lowered the energy.
   bool Expand(int32_t alpha);
-  void Classify(int32_t alpha, int32_t* y_lo, int32_t* y_hi);
-  int32_t BuildMove(int32_t alpha, int32_t y_lo, int32_t y_hi);
+  int32_t ClassifyRow(int32_t alpha, int32_t y);
+  int32_t BuildRow(int32_t y, int32_t node_row);
+  enum : int32_t { kPairRight = 0, kPairDown = 1, kHigh = 2, kRowFree = 1, kRowTake = 2 };
+  int32_t* Ring(int32_t y, int32_t kind) {
+    return move_rows_ + ((y % 3) * 3 + kind) * config_.width;
+  }
   void Record(int32_t alpha);
   void Refine(ImageU16 disp_q8);
 
@@ -122,7 +126,7 @@ class DepthStage {
   uint16_t* weight_down_ = nullptr;
   enum : uint8_t { kFree = 0, kKeep = 1, kTake = 2 };
   uint8_t* state_ = nullptr;                      // per pixel in a move: free for the cut, or fixed
-  uint16_t* sum_w_ = nullptr;                     // one row: each pixel's pair weights summed
+  int32_t* move_rows_ = nullptr;                  // the moves' row ring (expansion_move.cc)
   int32_t smooth_[DepthConfig::kMaxLabels] = {};  // min(d, smooth_trunc) for a label distance d
   uint16_t* prev_alpha_ = nullptr;                // D of the previous move's label, prev_label_
   int32_t prev_label_ = -1;

@@ -20,127 +20,155 @@ inline int32_t Abs(int32_t v) { return v < 0 ? -v : v; }
 // p takes alpha. The bound u_p > trunc * sum(w_pq) settles textured pixels without looking at
 // the neighbours. With a move margin, pixels for which alpha costs more than that above their
 // label also keep it: a restricted move, still an exact cut over the pixels it frees, so the
-// energy still never rises, over a much smaller graph. Returns the rows holding free or
-// switching pixels in *y_lo..*y_hi (*y_hi < 0 when there are none).
-void DepthStage::Classify(int32_t alpha, int32_t* y_lo, int32_t* y_hi) {
+// energy still never rises, over a much smaller graph.
+//
+// Written as e_pq = B + C - A of each pair (symmetric in p and q, >= 0), C - A = e_pq - w_pq b_p
+// with b_p = V(fp, alpha) / w_pq, so u_p + sum(C - A) = u_p - b_p sum(w_pq) + sum(e_pq): one
+// branch-free pass per row. Row y keeps its e_pq to the right and down and that sum in the ring
+// slot y % 3 for pass 2. Returns kRowFree | kRowTake for the states present in the row.
+int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y) {
   const int32_t w = config_.width, h = config_.height;
   const int32_t margin = config_.move_margin > 0 ? config_.move_margin : INT32_MAX;
-  const int32_t trunc = config_.smooth_trunc;
-  *y_lo = h;
-  *y_hi = -1;
-  for (int32_t y = 0; y < h; ++y) {
-    const int32_t row = y * w;
-    uint8_t* state = state_ + row;
-    const uint16_t* ca = cost_alpha_ + row;
-    const uint16_t* cc = cost_ + row;
-    const uint16_t* wr = weight_right_ + row;
-    const uint16_t* wd = weight_down_ + row;
-    // Each pixel's pair weights summed (<= 4 * 4096); the right weight of the last column and
-    // the down weight of the last row are 0.
-    uint16_t* sum_w = sum_w_;
-    sum_w[0] = static_cast<uint16_t>(wr[0] + wd[0] + (y > 0 ? wd[-w] : 0));
-    for (int32_t x = 1; x < w; ++x) {
-      sum_w[x] = static_cast<uint16_t>(wr[x] + wr[x - 1] + wd[x] + (y > 0 ? wd[x - w] : 0));
-    }
-    bool open = false;
+  const int32_t k = config_.smooth_trunc;
+  const int32_t row = y * w;
+  const uint8_t* f = labels_ + row;
+  const uint8_t* fd = y + 1 < h ? f + w : f;  // the last row's down weights are 0
+  const uint16_t* wr = weight_right_ + row;
+  const uint16_t* wd = weight_down_ + row;
+  int32_t* er = Ring(y, kPairRight);
+  int32_t* ed = Ring(y, kPairDown);
+  int32_t* hi = Ring(y, kHigh);
+  int32_t* sw = move_rows_ + 9 * w;  // each pixel's pair weights summed
+  auto v = [k](int32_t a, int32_t b) {
+    const int32_t d = a > b ? a - b : b - a;
+    return d < k ? d : k;
+  };
+  for (int32_t x = 0; x + 1 < w; ++x) {
+    er[x] = wr[x] * (v(f[x], alpha) + v(f[x + 1], alpha) - v(f[x], f[x + 1]));
+  }
+  er[w - 1] = 0;
+  for (int32_t x = 0; x < w; ++x) {
+    ed[x] = wd[x] * (v(f[x], alpha) + v(fd[x], alpha) - v(f[x], fd[x]));
+  }
+  sw[0] = wr[0] + wd[0];
+  hi[0] = er[0] + ed[0];
+  for (int32_t x = 1; x < w; ++x) {
+    sw[x] = wr[x] + wr[x - 1] + wd[x];
+    hi[x] = er[x] + er[x - 1] + ed[x];
+  }
+  if (y > 0) {
+    const uint16_t* wu = wd - w;
+    const int32_t* eu = Ring(y - 1, kPairDown);
     for (int32_t x = 0; x < w; ++x) {
-      const int32_t u = ca[x] - cc[x];
-      int32_t limit = sum_w[x] * trunc;
-      limit = limit < 0xffff ? limit : 0xffff;
-      limit = limit < margin ? limit : margin;
-      state[x] = u > limit ? kKeep : kFree;
-      open |= u <= limit;
-    }
-    if (!open) continue;
-    const uint8_t* f = labels_ + row;
-    for (int32_t x = 0; x < w; ++x) {
-      if (state[x] == kKeep) continue;
-      const int32_t fp = f[x];
-      const int32_t u = ca[x] - cc[x];
-      if (fp == alpha || u - smooth_[Abs(fp - alpha)] * sum_w[x] > 0) {
-        state[x] = kKeep;
-        continue;
-      }
-      int32_t hi = u;
-      auto keep = [&](int32_t fq, int32_t wpq) {
-        hi += wpq * (smooth_[Abs(alpha - fq)] - smooth_[Abs(fp - fq)]);
-      };
-      if (x + 1 < w) keep(f[x + 1], wr[x]);
-      if (x > 0) keep(f[x - 1], wr[x - 1]);
-      if (y + 1 < h) keep(f[x + w], wd[x]);
-      if (y > 0) keep(f[x - w], wd[x - w]);
-      state[x] = hi < 0 ? kTake : kFree;
-      *y_lo = y < *y_lo ? y : *y_lo;
-      *y_hi = y;
+      sw[x] += wu[x];
+      hi[x] += eu[x];
     }
   }
+  const uint16_t* ca = cost_alpha_ + row;
+  const uint16_t* cc = cost_ + row;
+  uint8_t* state = state_ + row;
+  int32_t present = 0;
+  for (int32_t x = 0; x < w; ++x) {
+    const int32_t u = ca[x] - cc[x];
+    int32_t limit = sw[x] * k;
+    limit = limit < 0xffff ? limit : 0xffff;
+    limit = limit < margin ? limit : margin;
+    const int32_t lo = u - v(f[x], alpha) * sw[x];
+    hi[x] += lo;
+    const bool keep = u > limit || f[x] == alpha || lo > 0;
+    const uint8_t s = keep ? kKeep : (hi[x] < 0 ? kTake : kFree);
+    state[x] = s;
+    present |= (s == kFree ? kRowFree : 0) | (s == kTake ? kRowTake : 0);
+  }
+  return present;
 }
 
-// Pass 2: the graph over the free pixels of rows y_lo..y_hi (node = p - y_lo * w), each node
-// written once. A fixed neighbour turns a pair term into a unary one, E(x_p) = a + (c - a) x_p
-// with a = V(fp, lq), c = V(alpha, lq), lq the label the neighbour is fixed to; a free right or
-// down neighbour adds the pair's arc p -> q, and a free left or up neighbour q the -C of the
-// pair (q, p) to p's balance. Returns the number of free pixels.
-int32_t DepthStage::BuildMove(int32_t alpha, int32_t y_lo, int32_t y_hi) {
+// Pass 2, one row behind pass 1: row y's nodes of the 2-label graph over the free pixels (node
+// row `node_row`). A fixed neighbour q turns the pair into a unary term on p: C - A when q keeps
+// its label, -B = C - A - e_pq when it takes alpha. A free right or down neighbour makes the arc
+// p -> q of capacity e_pq (p's balance keeps C - A), and a free left or up neighbour q puts the
+// -C of the pair (q, p), here -B = C - A - e_pq, on p's balance. Returns the free pixels.
+int32_t DepthStage::BuildRow(int32_t y, int32_t node_row) {
   const int32_t w = config_.width, h = config_.height;
-  const int32_t base = y_lo * w;
-  maxflow_.Begin(w, y_hi - y_lo + 1);
+  const uint8_t* st = state_ + y * w;
+  const uint8_t* up = y > 0 ? st - w : nullptr;
+  const uint8_t* down = y + 1 < h ? st + w : nullptr;
+  const int32_t* er = Ring(y, kPairRight);
+  const int32_t* ed = Ring(y, kPairDown);
+  const int32_t* eu = y > 0 ? Ring(y - 1, kPairDown) : nullptr;
+  const int32_t* hi = Ring(y, kHigh);
+  const int32_t base = node_row * w;
   int32_t free_pixels = 0;
-  for (int32_t y = y_lo; y <= y_hi; ++y) {
-    for (int32_t x = 0; x < w; ++x) {
-      const int32_t p = y * w + x;
-      if (state_[p] != kFree) {
-        maxflow_.SetNode(p - base, 0, 0, 0);
-        continue;
-      }
-      ++free_pixels;
-      const int32_t fp = labels_[p];
-      const int32_t b1 = smooth_[Abs(fp - alpha)];  // B / w_pq, and C / w_pq of (q, p)
-      int32_t balance = cost_alpha_[p] - cost_[p];
-      int32_t cap_right = 0, cap_down = 0;
-      auto fixed = [&](int32_t q, int32_t wpq) {
-        const int32_t lq = state_[q] == kTake ? alpha : labels_[q];
-        balance += wpq * (smooth_[Abs(alpha - lq)] - smooth_[Abs(fp - lq)]);
-      };
-      auto forward = [&](int32_t q, int32_t wpq, int32_t* cap) {
-        if (state_[q] != kFree) return fixed(q, wpq);
-        const int32_t fq = labels_[q];
-        const int32_t a = wpq * smooth_[Abs(fp - fq)], c = wpq * smooth_[Abs(alpha - fq)];
-        balance += c - a;
-        *cap = wpq * b1 + c - a;
-      };
-      auto backward = [&](int32_t q, int32_t wpq) {
-        if (state_[q] != kFree) return fixed(q, wpq);
-        balance -= wpq * b1;
-      };
-      if (x + 1 < w) forward(p + 1, weight_right_[p], &cap_right);
-      if (x > 0) backward(p - 1, weight_right_[p - 1]);
-      if (y + 1 < h) forward(p + w, weight_down_[p], &cap_down);
-      if (y > 0) backward(p - w, weight_down_[p - w]);
-      maxflow_.SetNode(p - base, balance, cap_right, cap_down);
+  for (int32_t x = 0; x < w; ++x) {
+    if (st[x] != kFree) {
+      maxflow_.SetNode(base + x, 0, 0, 0);
+      continue;
     }
+    ++free_pixels;
+    int32_t balance = hi[x];
+    int32_t cap_right = 0, cap_down = 0;
+    if (x + 1 < w) {
+      if (st[x + 1] == kFree) cap_right = er[x];
+      if (st[x + 1] == kTake) balance -= er[x];
+    }
+    if (x > 0 && st[x - 1] != kKeep) balance -= er[x - 1];
+    if (down) {
+      if (down[x] == kFree) cap_down = ed[x];
+      if (down[x] == kTake) balance -= ed[x];
+    }
+    if (up && up[x] != kKeep) balance -= eu[x];
+    maxflow_.SetNode(base + x, balance, cap_right, cap_down);
   }
+  maxflow_.RowDone(node_row);
   return free_pixels;
 }
 
 bool DepthStage::Expand(int32_t alpha) {
   const int32_t w = config_.width, h = config_.height;
   LabelCosts(alpha, cost_alpha_);
-  int32_t y_lo = 0, y_hi = 0;
-  Classify(alpha, &y_lo, &y_hi);
+  // Rows with free or switching pixels (y_lo..y_hi), and the graph's rows g_lo..: rows without
+  // a free pixel are left out at either end, and written as empty rows only between two others.
+  int32_t y_lo = h, y_hi = -1, g_lo = -1, rows = 0, pending = 0, free_pixels = 0;
+  int32_t present = 0;
+  for (int32_t y = 0; y <= h; ++y) {
+    const int32_t above = present;
+    if (y < h) {
+      present = ClassifyRow(alpha, y);
+      if (present != 0) {
+        y_lo = y < y_lo ? y : y_lo;
+        y_hi = y;
+      }
+    }
+    if (y == 0) continue;
+    if (!(above & kRowFree)) {
+      pending += g_lo >= 0 ? 1 : 0;
+      continue;
+    }
+    if (g_lo < 0) {
+      g_lo = y - 1;
+      maxflow_.Begin(w, h - g_lo);
+    }
+    for (; pending > 0; --pending, ++rows) {
+      for (int32_t x = 0; x < w; ++x) maxflow_.SetNode(rows * w + x, 0, 0, 0);
+      maxflow_.RowDone(rows);
+    }
+    free_pixels += BuildRow(y - 1, rows++);
+  }
   if (y_hi < 0) {
     Record(alpha);
     return false;
   }
-  const int32_t base = y_lo * w;
-  const int32_t free_pixels = BuildMove(alpha, y_lo, y_hi);
   stats_.cut_pixels += free_pixels;
-  if (free_pixels > 0) (void)maxflow_.Solve();
-
-  // Apply, and update the energy from the pixels that changed and their pair terms.
-  for (int32_t p = base; p < (y_hi + 1) * w; ++p) {
-    if (state_[p] == kFree) state_[p] = maxflow_.InSource(p - base) ? kKeep : kTake;
+  if (free_pixels > 0) {
+    maxflow_.Truncate(rows);
+    (void)maxflow_.Solve();
+    const int32_t base = g_lo * w;
+    for (int32_t p = base; p < base + rows * w; ++p) {
+      if (state_[p] == kFree) state_[p] = maxflow_.InSource(p - base) ? kKeep : kTake;
+    }
   }
+
+  // Update the energy from the pixels that changed and their pair terms.
   int64_t delta = 0;
   for (int32_t y = y_lo; y <= y_hi; ++y) {
     for (int32_t x = 0; x < w; ++x) {

@@ -2,51 +2,83 @@
 // 2004) written for an implicit grid: two search trees grow from the terminals, an s-t path is
 // augmented as soon as they touch, and the nodes cut off by saturated arcs look for a new parent
 // in their own tree before they are freed. Time stamps and distances keep the trees shallow.
+//
+// The padding rows and the edge arcs hold 0 forever: flow only moves along arcs with residual
+// capacity, and a parent is only ever linked through one, so neither can become a tree link.
 #include "algo/depth/grid_maxflow.h"
 
 #include <cstring>
 
 namespace lb {
 
-void GridMaxflow::Carve(Arena& arena, int32_t max_nodes) {
-  max_nodes_ = max_nodes;
-  nodes_ = arena.Allocate<Node>(static_cast<size_t>(max_nodes));
-  orphans_ = arena.Allocate<int32_t>(static_cast<size_t>(max_nodes));
+void GridMaxflow::Carve(Arena& arena, int32_t max_width, int32_t max_height) {
+  max_nodes_ = max_width * max_height;
+  max_width_ = max_width;
+  storage_ =
+      arena.Allocate<Node>(static_cast<size_t>(max_nodes_) + 2 * static_cast<size_t>(max_width));
+  orphans_ = arena.Allocate<int32_t>(static_cast<size_t>(max_nodes_));
+  queue_ = arena.Allocate<int32_t>(static_cast<size_t>(max_nodes_));
 }
 
-void GridMaxflow::Reset(int32_t width, int32_t height) {
+void GridMaxflow::Start(int32_t width, int32_t height) {
   width_ = width;
   height_ = height;
   count_ = width * height;
-  memset(static_cast<void*>(nodes_), 0, sizeof(Node) * static_cast<size_t>(count_));
+  nodes_ = storage_ + width;
+  offset_[kRight] = 1;
+  offset_[kLeft] = -1;
+  offset_[kDown] = width;
+  offset_[kUp] = -width;
   flow_ = 0;
+  pushed_ = inited_ = 0;
+  queue_head_ = queue_count_ = 0;
 }
 
-uint32_t GridMaxflow::NeighbourMask(int32_t p) const {
-  const int32_t x = p % width_;  // one division per visit, not one per direction
-  return (x != width_ - 1 ? 1u << kRight : 0u) | (x != 0 ? 1u << kLeft : 0u) |
-         (p + width_ < count_ ? 1u << kDown : 0u) | (p >= width_ ? 1u << kUp : 0u);
+void GridMaxflow::Begin(int32_t width, int32_t height) {
+  Start(width, height);
+  const size_t row = sizeof(Node) * static_cast<size_t>(width);
+  memset(static_cast<void*>(storage_), 0, row);
+  memset(static_cast<void*>(nodes_ + count_), 0, row);
+}
+
+void GridMaxflow::Truncate(int32_t height) {
+  height_ = height;
+  count_ = width_ * height;
+  memset(static_cast<void*>(nodes_ + count_), 0, sizeof(Node) * static_cast<size_t>(width_));
+}
+
+void GridMaxflow::Reset(int32_t width, int32_t height) {
+  Start(width, height);
+  memset(static_cast<void*>(storage_), 0, sizeof(Node) * static_cast<size_t>(count_ + 2 * width));
 }
 
 void GridMaxflow::Activate(int32_t p) {
   Node& n = nodes_[p];
-  if (n.next != kNotActive) return;
-  n.next = p;  // the tail links to itself
-  if (queue_tail_ == kNotActive) {
-    queue_head_ = p;
-  } else {
-    nodes_[queue_tail_].next = p;
-  }
-  queue_tail_ = p;
+  if (n.queued) return;
+  n.queued = 1;
+  int32_t slot = queue_head_ + queue_count_;
+  if (slot >= max_nodes_) slot -= max_nodes_;
+  queue_[slot] = p;
+  ++queue_count_;
 }
 
 int32_t GridMaxflow::NextActive() {
-  while (queue_head_ != kNotActive) {
-    const int32_t p = queue_head_;
+  // Far enough ahead to hide a miss, near enough that the lines are still cached when used.
+  constexpr int32_t kAhead = 8;
+  while (queue_count_ > 0) {
+    const int32_t p = queue_[queue_head_];
+    if (queue_count_ > kAhead) {
+      int32_t slot = queue_head_ + kAhead;
+      if (slot >= max_nodes_) slot -= max_nodes_;
+      const Node* ahead = nodes_ + queue_[slot];
+      __builtin_prefetch(ahead);
+      __builtin_prefetch(ahead - width_);
+      __builtin_prefetch(ahead + width_);
+    }
+    queue_head_ = queue_head_ + 1 == max_nodes_ ? 0 : queue_head_ + 1;
+    --queue_count_;
     Node& n = nodes_[p];
-    queue_head_ = (n.next == p) ? kNotActive : n.next;
-    if (queue_head_ == kNotActive) queue_tail_ = kNotActive;
-    n.next = kNotActive;
+    n.queued = 0;
     if (n.tree != kFree) return p;
   }
   return kNotActive;
@@ -62,7 +94,7 @@ void GridMaxflow::PushOrphan(int32_t p) {
 
 // s_node is in the source tree, its neighbour in direction `dir` in the sink tree.
 void GridMaxflow::Augment(int32_t s_node, int dir) {
-  const int32_t t_node = Neighbour(s_node, dir);
+  const int32_t t_node = s_node + offset_[dir];
   int32_t bottleneck = nodes_[s_node].cap[dir];
   // Source side: arcs parent -> child, up to the root's source capacity.
   for (int32_t p = s_node;;) {
@@ -71,9 +103,8 @@ void GridMaxflow::Augment(int32_t s_node, int dir) {
       if (n.tcap < bottleneck) bottleneck = n.tcap;
       break;
     }
-    const int32_t parent = Neighbour(p, n.parent);
+    const int32_t parent = p + offset_[n.parent];
     const int32_t c = nodes_[parent].cap[n.parent ^ 1];
-
     if (c < bottleneck) bottleneck = c;
     p = parent;
   }
@@ -85,7 +116,7 @@ void GridMaxflow::Augment(int32_t s_node, int dir) {
       break;
     }
     if (n.cap[n.parent] < bottleneck) bottleneck = n.cap[n.parent];
-    p = Neighbour(p, n.parent);
+    p += offset_[n.parent];
   }
 
   nodes_[s_node].cap[dir] -= bottleneck;
@@ -97,11 +128,10 @@ void GridMaxflow::Augment(int32_t s_node, int dir) {
       if (n.tcap == 0) PushOrphan(p);
       break;
     }
-    const int32_t parent = Neighbour(p, n.parent);
     const int d = n.parent;
+    const int32_t parent = p + offset_[d];
     n.cap[d] += bottleneck;
-    nodes_[parent].cap[d ^ 1] -= bottleneck;
-    if (nodes_[parent].cap[d ^ 1] == 0) PushOrphan(p);
+    if ((nodes_[parent].cap[d ^ 1] -= bottleneck) == 0) PushOrphan(p);
     p = parent;
   }
   for (int32_t p = t_node;;) {
@@ -111,29 +141,28 @@ void GridMaxflow::Augment(int32_t s_node, int dir) {
       if (n.tcap == 0) PushOrphan(p);
       break;
     }
-    const int32_t parent = Neighbour(p, n.parent);
     const int d = n.parent;
-    n.cap[d] -= bottleneck;
+    const int32_t parent = p + offset_[d];
     nodes_[parent].cap[d ^ 1] += bottleneck;
-    if (n.cap[d] == 0) PushOrphan(p);
+    if ((n.cap[d] -= bottleneck) == 0) PushOrphan(p);
     p = parent;
   }
   flow_ += bottleneck;
 }
 
 // Finds a new parent for orphan p in its own tree, or frees it and orphans its children.
+template <bool kSource>
 void GridMaxflow::Adopt(int32_t p) {
   Node& n = nodes_[p];
-  const bool source = n.tree == kSourceTree;
+  const uint8_t tree = kSource ? kSourceTree : kSinkTree;
   int best_dir = -1;
   uint32_t best_dist = UINT32_MAX;
-  const uint32_t mask = NeighbourMask(p);
   for (int dir = 0; dir < 4; ++dir) {
-    if (!(mask & (1u << dir))) continue;
-    const int32_t q = Neighbour(p, dir);
-    if (nodes_[q].tree != n.tree) continue;
+    const int32_t q = p + offset_[dir];
+    Node& first = nodes_[q];
+    if (first.tree != tree) continue;
     // The arc that would carry flow from the new parent: q->p in the source tree, p->q in the sink.
-    const int32_t c = source ? nodes_[q].cap[dir ^ 1] : n.cap[dir];
+    const int32_t c = kSource ? first.cap[dir ^ 1] : n.cap[dir];
     if (c <= 0) continue;
     // Walk up from q: does it reach the terminal without passing through an orphan?
     uint32_t d = 0;
@@ -153,7 +182,7 @@ void GridMaxflow::Adopt(int32_t p) {
         break;
       }
       if (m.parent == kOrphan) break;
-      j = Neighbour(j, m.parent);
+      j += offset_[m.parent];
     }
     if (!valid) continue;
     if (d < best_dist) {
@@ -166,7 +195,7 @@ void GridMaxflow::Adopt(int32_t p) {
       m.ts = time_;
       m.dist = static_cast<uint16_t>(d > 0xffff ? 0xffff : d);
       --d;
-      j = Neighbour(j, m.parent);
+      j += offset_[m.parent];
     }
   }
   if (best_dir >= 0) {
@@ -178,20 +207,20 @@ void GridMaxflow::Adopt(int32_t p) {
   // No parent: p leaves its tree. Neighbours that could feed it become active again, and its
   // children become orphans.
   for (int dir = 0; dir < 4; ++dir) {
-    if (!(mask & (1u << dir))) continue;
-    const int32_t q = Neighbour(p, dir);
+    const int32_t q = p + offset_[dir];
     Node& m = nodes_[q];
-    if (m.tree != n.tree) continue;
-    const int32_t c = source ? m.cap[dir ^ 1] : n.cap[dir];
+    if (m.tree != tree) continue;
+    const int32_t c = kSource ? m.cap[dir ^ 1] : n.cap[dir];
     if (c > 0) Activate(q);
     if (m.parent == (dir ^ 1)) PushOrphan(q);
   }
   n.tree = kFree;
 }
 
-// Augments every path source -> p -> q -> sink over one arc in one raster pass, before any tree
-// search: the asymmetric split of the pair terms leaves many such neighbouring pairs.
-void GridMaxflow::PushDirect() {
+// Augments every path source -> p -> q -> sink over one arc of row y, before any tree search:
+// the asymmetric split of the pair terms leaves many such neighbouring pairs. Needs row y + 1
+// set, and is the last change to row y's terminal balances.
+void GridMaxflow::PushRow(int32_t y) {
   const int32_t w = width_;
   auto push = [&](Node& from, Node& to, int dir) {
     int32_t d = from.tcap < -to.tcap ? from.tcap : -to.tcap;
@@ -202,102 +231,107 @@ void GridMaxflow::PushDirect() {
     to.cap[dir ^ 1] += d;
     flow_ += d;
   };
-  for (int32_t y = 0; y < height_; ++y) {
-    for (int32_t x = 0; x < w; ++x) {
-      const int32_t p = y * w + x;
-      Node& n = nodes_[p];
-      if (n.tcap == 0) continue;
-      if (x + 1 < w) {
-        Node& m = nodes_[p + 1];
-        if (n.tcap > 0 && m.tcap < 0)
-          push(n, m, kRight);
-        else if (n.tcap < 0 && m.tcap > 0)
-          push(m, n, kLeft);
-      }
-      if (y + 1 < height_) {
-        Node& m = nodes_[p + w];
-        if (n.tcap > 0 && m.tcap < 0)
-          push(n, m, kDown);
-        else if (n.tcap < 0 && m.tcap > 0)
-          push(m, n, kUp);
-      }
+  Node* row = nodes_ + y * w;
+  const bool down = y + 1 < height_;
+  for (int32_t x = 0; x < w; ++x) {
+    Node& n = row[x];
+    if (n.tcap == 0) continue;
+    if (x + 1 < w) {
+      Node& m = row[x + 1];
+      if (n.tcap > 0 && m.tcap < 0)
+        push(n, m, kRight);
+      else if (n.tcap < 0 && m.tcap > 0)
+        push(m, n, kLeft);
+    }
+    if (down) {
+      Node& m = row[x + w];
+      if (n.tcap > 0 && m.tcap < 0)
+        push(n, m, kDown);
+      else if (n.tcap < 0 && m.tcap > 0)
+        push(m, n, kUp);
     }
   }
 }
 
-int64_t GridMaxflow::Solve() {
-  queue_head_ = queue_tail_ = kNotActive;
-  orphan_head_ = orphan_count_ = 0;
-  time_ = 0;
-  PushDirect();
+// Roots of row y; needs the final balances of rows y - 1..y + 1.
+void GridMaxflow::InitRow(int32_t y) {
   const int32_t w = width_;
-  for (int32_t y = 0; y < height_; ++y) {
-    for (int32_t x = 0; x < w; ++x) {
-      const int32_t p = y * w + x;
-      Node& n = nodes_[p];
-      n.next = kNotActive;
-      n.ts = 0;
-      n.dist = 1;
-      if (n.tcap == 0) {
-        n.tree = kFree;
-        n.parent = kOrphan;
-        continue;
-      }
-      n.parent = kTerminal;
-      // Only a root with a residual arc into another tree (or to a free node) can grow; the
-      // rest become active later if a neighbour leaves their tree (Adopt activates them).
-      bool grows = false;
-      if (n.tcap > 0) {
-        n.tree = kSourceTree;
-        grows = (x + 1 < w && n.cap[kRight] > 0 && nodes_[p + 1].tcap <= 0) ||
-                (x > 0 && n.cap[kLeft] > 0 && nodes_[p - 1].tcap <= 0) ||
-                (y + 1 < height_ && n.cap[kDown] > 0 && nodes_[p + w].tcap <= 0) ||
-                (y > 0 && n.cap[kUp] > 0 && nodes_[p - w].tcap <= 0);
-      } else {
-        n.tree = kSinkTree;
-        grows = (x + 1 < w && nodes_[p + 1].cap[kLeft] > 0 && nodes_[p + 1].tcap >= 0) ||
-                (x > 0 && nodes_[p - 1].cap[kRight] > 0 && nodes_[p - 1].tcap >= 0) ||
-                (y + 1 < height_ && nodes_[p + w].cap[kUp] > 0 && nodes_[p + w].tcap >= 0) ||
-                (y > 0 && nodes_[p - w].cap[kDown] > 0 && nodes_[p - w].tcap >= 0);
-      }
-      if (grows) Activate(p);
+  Node* row = nodes_ + y * w;
+  for (int32_t x = 0; x < w; ++x) {
+    Node& n = row[x];
+    n.queued = 0;
+    n.ts = 0;
+    n.dist = 1;
+    if (n.tcap == 0) {
+      n.tree = kFree;
+      n.parent = kOrphan;
+      continue;
+    }
+    n.parent = kTerminal;
+    // Only a root with a residual arc into another tree (or to a free node) can grow; the
+    // rest become active later if a neighbour leaves their tree (Adopt activates them).
+    bool grows = false;
+    const Node &r = row[x + 1], &l = row[x - 1], &d = row[x + w], &u = row[x - w];
+    if (n.tcap > 0) {
+      n.tree = kSourceTree;
+      grows = (n.cap[kRight] > 0 && r.tcap <= 0) || (n.cap[kLeft] > 0 && l.tcap <= 0) ||
+              (n.cap[kDown] > 0 && d.tcap <= 0) || (n.cap[kUp] > 0 && u.tcap <= 0);
+    } else {
+      n.tree = kSinkTree;
+      grows = (r.cap[kLeft] > 0 && r.tcap >= 0) || (l.cap[kRight] > 0 && l.tcap >= 0) ||
+              (d.cap[kUp] > 0 && d.tcap >= 0) || (u.cap[kDown] > 0 && u.tcap >= 0);
+    }
+    if (grows) Activate(static_cast<int32_t>(&n - nodes_));
+  }
+}
+
+// Scans p's arcs out of its tree: claims free neighbours, and on touching the other tree returns
+// true with the touching arc as (source-side node, direction).
+template <bool kSource>
+bool GridMaxflow::Grow(int32_t p, int32_t* s_node, int* s_dir) {
+  Node& n = nodes_[p];
+  const uint8_t tree = kSource ? kSourceTree : kSinkTree;
+  for (int dir = 0; dir < 4; ++dir) {
+    const int32_t q = p + offset_[dir];
+    Node& m = nodes_[q];
+    const int32_t c = kSource ? n.cap[dir] : m.cap[dir ^ 1];
+    if (c <= 0) continue;
+    if (m.tree == kFree) {
+      m.tree = tree;
+      m.parent = static_cast<uint8_t>(dir ^ 1);
+      m.ts = n.ts;
+      m.dist = static_cast<uint16_t>(n.dist == 0xffff ? 0xffff : n.dist + 1);
+      Activate(q);
+    } else if (m.tree != tree) {
+      *s_node = kSource ? p : q;
+      *s_dir = kSource ? dir : (dir ^ 1);
+      return true;
+    } else if (m.ts <= n.ts && m.dist > n.dist) {
+      // p is a closer parent for q than the one it has.
+      m.parent = static_cast<uint8_t>(dir ^ 1);
+      m.ts = n.ts;
+      m.dist = static_cast<uint16_t>(n.dist + 1);
     }
   }
+  return false;
+}
+
+int64_t GridMaxflow::Solve() {
+  while (pushed_ < height_) PushRow(pushed_++);
+  while (inited_ < height_) InitRow(inited_++);
+  orphan_head_ = orphan_count_ = 0;
+  time_ = 0;
 
   int32_t current = kNotActive;
   for (;;) {
     if (current == kNotActive || nodes_[current].tree == kFree) current = NextActive();
     if (current == kNotActive) break;
     const int32_t p = current;
-
-    Node& n = nodes_[p];
-    const bool source = n.tree == kSourceTree;
-    int32_t touch_s = -1;
+    int32_t touch_s = 0;
     int touch_dir = 0;
-    const uint32_t mask = NeighbourMask(p);
-    for (int dir = 0; dir < 4 && touch_s < 0; ++dir) {
-      if (!(mask & (1u << dir))) continue;
-      const int32_t q = Neighbour(p, dir);
-      const int32_t c = source ? n.cap[dir] : nodes_[q].cap[dir ^ 1];
-      if (c <= 0) continue;
-      Node& m = nodes_[q];
-      if (m.tree == kFree) {
-        m.tree = n.tree;
-        m.parent = static_cast<uint8_t>(dir ^ 1);
-        m.ts = n.ts;
-        m.dist = static_cast<uint16_t>(n.dist == 0xffff ? 0xffff : n.dist + 1);
-        Activate(q);
-      } else if (m.tree != n.tree) {
-        touch_s = source ? p : q;
-        touch_dir = source ? dir : (dir ^ 1);
-      } else if (m.ts <= n.ts && m.dist > n.dist) {
-        // p is a closer parent for q than the one it has.
-        m.parent = static_cast<uint8_t>(dir ^ 1);
-        m.ts = n.ts;
-        m.dist = static_cast<uint16_t>(n.dist + 1);
-      }
-    }
-    if (touch_s < 0) {
+    const bool touched = nodes_[p].tree == kSourceTree ? Grow<true>(p, &touch_s, &touch_dir)
+                                                       : Grow<false>(p, &touch_s, &touch_dir);
+    if (!touched) {
       current = kNotActive;
       continue;
     }
@@ -307,7 +341,11 @@ int64_t GridMaxflow::Solve() {
       const int32_t o = orphans_[orphan_head_];
       orphan_head_ = orphan_head_ + 1 == max_nodes_ ? 0 : orphan_head_ + 1;
       --orphan_count_;
-      Adopt(o);
+      if (nodes_[o].tree == kSourceTree) {
+        Adopt<true>(o);
+      } else {
+        Adopt<false>(o);
+      }
     }
     // Keep growing from p while it is still in a tree: it may touch the other tree again.
   }

@@ -1,6 +1,9 @@
 // Boykov-Kolmogorov max-flow on an implicit 4-connected grid: node p = y * width + x, arcs to the
 // right, left, down and up neighbours found by arithmetic, so there are no adjacency lists. All
 // node storage is carved once for the largest grid and reused by every expansion move (Reset).
+// A zeroed row above and below the grid, and arcs across the left and right edges that stay 0
+// (the last node of a row and the first of the next see each other through them), let every
+// visit look at all four neighbours without a boundary test.
 //
 // Capacities are int32 and must stay within kMaxCapacity so that the residual of an arc (its own
 // capacity plus its sister's) and a node's terminal balance cannot overflow; flow totals are int64.
@@ -19,22 +22,19 @@ class GridMaxflow {
   // Arc directions; the sister of arc (p, d) is (neighbour(p, d), d ^ 1).
   enum Dir : uint8_t { kRight = 0, kLeft = 1, kDown = 2, kUp = 3 };
 
-  // Carves node storage for grids of up to `max_nodes` nodes.
-  void Carve(Arena& arena, int32_t max_nodes);
+  // Carves node storage for grids of up to max_width x max_height nodes.
+  void Carve(Arena& arena, int32_t max_width, int32_t max_height);
 
-  // Starts a new graph of width x height nodes (width * height <= max_nodes), all capacities 0.
+  // Starts a new graph of width x height nodes, all capacities 0.
   void Reset(int32_t width, int32_t height);
 
   // Starts a new graph of width x height nodes whose every node the caller then sets once with
-  // SetNode (no clearing pass).
-  void Begin(int32_t width, int32_t height) {
-    width_ = width;
-    height_ = height;
-    count_ = width * height;
-    flow_ = 0;
-  }
+  // SetNode, row by row, calling RowDone after each row (no clearing pass: the one-arc paths
+  // and the initial trees are prepared two rows behind, while the rows are still in cache).
+  void Begin(int32_t width, int32_t height);
   // Sets node p: its terminal balance (as AddTerminalBalance) and its arcs to the right and down
-  // neighbours; the sister arcs from those neighbours are 0.
+  // neighbours, which must be 0 in the last column and the last row; the sister arcs from those
+  // neighbours are 0.
   void SetNode(int32_t p, int32_t balance, int32_t cap_right, int32_t cap_down) {
     Node& n = nodes_[p];
     n.cap[kRight] = cap_right;
@@ -43,6 +43,14 @@ class GridMaxflow {
     n.cap[kUp] = 0;
     n.tcap = balance;
   }
+  // Every node of rows 0..y is set.
+  void RowDone(int32_t y) {
+    if (y >= 1) PushRow(pushed_++);
+    if (y >= 2) InitRow(inited_++);
+  }
+
+  // Ends the graph after its first `height` rows (all RowDone), as if it had been begun so.
+  void Truncate(int32_t height);
 
   // Adds terminal capacities source->p and p->sink (both >= 0).
   void AddTerminal(int32_t p, int32_t cap_source, int32_t cap_sink) {
@@ -53,10 +61,11 @@ class GridMaxflow {
   // Adds a signed terminal balance: positive goes to source->p, negative to p->sink.
   void AddTerminalBalance(int32_t p, int32_t balance) { nodes_[p].tcap += balance; }
 
-  // Adds capacity to the arc p->q and its sister q->p, q = neighbour of p in direction `dir`.
+  // Adds capacity to the arc p->q and its sister q->p, q = neighbour of p in direction `dir`
+  // (inside the grid).
   void AddEdge(int32_t p, Dir dir, int32_t cap_pq, int32_t cap_qp) {
     nodes_[p].cap[dir] += cap_pq;
-    nodes_[Neighbour(p, dir)].cap[dir ^ 1] += cap_qp;
+    nodes_[p + offset_[dir]].cap[dir ^ 1] += cap_qp;
   }
 
   // Computes the maximum flow (including what AddTerminal routed directly).
@@ -76,7 +85,7 @@ class GridMaxflow {
   struct Node {
     int32_t cap[4];  // residual capacity of the arc to each neighbour
     int32_t tcap;    // residual terminal capacity: > 0 from the source, < 0 to the sink
-    int32_t next;    // active queue link (kNotActive when not queued, self at the tail)
+    int32_t queued;  // 1 while in the active queue
     int32_t ts;      // time stamp of the last verified distance to a terminal
     uint16_t dist;   // distance to the terminal (saturating; only a heuristic)
     uint8_t parent;  // a Dir, kTerminal or kOrphan
@@ -84,33 +93,29 @@ class GridMaxflow {
   };
   static_assert(sizeof(Node) == 32);
 
-  int32_t Neighbour(int32_t p, int dir) const {
-    switch (dir) {
-      case kRight:
-        return p + 1;
-      case kLeft:
-        return p - 1;
-      case kDown:
-        return p + width_;
-      default:
-        return p - width_;
-    }
-  }
-  // Bit d set when node p has a neighbour in direction d.
-  uint32_t NeighbourMask(int32_t p) const;
-
-  void PushDirect();
+  void Start(int32_t width, int32_t height);
+  void PushRow(int32_t y);
+  void InitRow(int32_t y);
   void Activate(int32_t p);
   int32_t NextActive();
+  template <bool kSource>
+  bool Grow(int32_t p, int32_t* s_node, int* dir);
   void Augment(int32_t s_node, int dir);
+  template <bool kSource>
   void Adopt(int32_t p);
   void PushOrphan(int32_t p);
 
-  Node* nodes_ = nullptr;
+  Node* storage_ = nullptr;
+  Node* nodes_ = nullptr;       // storage_ + width_: the first grid node
   int32_t* orphans_ = nullptr;  // ring buffer of max_nodes_ entries
-  int32_t max_nodes_ = 0;
+  // FIFO of active nodes, max_nodes_ entries (a node is queued at most once): unlike a linked
+  // list, it shows the nodes to come, which are prefetched.
+  int32_t* queue_ = nullptr;
+  int32_t max_nodes_ = 0, max_width_ = 0;
   int32_t width_ = 0, height_ = 0, count_ = 0;
-  int32_t queue_head_ = kNotActive, queue_tail_ = kNotActive;
+  int32_t offset_[4] = {};           // node index step in each direction
+  int32_t pushed_ = 0, inited_ = 0;  // rows whose one-arc paths / initial trees are done
+  int32_t queue_head_ = 0, queue_count_ = 0;
   int32_t orphan_head_ = 0, orphan_count_ = 0;
   int32_t time_ = 0;
   int64_t flow_ = 0;
