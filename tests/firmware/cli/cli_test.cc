@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "tests/algo/motion/burst.h"
 #include "tests/sim/files/test_images.h"
 
 namespace lb {
@@ -134,6 +135,33 @@ TEST_F(Cli, BurstWithoutMotionSavesAnUnblurredPhotoAndSaysWhy) {
   EXPECT_NE(r.err.find("warning"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("not blurred"), std::string::npos) << r.err;
   EXPECT_GT(Slurp(Out()).size(), 1000u);
+}
+
+TEST_F(Cli, DepthOfAHandheldBurstFindsItsOwnGeometry) {
+  motiontest::Burst b;
+  ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(3), 320, 240, 5, &b));
+  std::vector<std::string> args = {"depth",           "--labels",      "16",
+                                   "--disparity-out", dir_ + "/d.pfm", "--views"};
+  for (int v = 0; v < 5; ++v) {
+    args.push_back(dir_ + "/h" + std::to_string(v) + ".ppm");
+    const std::vector<uint16_t> samples(b.pixels[v].begin(), b.pixels[v].end());
+    ASSERT_TRUE(test::WriteFile(args.back(), test::EncodePnm("P6", 320, 240, 255, samples)));
+  }
+  Result r = Run(args);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string pfm = Slurp(dir_ + "/d.pfm");
+  EXPECT_EQ(pfm.rfind("Pf\n320 240\n", 0), 0u) << pfm.substr(0, 20);
+  const size_t header = pfm.find('\n', pfm.find('\n', 3) + 1) + 1;  // "Pf", size, scale lines
+  EXPECT_EQ(pfm.size(), header + 320u * 240 * 4) << "header then one float a pixel";
+
+  // The same frame five times: no motion to find, a clear error and no file.
+  for (int v = 1; v < 5; ++v) args[6 + v] = args[6];
+  args[4] = dir_ + "/still.pfm";
+  r = Run(args);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("sideways"), std::string::npos) << r.err;
+  EXPECT_EQ(Slurp(dir_ + "/still.pfm"), "");
 }
 
 TEST_F(Cli, TruncatedPpm) {

@@ -101,6 +101,20 @@ TEST(ConfigTest, ValuesReachTheSettings) {
   EXPECT_EQ(o.render.aperture.blades, 6);
 }
 
+TEST(ConfigTest, GeometryAndLensReachTheJob) {
+  DaemonConfig c;
+  EXPECT_EQ(MakeJobOptions(c).pipeline.geometry, Geometry::kAuto) << "a camera is handheld";
+  ASSERT_TRUE(Parse("geometry = rectified\nfocal_35mm = 28\n", &c).ok());
+  const JobOptions o = MakeJobOptions(c);
+  EXPECT_EQ(o.pipeline.geometry, Geometry::kRectified);
+  EXPECT_EQ(o.focal_35mm, 28);
+  EXPECT_EQ(Error("geometry = tripod\n"),
+            "test.conf:1: geometry: 'tripod' is neither auto nor rectified");
+  EXPECT_EQ(Error("focal_35mm = 4\n"), "test.conf:1: focal_35mm: 4 mm is no lens");
+  EXPECT_EQ(Error("focal_35mm = 9000\n"),
+            "test.conf:1: focal_35mm: '9000' is not a whole number from 0 to 2000");
+}
+
 TEST(ConfigTest, NativeResolutionAutoDeviceAndPointFocus) {
   DaemonConfig c;
   c.device = "/dev/video9";
