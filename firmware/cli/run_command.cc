@@ -224,6 +224,12 @@ int RunCommand(int argc, char** argv) {
       out_path.c_str(), report.width, report.height, runner.mode().frames,
       report.focus_disp_q8 / 256.0, report.capture_s, report.depth_s, report.render_s,
       static_cast<double>(report.arena_bytes) / (1024.0 * 1024.0));
+  const Pipeline& p = runner.pipeline();
+  if (job.pipeline.geometry == Geometry::kAuto && report.warning.ok()) {
+    printf(
+        "motion: %d points followed (reprojection %.2f px), depth labels %.2f..%.2f px per frame\n",
+        p.motion().points, p.motion().rms_px, p.disp_min_q8() / 256.0, p.disp_max_q8() / 256.0);
+  }
   return 0;
 }
 
