@@ -130,7 +130,14 @@ Status MotionStage::Estimate(const ConstImageU8* views, int32_t reference,
   result->reference = reference;
   result->intrinsics = k;
   LB_RETURN_IF_ERROR(Track(views, reference, result));
-  LB_RETURN_IF_ERROR(Adjust(k, reference, result));
+  const Status adjusted = Adjust(k, reference, result);
+  if (adjusted.code() == Code::kDegenerate) {
+    // Nothing to adjust (no point followed into any frame): say why in the user's terms, a
+    // blurred frame or points lost, rather than the adjustment's.
+    const Status why = Check(result);
+    return why.ok() ? adjusted : why;
+  }
+  LB_RETURN_IF_ERROR(adjusted);
   return Check(result);
 }
 

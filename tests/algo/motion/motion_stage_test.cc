@@ -158,6 +158,26 @@ TEST(MotionStageDegenerate, BlurredFrameIsReported) {
       << run.status.message();
 }
 
+TEST(MotionStageDegenerate, FramesWithNothingInCommonAreLostTracking) {
+  Burst b;
+  ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(10), 320, 240, 5, &b));
+  // Every other frame is unrelated noise (a sensor gone wrong, a hand over the lens).
+  uint32_t state = 12345;
+  for (int32_t v = 0; v < 5; ++v) {
+    if (v == b.scene.reference()) continue;
+    for (auto& p : b.pixels[v]) {
+      state = state * 1664525u + 1013904223u;
+      p = static_cast<uint8_t>(state >> 24);
+    }
+  }
+  Estimation run;
+  Estimate(b, &run);
+  EXPECT_EQ(run.status.code(), Code::kDegenerate);
+  EXPECT_EQ(run.result.diagnosis, MotionDiagnosis::kLostTracking) << run.status.message();
+  EXPECT_NE(std::strstr(run.status.message(), "could be followed"), nullptr)
+      << run.status.message();
+}
+
 TEST(MotionStage, RejectsViewsThatDoNotMatchTheConfiguration) {
   Burst b;
   ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(1), 320, 240, 3, &b));
