@@ -30,6 +30,16 @@ inline CameraIntrinsics IntrinsicsFromFocal(double focal_mm, double sensor_width
   return {f, f, 0.5 * width, 0.5 * height};
 }
 
+// A 35 mm equivalent focal length (mm) as px of a width x height image, and back: the equivalent
+// is defined on the 43.27 mm diagonal of a 36 x 24 mm frame, so any aspect ratio works.
+inline double FocalPxFrom35mm(double focal_35mm, int32_t width, int32_t height) {
+  return focal_35mm * __builtin_sqrt(double{1} * width * width + double{1} * height * height) /
+         43.27;
+}
+inline double Focal35mmFromPx(double focal_px, int32_t width, int32_t height) {
+  return focal_px / FocalPxFrom35mm(1.0, width, height);
+}
+
 struct ViewMotion {
   double rotation[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   double translation[3] = {0, 0, 0};

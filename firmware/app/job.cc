@@ -1,10 +1,10 @@
 #include "firmware/app/job.h"
 
-#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
 
+#include "algo/motion/camera.h"
 #include "firmware/app/refocusable.h"
 #include "firmware/jpeg/jpeg_writer.h"
 #include "firmware/storage/atomic_file.h"
@@ -25,12 +25,6 @@ void FormatExifTime(char* out, size_t size) {
   strftime(out, size, "%Y:%m:%d %H:%M:%S", &local);
 }
 
-// The frame's diagonal in px: the 35 mm equivalent focal length is defined on the 43.27 mm
-// diagonal of a 36 x 24 mm frame (see sim/files/exif_focal.h).
-double Diagonal(const SensorMode& mode) {
-  return std::hypot(static_cast<double>(mode.width), static_cast<double>(mode.height));
-}
-
 }  // namespace
 
 void Job::FreeDeleter::operator()(void* p) const { free(p); }
@@ -47,7 +41,7 @@ Status Job::Configure(Sensor* sensor, const JobOptions& options) {
   pc.height = mode_.height;
   pc.frames = mode_.frames;
   if (mode_.focal_px == 0 && options.focal_35mm > 0) {
-    mode_.focal_px = options.focal_35mm * Diagonal(mode_) / 43.27;
+    mode_.focal_px = FocalPxFrom35mm(options.focal_35mm, mode_.width, mode_.height);
   }
   if (pc.focal_px == 0) pc.focal_px = mode_.focal_px;
   if (pc.reference < 0 || pc.reference >= pc.frames) pc.reference = pc.frames / 2;
@@ -95,8 +89,8 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
   meta.datetime_original = when;
   meta.f_number = options_.render.f_number;
   if (mode_.focal_px > 0) {
-    // The 35 mm equivalent is defined on the 43.27 mm diagonal (see sim/files/exif_focal.h).
-    meta.focal_35mm = static_cast<int32_t>(mode_.focal_px * 43.27 / Diagonal(mode_) + 0.5);
+    meta.focal_35mm =
+        static_cast<int32_t>(Focal35mmFromPx(mode_.focal_px, mode_.width, mode_.height) + 0.5);
   }
   if (options_.refocusable) {
     // The XMP precedes the image data, so it is built before the first strip is encoded.

@@ -2,7 +2,6 @@
 // PFM, and optionally a colour-mapped PNG preview. With --geometry auto (the default) the camera
 // motion is estimated from the views; with rectified they are taken as equally spaced, left to
 // right.
-#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -205,9 +204,8 @@ int DepthCommand(int argc, char** argv) {
   std::vector<ConstImageU8> views;
   for (const auto& p : pixels) views.push_back(MakeView(p.data(), c.width, c.height, 3));
   if (geometry == Geometry::kAuto) {
-    double focal = focal_35mm > 0
-                       ? focal_35mm * std::hypot(double{1} * c.width, double{1} * c.height) / 43.27
-                       : ExifFocalPx(files[0], c.width, c.height);
+    const double focal = focal_35mm > 0 ? FocalPxFrom35mm(focal_35mm, c.width, c.height)
+                                        : ExifFocalPx(files[0], c.width, c.height);
     s = EstimatePlanes(views, focal, range_given, &stage, &c);
     if (!s.ok()) return Fail(s.message());
   }

@@ -2,7 +2,7 @@
 
 #include <libexif/exif-data.h>
 
-#include <cmath>
+#include "algo/motion/camera.h"
 
 namespace lb {
 
@@ -14,9 +14,8 @@ double ExifFocalPx(const char* path, int32_t width, int32_t height) {
       exif_content_get_entry(data->ifd[EXIF_IFD_EXIF], EXIF_TAG_FOCAL_LENGTH_IN_35MM_FILM);
   if (e != nullptr && e->format == EXIF_FORMAT_SHORT && e->components == 1) {
     const double f35 = exif_get_short(e->data, exif_data_get_byte_order(data));
-    const double diagonal_px = std::hypot(static_cast<double>(width), static_cast<double>(height));
     // 0 means "unknown" in EXIF; a 35 mm equivalent outside 8..2000 mm is a broken tag.
-    if (f35 >= 8 && f35 <= 2000) focal = f35 * diagonal_px / 43.27;
+    if (f35 >= 8 && f35 <= 2000) focal = FocalPxFrom35mm(f35, width, height);
   }
   exif_data_unref(data);
   return focal;
