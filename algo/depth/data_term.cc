@@ -72,22 +72,23 @@ void DataTerm::Prepare(const ConstImageU8* views) {
   }
 }
 
-void DataTerm::PixelCostRow(int32_t view, int32_t y, int32_t disp_q8, uint8_t* out) const {
+void DataTerm::PixelCostRow(int32_t view, int32_t y, int32_t disp_q8, int32_t x0, int32_t x1,
+                            uint8_t* out) const {
   const int32_t w = width_;
   if (planes_ != nullptr) {
     const WarpSource src{images_[reference_], images_[view], census_[reference_], census_[view]};
-    PlaneCostRow(planes_[view], src, y, params_, invalid_cost_, out);
+    PlaneCostRow(planes_[view], src, y, params_, invalid_cost_, x0, x1, out);
     return;
   }
   // Sample position in the view: x * 256 + shift_q8, the same fraction for every pixel.
   const int32_t shift_q8 = -(view - reference_) * disp_q8;
   const int32_t off = shift_q8 >> 8;  // floor
   const int32_t f = shift_q8 & 255;   // Q8 weight of the right-hand sample
-  const int32_t x_lo = Clamp(-off, 0, w);
-  const int32_t x_hi = Clamp(w - (f > 0 ? 1 : 0) - off, x_lo, w);
+  const int32_t x_lo = Clamp(-off, x0, x1);
+  const int32_t x_hi = Clamp(w - (f > 0 ? 1 : 0) - off, x_lo, x1);
   const uint8_t invalid = static_cast<uint8_t>(invalid_cost_);
-  for (int32_t x = 0; x < x_lo; ++x) out[x] = invalid;
-  for (int32_t x = x_hi; x < w; ++x) out[x] = invalid;
+  for (int32_t x = x0; x < x_lo; ++x) out[x] = invalid;
+  for (int32_t x = x_hi; x < x1; ++x) out[x] = invalid;
   if (x_hi <= x_lo) return;
   const ptrdiff_t row = static_cast<ptrdiff_t>(y) * 3 * w;
   kernels_->cost(images_[reference_].Row(y) + 3 * x_lo, images_[view].Row(y) + 3 * (x_lo + off),
@@ -95,18 +96,21 @@ void DataTerm::PixelCostRow(int32_t view, int32_t y, int32_t disp_q8, uint8_t* o
                  f, params_.color_trunc, params_.census_weight, out + x_lo);
 }
 
-// Horizontal 3-sum of the pixel costs of row y (borders replicated): 0..765.
-void DataTerm::WindowRow(int32_t view, int32_t y, int32_t disp_q8, uint16_t* hsum) {
+// Horizontal 3-sum of the pixel costs of row y (borders replicated) for columns x0..x1-1:
+// 0..765.
+void DataTerm::WindowRow(int32_t view, int32_t y, int32_t disp_q8, int32_t x0, int32_t x1,
+                         uint16_t* hsum) {
   const int32_t w = width_;
   uint8_t* cost = pixel_ + 1;
-  PixelCostRow(view, Clamp(y, 0, height_ - 1), disp_q8, cost);
-  cost[-1] = cost[0];
-  cost[w] = cost[w - 1];
-  kernels_->hsum(cost, 0, w, hsum);
+  const int32_t c0 = x0 > 0 ? x0 - 1 : 0, c1 = x1 < w ? x1 + 1 : w;
+  PixelCostRow(view, Clamp(y, 0, height_ - 1), disp_q8, c0, c1, cost);
+  if (x0 == 0) cost[-1] = cost[0];
+  if (x1 == w) cost[w] = cost[w - 1];
+  kernels_->hsum(cost, x0, x1, hsum);
 }
 
-void DataTerm::ComputeRows(int32_t disp_q8, int32_t y0, int32_t y1, uint16_t* out,
-                           ptrdiff_t stride) {
+void DataTerm::ComputeRect(int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0, int32_t y1,
+                           uint16_t* out, ptrdiff_t stride) {
   const int32_t w = width_;
   const int32_t others = views_ - 1;
   auto ring = [&](int32_t j, int32_t row) {
@@ -114,22 +118,22 @@ void DataTerm::ComputeRows(int32_t disp_q8, int32_t y0, int32_t y1, uint16_t* ou
   };
   auto view = [&](int32_t j) { return j < reference_ ? j : j + 1; };
   for (int32_t j = 0; j < others; ++j) {
-    WindowRow(view(j), y0 - 1, disp_q8, ring(j, y0 - 1));
-    WindowRow(view(j), y0, disp_q8, ring(j, y0));
+    WindowRow(view(j), y0 - 1, disp_q8, x0, x1, ring(j, y0 - 1));
+    WindowRow(view(j), y0, disp_q8, x0, x1, ring(j, y0));
   }
   const uint16_t* rows[3 * 15];
-  const size_t row_bytes = static_cast<size_t>(3) * w;
+  const size_t row_bytes = static_cast<size_t>(3) * (x1 - x0);
   for (int32_t y = y0; y < y1; ++y) {
     for (int32_t j = 0; j < others; ++j) {
-      WindowRow(view(j), y + 1, disp_q8, ring(j, y + 1));
+      WindowRow(view(j), y + 1, disp_q8, x0, x1, ring(j, y + 1));
       // The views' next rows are far apart (a whole view each), so the hardware prefetcher
       // misses their starts; asking early hides the cache misses behind the other views.
       const int32_t next = Clamp(y + 2, 0, height_ - 1);
-      Prefetch(images_[view(j)].Row(next), row_bytes);
-      Prefetch(census_[view(j)] + static_cast<ptrdiff_t>(next) * 3 * w, row_bytes);
+      Prefetch(images_[view(j)].Row(next) + 3 * x0, row_bytes);
+      Prefetch(census_[view(j)] + static_cast<ptrdiff_t>(next) * 3 * w + x0, row_bytes);
       for (int32_t k = 0; k < 3; ++k) rows[3 * j + k] = ring(j, y - 1 + k);
     }
-    kernels_->select(rows, others, 0, w, out + (y - y0) * stride);
+    kernels_->select(rows, others, x0, x1, out + (y - y0) * stride);
   }
 }
 

@@ -45,7 +45,13 @@ class DataTerm {
   void Prepare(const ConstImageU8* views);
 
   // D for rows y0..y1-1 at disparity dispQ8 (px per view step) into out (row stride in elements).
-  void ComputeRows(int32_t disp_q8, int32_t y0, int32_t y1, uint16_t* out, ptrdiff_t stride);
+  void ComputeRows(int32_t disp_q8, int32_t y0, int32_t y1, uint16_t* out, ptrdiff_t stride) {
+    ComputeRect(disp_q8, 0, width_, y0, y1, out, stride);
+  }
+  // The same for columns x0..x1-1 only, out still pointing at (0, y0): the values are those of
+  // ComputeRows, bit for bit.
+  void ComputeRect(int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0, int32_t y1, uint16_t* out,
+                   ptrdiff_t stride);
 
   // Plane sweep (warp_cost.h): the homography of each view for the label of the next ComputeRows
   // calls (borrowed; disp_q8 is then ignored), or nullptr for the rectified shifts.
@@ -60,8 +66,10 @@ class DataTerm {
   struct Kernels;
 
  private:
-  void PixelCostRow(int32_t view, int32_t y, int32_t disp_q8, uint8_t* out) const;
-  void WindowRow(int32_t view, int32_t y, int32_t disp_q8, uint16_t* hsum);
+  // Pixel costs of columns x0..x1-1 of row y (out indexed by x).
+  void PixelCostRow(int32_t view, int32_t y, int32_t disp_q8, int32_t x0, int32_t x1,
+                    uint8_t* out) const;
+  void WindowRow(int32_t view, int32_t y, int32_t disp_q8, int32_t x0, int32_t x1, uint16_t* hsum);
 
   int32_t width_ = 0, height_ = 0, views_ = 0, reference_ = 0;
   DataTermParams params_;

@@ -38,12 +38,13 @@ Status DepthStage::Validate(const DepthConfig& c) {
       c.smooth_weight < 0 || c.smooth_weight > 4096 || c.smooth_trunc < 1 || c.smooth_trunc > 64 ||
       c.edge_threshold < 0 || c.edge_threshold > 255 || c.edge_weight_q8 < 0 ||
       c.edge_weight_q8 > 256 || c.max_cycles < 0 || c.max_cycles > 32 || c.move_margin < 0 ||
-      c.move_margin > 65535) {
+      c.move_margin > 65535 || c.coarse_step < 1 || c.coarse_step > 16 || c.fine_window < 1 ||
+      c.fine_window > 255) {
     return Status(Code::kInvalidArgument,
                   "depth: cost parameters out of range (colour %d, census %d, smoothness %d "
-                  "trunc %d edge %d/%d, cycles %d)",
+                  "trunc %d edge %d/%d, cycles %d, coarse step %d window %d)",
                   c.color_trunc, c.census_weight, c.smooth_weight, c.smooth_trunc, c.edge_threshold,
-                  c.edge_weight_q8, c.max_cycles);
+                  c.edge_weight_q8, c.max_cycles, c.coarse_step, c.fine_window);
   }
   if (c.geometry != DepthGeometry::kRectified && c.geometry != DepthGeometry::kPlanes) {
     return Status(Code::kInvalidArgument, "depth: unknown geometry %d",
@@ -76,6 +77,10 @@ Status DepthStage::Carve(Arena& arena) {
   prev_alpha_ = arena.Allocate<uint16_t>(n);
   below_ = arena.Allocate<uint16_t>(n);
   above_ = arena.Allocate<uint16_t>(n);
+  row_labels_ = arena.Allocate<uint64_t>(4 * static_cast<size_t>(h));
+  span_ = arena.Allocate<int32_t>(2 * static_cast<size_t>(h));
+  prev_span_ = arena.Allocate<int32_t>(2 * static_cast<size_t>(h));
+  rects_ = arena.Allocate<Rect>(static_cast<size_t>(h));
   planes_ = nullptr;
   if (config_.geometry == DepthGeometry::kPlanes) {
     planes_ = arena.Allocate<PlaneHomography>(static_cast<size_t>(config_.labels) * config_.views);
@@ -128,6 +133,14 @@ Status DepthStage::SetDisparityRange(int32_t disp_min_q8, int32_t disp_max_q8) {
 void DepthStage::LabelCosts(int32_t label, uint16_t* out) {
   if (config_.geometry == DepthGeometry::kPlanes) data_.SetPlanes(planes_ + label * config_.views);
   data_.ComputeRows(LabelDispQ8(label), 0, config_.height, out, config_.width);
+}
+
+void DepthStage::RowLabels(int32_t y) {
+  const int32_t w = config_.width;
+  uint64_t* m = row_labels_ + 4 * y;
+  m[0] = m[1] = m[2] = m[3] = 0;
+  const uint8_t* f = labels_ + y * w;
+  for (int32_t x = 0; x < w; ++x) m[f[x] >> 6] |= uint64_t{1} << (f[x] & 63);
 }
 
 void DepthStage::EdgeWeights(const ConstImageU8& ref) {
@@ -184,7 +197,9 @@ void DepthStage::WinnerTakeAll() {
     cost_[p] = 0xffff;
     labels_[p] = 0;
   }
-  for (int32_t label = 0; label < config_.labels; ++label) {
+  // Coarse to fine starts from the best coarse label: the fine labels come in the fine moves.
+  const int32_t step = config_.max_cycles > 0 ? config_.coarse_step : 1;
+  for (int32_t label = 0; label < config_.labels; label += step) {
     LabelCosts(label, cost_alpha_);
     for (int32_t p = 0; p < n; ++p) {
       if (cost_alpha_[p] < cost_[p]) {
@@ -261,10 +276,21 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
   energy_ = LabelEnergy(labels_, cost_, weight_right_, weight_down_, w, h, c.smooth_trunc);
   stats_.initial_energy = energy_;
   for (int32_t p = 0; p < w * h; ++p) below_[p] = above_[p] = 0xffff;
+  for (int32_t y = 0; y < h; ++y) {
+    RowLabels(y);
+    span_[2 * y] = span_[2 * y + 1] = 0;
+  }
   prev_label_ = -1;
   stats_.cycles = 0;
   stats_.moves = 0;
   stats_.cut_pixels = 0;
+  window_ = DepthConfig::kMaxLabels;
+  if (c.coarse_step > 1 && c.max_cycles > 0) {
+    for (int32_t alpha = 0; alpha < c.labels; alpha += c.coarse_step) {
+      if (Expand(alpha)) ++stats_.moves;
+    }
+    window_ = c.fine_window;
+  }
   for (int32_t cycle = 0; cycle < c.max_cycles; ++cycle) {
     bool lowered = false;
     for (int32_t alpha = 0; alpha < c.labels; ++alpha) {

@@ -48,6 +48,12 @@ struct DepthConfig {
   int32_t edge_threshold = 16;  // 0..255
   int32_t edge_weight_q8 = 64;  // 0..256
   int32_t max_cycles = 1;       // expansion cycles after the winner-take-all start, 0..32
+  // Coarse to fine: with coarse_step > 1, one pass of full moves over every coarse_step-th
+  // label comes first, and the cycles' moves then free only pixels whose label is within
+  // fine_window of alpha (a restricted move: still an exact cut over the pixels it frees). The
+  // coarse pass settles the layout, the fine moves its sub-pixel steps, over far smaller graphs.
+  int32_t coarse_step = 4;  // 1..16; 1: every move is a full move
+  int32_t fine_window = 2;  // 1..255
   // A move frees only pixels whose D(alpha) is at most this above D(f_p); 0 frees every pixel
   // that could gain (the full expansion move). 0..65535.
   int32_t move_margin = 0;
@@ -89,11 +95,15 @@ class DepthStage {
   const DepthConfig& config() const { return config_; }
 
   // For tests, valid after Compute: the label map (row stride = width), its energy, one more
-  // expansion move (applied whatever it gives; true when it lowered the energy), and the energy
-  // of any label map recomputed from scratch (slow: D for every label).
+  // expansion move (applied whatever it gives; true when it lowered the energy), restricted to
+  // pixels whose label is within `window` of alpha, and the energy of any label map recomputed
+  // from scratch (slow: D for every label).
   const uint8_t* labels() const { return labels_; }
   int64_t energy() const { return energy_; }
-  bool ExpandMove(int32_t alpha) { return Expand(alpha); }
+  bool ExpandMove(int32_t alpha, int32_t window = DepthConfig::kMaxLabels) {
+    window_ = window;
+    return Expand(alpha);
+  }
   int64_t Energy(const uint8_t* labels);
   int32_t LabelDispQ8(int32_t label) const { return LabelDispQ8(config_, label); }
   // The disparity of a label, Q8.8, for any valid configuration.
@@ -106,8 +116,18 @@ class DepthStage {
   void WinnerTakeAll();
   // One alpha-expansion move (expansion_move.cc); returns true when it lowered the energy.
   bool Expand(int32_t alpha);
-  int32_t ClassifyRow(int32_t alpha, int32_t y);
-  int32_t BuildRow(int32_t y, int32_t node_row);
+  // The rectangles of a move: one for the whole image, or, for a restricted move, one per run
+  // of rows holding a label near alpha, over the columns where such labels are (span_).
+  struct Rect {
+    int32_t x0, x1, y0, y1;
+  };
+  int32_t MoveRects(int32_t alpha);
+  int64_t CutRect(int32_t alpha, const Rect& r);  // returns the energy change
+  int32_t ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1);
+  void PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1);
+  int32_t BuildRow(const Rect& r, int32_t y, int32_t node_row);
+  int64_t MoveDelta(int32_t alpha, const Rect& r, int32_t y_lo, int32_t y_hi);
+  void RowLabels(int32_t y);
   enum : int32_t { kPairRight = 0, kPairDown = 1, kHigh = 2, kRowFree = 1, kRowTake = 2 };
   int32_t* Ring(int32_t y, int32_t kind) {
     return move_rows_ + ((y % 3) * 3 + kind) * config_.width;
@@ -133,6 +153,13 @@ class DepthStage {
   uint16_t* below_ = nullptr;  // D_p(f_p - 1), 0xffff when not seen
   uint16_t* above_ = nullptr;  // D_p(f_p + 1)
   int64_t energy_ = 0;
+  int32_t window_ = 255;  // the move in progress frees labels within this of alpha
+  // Per row, the labels present (bit l of word l / 64), and the columns whose D the move in
+  // progress (span_) and the one before (prev_span_) computed: [x0, x1) as two entries.
+  uint64_t* row_labels_ = nullptr;
+  int32_t* span_ = nullptr;
+  int32_t* prev_span_ = nullptr;
+  Rect* rects_ = nullptr;
   PlaneHomography* planes_ = nullptr;  // kPlanes: [label * views + view]
   bool planes_set_ = false;
 };

@@ -13,6 +13,58 @@ inline int32_t Abs(int32_t v) { return v < 0 ? -v : v; }
 
 }  // namespace
 
+// A move looks at rectangles: the whole image for a full move. A restricted move frees only
+// pixels whose label is within window_ of alpha, so it looks at the runs of rows holding such
+// a label, each over the columns from the first to the last of them. The rows between runs
+// keep their labels, which makes each rectangle's cut independent of the others.
+int32_t DepthStage::MoveRects(int32_t alpha) {
+  const int32_t w = config_.width, h = config_.height;
+  int32_t* t = prev_span_;
+  prev_span_ = span_;
+  span_ = t;
+  if (window_ >= config_.labels - 1) {
+    for (int32_t y = 0; y < h; ++y) {
+      span_[2 * y] = 0;
+      span_[2 * y + 1] = w;
+    }
+    rects_[0] = Rect{0, w, 0, h};
+    return 1;
+  }
+  const int32_t lo = alpha - window_ > 0 ? alpha - window_ : 0;
+  const int32_t hi = alpha + window_ < config_.labels - 1 ? alpha + window_ : config_.labels - 1;
+  uint64_t want[4] = {};
+  for (int32_t l = lo; l <= hi; ++l) want[l >> 6] |= uint64_t{1} << (l & 63);
+  auto near = [&](int32_t y) {
+    const uint64_t* m = row_labels_ + 4 * y;
+    return ((m[0] & want[0]) | (m[1] & want[1]) | (m[2] & want[2]) | (m[3] & want[3])) != 0;
+  };
+  auto outside = [lo, hi](int32_t f) { return f < lo || f > hi; };
+  int32_t count = 0;
+  for (int32_t y = 0; y < h;) {
+    if (!near(y)) {
+      span_[2 * y] = span_[2 * y + 1] = 0;
+      ++y;
+      continue;
+    }
+    Rect r{w, 0, y, y};
+    for (; y < h && near(y); ++y) {
+      const uint8_t* f = labels_ + y * w;
+      int32_t x0 = 0, x1 = w;
+      while (outside(f[x0])) ++x0;  // near(y): some label of the row is inside
+      while (outside(f[x1 - 1])) --x1;
+      r.x0 = x0 < r.x0 ? x0 : r.x0;
+      r.x1 = x1 > r.x1 ? x1 : r.x1;
+    }
+    r.y1 = y;
+    for (int32_t ry = r.y0; ry < r.y1; ++ry) {
+      span_[2 * ry] = r.x0;
+      span_[2 * ry + 1] = r.x1;
+    }
+    rects_[count++] = r;
+  }
+  return count;
+}
+
 // Pass 1: pixels whose choice does not depend on their neighbours are fixed before the cut.
 // Flipping p to alpha changes the energy by u_p plus, per neighbour q, C - A (q keeps its label)
 // or -B (q takes alpha); -B is the smaller of the two (the triangle inequality), so if
@@ -26,7 +78,7 @@ inline int32_t Abs(int32_t v) { return v < 0 ? -v : v; }
 // with b_p = V(fp, alpha) / w_pq, so u_p + sum(C - A) = u_p - b_p sum(w_pq) + sum(e_pq): one
 // branch-free pass per row. Row y keeps its e_pq to the right and down and that sum in the ring
 // slot y % 3 for pass 2. Returns kRowFree | kRowTake for the states present in the row.
-int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y) {
+int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1) {
   const int32_t w = config_.width, h = config_.height;
   const int32_t margin = config_.move_margin > 0 ? config_.move_margin : INT32_MAX;
   const int32_t k = config_.smooth_trunc;
@@ -43,23 +95,23 @@ int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y) {
     const int32_t d = a > b ? a - b : b - a;
     return d < k ? d : k;
   };
-  for (int32_t x = 0; x + 1 < w; ++x) {
+  // Pairs to the right from x0 - 1 (the left neighbour, fixed or not, is paired with x0).
+  const int32_t xe = x1 < w ? x1 : w - 1;
+  for (int32_t x = x0 > 0 ? x0 - 1 : 0; x < xe; ++x) {
     er[x] = wr[x] * (v(f[x], alpha) + v(f[x + 1], alpha) - v(f[x], f[x + 1]));
   }
-  er[w - 1] = 0;
-  for (int32_t x = 0; x < w; ++x) {
+  if (x1 == w) er[w - 1] = 0;
+  for (int32_t x = x0; x < x1; ++x) {
     ed[x] = wd[x] * (v(f[x], alpha) + v(fd[x], alpha) - v(f[x], fd[x]));
   }
-  sw[0] = wr[0] + wd[0];
-  hi[0] = er[0] + ed[0];
-  for (int32_t x = 1; x < w; ++x) {
-    sw[x] = wr[x] + wr[x - 1] + wd[x];
-    hi[x] = er[x] + er[x - 1] + ed[x];
+  for (int32_t x = x0; x < x1; ++x) {
+    sw[x] = wr[x] + wd[x] + (x > 0 ? wr[x - 1] : 0);
+    hi[x] = er[x] + ed[x] + (x > 0 ? er[x - 1] : 0);
   }
   if (y > 0) {
     const uint16_t* wu = wd - w;
     const int32_t* eu = Ring(y - 1, kPairDown);
-    for (int32_t x = 0; x < w; ++x) {
+    for (int32_t x = x0; x < x1; ++x) {
       sw[x] += wu[x];
       hi[x] += eu[x];
     }
@@ -68,14 +120,14 @@ int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y) {
   const uint16_t* cc = cost_ + row;
   uint8_t* state = state_ + row;
   int32_t present = 0;
-  for (int32_t x = 0; x < w; ++x) {
+  for (int32_t x = x0; x < x1; ++x) {
     const int32_t u = ca[x] - cc[x];
     int32_t limit = sw[x] * k;
     limit = limit < 0xffff ? limit : 0xffff;
     limit = limit < margin ? limit : margin;
     const int32_t lo = u - v(f[x], alpha) * sw[x];
     hi[x] += lo;
-    const bool keep = u > limit || f[x] == alpha || lo > 0;
+    const bool keep = u > limit || f[x] == alpha || lo > 0 || Abs(f[x] - alpha) > window_;
     const uint8_t s = keep ? kKeep : (hi[x] < 0 ? kTake : kFree);
     state[x] = s;
     present |= (s == kFree ? kRowFree : 0) | (s == kTake ? kRowTake : 0);
@@ -83,23 +135,40 @@ int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y) {
   return present;
 }
 
+// The pairs from row y (fixed: above a rectangle) down into the rectangle's first row.
+void DepthStage::PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1) {
+  const int32_t w = config_.width, k = config_.smooth_trunc;
+  const uint8_t* f = labels_ + y * w;
+  const uint8_t* fd = f + w;
+  const uint16_t* wd = weight_down_ + y * w;
+  int32_t* ed = Ring(y, kPairDown);
+  auto v = [k](int32_t a, int32_t b) {
+    const int32_t d = a > b ? a - b : b - a;
+    return d < k ? d : k;
+  };
+  for (int32_t x = x0; x < x1; ++x) {
+    ed[x] = wd[x] * (v(f[x], alpha) + v(fd[x], alpha) - v(f[x], fd[x]));
+  }
+}
+
 // Pass 2, one row behind pass 1: row y's nodes of the 2-label graph over the free pixels (node
 // row `node_row`). A fixed neighbour q turns the pair into a unary term on p: C - A when q keeps
 // its label, -B = C - A - e_pq when it takes alpha. A free right or down neighbour makes the arc
 // p -> q of capacity e_pq (p's balance keeps C - A), and a free left or up neighbour q puts the
-// -C of the pair (q, p), here -B = C - A - e_pq, on p's balance. Returns the free pixels.
-int32_t DepthStage::BuildRow(int32_t y, int32_t node_row) {
-  const int32_t w = config_.width, h = config_.height;
+// -C of the pair (q, p), here -B = C - A - e_pq, on p's balance. Neighbours outside the
+// rectangle keep their labels. Returns the free pixels.
+int32_t DepthStage::BuildRow(const Rect& r, int32_t y, int32_t node_row) {
+  const int32_t w = config_.width;
   const uint8_t* st = state_ + y * w;
-  const uint8_t* up = y > 0 ? st - w : nullptr;
-  const uint8_t* down = y + 1 < h ? st + w : nullptr;
+  const uint8_t* up = y > r.y0 ? st - w : nullptr;
+  const uint8_t* down = y + 1 < r.y1 ? st + w : nullptr;
   const int32_t* er = Ring(y, kPairRight);
   const int32_t* ed = Ring(y, kPairDown);
   const int32_t* eu = y > 0 ? Ring(y - 1, kPairDown) : nullptr;
   const int32_t* hi = Ring(y, kHigh);
-  const int32_t base = node_row * w;
+  const int32_t base = node_row * (r.x1 - r.x0) - r.x0;
   int32_t free_pixels = 0;
-  for (int32_t x = 0; x < w; ++x) {
+  for (int32_t x = r.x0; x < r.x1; ++x) {
     if (st[x] != kFree) {
       maxflow_.SetNode(base + x, 0, 0, 0);
       continue;
@@ -107,11 +176,11 @@ int32_t DepthStage::BuildRow(int32_t y, int32_t node_row) {
     ++free_pixels;
     int32_t balance = hi[x];
     int32_t cap_right = 0, cap_down = 0;
-    if (x + 1 < w) {
+    if (x + 1 < r.x1) {
       if (st[x + 1] == kFree) cap_right = er[x];
       if (st[x + 1] == kTake) balance -= er[x];
     }
-    if (x > 0 && st[x - 1] != kKeep) balance -= er[x - 1];
+    if (x > r.x0 && st[x - 1] != kKeep) balance -= er[x - 1];
     if (down) {
       if (down[x] == kFree) cap_down = ed[x];
       if (down[x] == kTake) balance -= ed[x];
@@ -123,72 +192,91 @@ int32_t DepthStage::BuildRow(int32_t y, int32_t node_row) {
   return free_pixels;
 }
 
-bool DepthStage::Expand(int32_t alpha) {
-  const int32_t w = config_.width, h = config_.height;
-  LabelCosts(alpha, cost_alpha_);
+// Classifies and builds the rectangle's rows, cuts the graph and settles its free pixels.
+int64_t DepthStage::CutRect(int32_t alpha, const Rect& r) {
+  const int32_t w = config_.width, gw = r.x1 - r.x0;
+  if (r.y0 > 0) PairsDown(alpha, r.y0 - 1, r.x0, r.x1);
   // Rows with free or switching pixels (y_lo..y_hi), and the graph's rows g_lo..: rows without
   // a free pixel are left out at either end, and written as empty rows only between two others.
-  int32_t y_lo = h, y_hi = -1, g_lo = -1, rows = 0, pending = 0, free_pixels = 0;
+  int32_t y_lo = r.y1, y_hi = -1, g_lo = -1, rows = 0, pending = 0, free_pixels = 0;
   int32_t present = 0;
-  for (int32_t y = 0; y <= h; ++y) {
+  for (int32_t y = r.y0; y <= r.y1; ++y) {
     const int32_t above = present;
-    if (y < h) {
-      present = ClassifyRow(alpha, y);
+    if (y < r.y1) {
+      present = ClassifyRow(alpha, y, r.x0, r.x1);
       if (present != 0) {
         y_lo = y < y_lo ? y : y_lo;
         y_hi = y;
       }
     }
-    if (y == 0) continue;
+    if (y == r.y0) continue;
     if (!(above & kRowFree)) {
       pending += g_lo >= 0 ? 1 : 0;
       continue;
     }
     if (g_lo < 0) {
       g_lo = y - 1;
-      maxflow_.Begin(w, h - g_lo);
+      maxflow_.Begin(gw, r.y1 - g_lo);
     }
     for (; pending > 0; --pending, ++rows) {
-      for (int32_t x = 0; x < w; ++x) maxflow_.SetNode(rows * w + x, 0, 0, 0);
+      for (int32_t x = 0; x < gw; ++x) maxflow_.SetNode(rows * gw + x, 0, 0, 0);
       maxflow_.RowDone(rows);
     }
-    free_pixels += BuildRow(y - 1, rows++);
+    free_pixels += BuildRow(r, y - 1, rows++);
   }
-  if (y_hi < 0) {
-    Record(alpha);
-    return false;
-  }
+  if (y_hi < 0) return 0;
   stats_.cut_pixels += free_pixels;
   if (free_pixels > 0) {
     maxflow_.Truncate(rows);
     (void)maxflow_.Solve();
-    const int32_t base = g_lo * w;
-    for (int32_t p = base; p < base + rows * w; ++p) {
-      if (state_[p] == kFree) state_[p] = maxflow_.InSource(p - base) ? kKeep : kTake;
+    for (int32_t gy = 0; gy < rows; ++gy) {
+      uint8_t* st = state_ + (g_lo + gy) * w;
+      for (int32_t x = r.x0; x < r.x1; ++x) {
+        if (st[x] == kFree) st[x] = maxflow_.InSource(gy * gw + x - r.x0) ? kKeep : kTake;
+      }
     }
   }
+  return MoveDelta(alpha, r, y_lo, y_hi);
+}
 
-  // Update the energy from the pixels that changed and their pair terms.
+// The energy change from the pixels that switch and their pair terms.
+int64_t DepthStage::MoveDelta(int32_t alpha, const Rect& r, int32_t y_lo, int32_t y_hi) {
+  const int32_t w = config_.width, h = config_.height;
   int64_t delta = 0;
   for (int32_t y = y_lo; y <= y_hi; ++y) {
-    for (int32_t x = 0; x < w; ++x) {
+    for (int32_t x = r.x0; x < r.x1; ++x) {
       const int32_t p = y * w + x;
       if (state_[p] != kTake) continue;
       const int32_t fp = labels_[p];
       delta += cost_alpha_[p] - cost_[p];
       // Pairs with an unchanged neighbour; a pair of two switching pixels goes from
       // V(fp, fq) to 0 and is counted once, from its left or upper pixel.
-      auto pair = [&](int32_t q, int32_t wpq, bool first) {
-        if (state_[q] == kTake && !(first && q > p)) return;
+      auto pair = [&](int32_t q, int32_t wpq, bool first, bool inside) {
+        const bool takes = inside && state_[q] == kTake;
+        if (takes && !first) return;
         const int32_t fq = labels_[q];
-        const int32_t after = state_[q] == kTake ? 0 : smooth_[Abs(alpha - fq)];
+        const int32_t after = takes ? 0 : smooth_[Abs(alpha - fq)];
         delta += int64_t{wpq} * (after - smooth_[Abs(fp - fq)]);
       };
-      if (x + 1 < w) pair(p + 1, weight_right_[p], true);
-      if (x > 0) pair(p - 1, weight_right_[p - 1], false);
-      if (y + 1 < h) pair(p + w, weight_down_[p], true);
-      if (y > 0) pair(p - w, weight_down_[p - w], false);
+      if (x + 1 < w) pair(p + 1, weight_right_[p], true, x + 1 < r.x1);
+      if (x > 0) pair(p - 1, weight_right_[p - 1], false, x > r.x0);
+      if (y + 1 < h) pair(p + w, weight_down_[p], true, y + 1 < r.y1);
+      if (y > 0) pair(p - w, weight_down_[p - w], false, y > r.y0);
     }
+  }
+  return delta;
+}
+
+bool DepthStage::Expand(int32_t alpha) {
+  const int32_t w = config_.width;
+  const int32_t count = MoveRects(alpha);
+  if (config_.geometry == DepthGeometry::kPlanes) data_.SetPlanes(planes_ + alpha * config_.views);
+  const int32_t disp_q8 = LabelDispQ8(alpha);
+  int64_t delta = 0;
+  for (int32_t i = 0; i < count; ++i) {
+    const Rect& r = rects_[i];
+    data_.ComputeRect(disp_q8, r.x0, r.x1, r.y0, r.y1, cost_alpha_ + r.y0 * w, w);
+    delta += CutRect(alpha, r);
   }
   energy_ += delta;
   Record(alpha);
@@ -198,22 +286,33 @@ bool DepthStage::Expand(int32_t alpha) {
 // Applies the move's switches and keeps D_p(f_p - 1) and D_p(f_p + 1) for the sub-label fit
 // without another pass of the data term: moves run in label order, so a pixel that keeps label
 // f saw D(f - 1) and D(f + 1) in the moves before and after f, and one that just took alpha saw
-// D(alpha - 1) in the move before (kept in prev_alpha_) and will see D(alpha + 1) in the next.
+// D(alpha - 1) in the move before (kept in prev_alpha_, where that move looked) and will see
+// D(alpha + 1) in the next. A restricted move looks at every pixel within its window, so at
+// every pixel of label alpha - 1 and alpha + 1.
 void DepthStage::Record(int32_t alpha) {
-  const int32_t n = config_.width * config_.height;
+  const int32_t w = config_.width, h = config_.height;
   const bool have_prev = prev_label_ == alpha - 1;
-  for (int32_t p = 0; p < n; ++p) {
-    const int32_t f = labels_[p];
-    if (state_[p] == kTake) {
-      labels_[p] = static_cast<uint8_t>(alpha);
-      cost_[p] = cost_alpha_[p];
-      below_[p] = have_prev ? prev_alpha_[p] : 0xffff;
-      above_[p] = 0xffff;
-    } else if (f == alpha + 1) {
-      below_[p] = cost_alpha_[p];
-    } else if (f + 1 == alpha) {
-      above_[p] = cost_alpha_[p];
+  for (int32_t y = 0; y < h; ++y) {
+    const int32_t x0 = span_[2 * y], x1 = span_[2 * y + 1];
+    const int32_t px0 = have_prev ? prev_span_[2 * y] : 0;
+    const int32_t px1 = have_prev ? prev_span_[2 * y + 1] : 0;
+    bool took = false;
+    for (int32_t x = x0; x < x1; ++x) {
+      const int32_t p = y * w + x;
+      const int32_t f = labels_[p];
+      if (state_[p] == kTake) {
+        labels_[p] = static_cast<uint8_t>(alpha);
+        cost_[p] = cost_alpha_[p];
+        below_[p] = x >= px0 && x < px1 ? prev_alpha_[p] : 0xffff;
+        above_[p] = 0xffff;
+        took = true;
+      } else if (f == alpha + 1) {
+        below_[p] = cost_alpha_[p];
+      } else if (f + 1 == alpha) {
+        above_[p] = cost_alpha_[p];
+      }
     }
+    if (took) RowLabels(y);
   }
   uint16_t* t = prev_alpha_;
   prev_alpha_ = cost_alpha_;

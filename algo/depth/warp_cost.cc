@@ -81,21 +81,25 @@ bool WarpSpan(const PlaneHomography& h, int32_t x0, int32_t x1, int32_t y, int32
 }
 
 void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
-                  const DataTermParams& params, int32_t invalid_cost, uint8_t* out) {
+                  const DataTermParams& params, int32_t invalid_cost, int32_t x_begin,
+                  int32_t x_end, uint8_t* out) {
   const int32_t w = src.ref.width;
   const CostParams p{w, src.ref.height, params.color_trunc, params.census_weight,
                      static_cast<uint8_t>(invalid_cost)};
   const uint8_t* ref = src.ref.Row(y);
   const uint8_t* cref = src.census_ref + static_cast<ptrdiff_t>(y) * 3 * w;
   int32_t xq[kAnchorStep + 1], yq[kAnchorStep + 1];
-  for (int32_t x0 = 0, end = 0; x0 < w; x0 = end) {
+  int32_t first = x_begin - x_begin % kAnchorStep;
+  if (first == w - 1 && first > 0) first -= kAnchorStep;  // w - 1 ends the span before it
+  for (int32_t x0 = first, end = 0; x0 < x_end; x0 = end) {
     const int32_t x1 = x0 + kAnchorStep < w - 1 ? x0 + kAnchorStep : w - 1;
     end = x1 == w - 1 ? w : x1;  // the last span keeps its end anchor
+    const int32_t lo = x0 > x_begin ? x0 : x_begin, hi = end < x_end ? end : x_end;
     if (!WarpSpan(h, x0, x1, y, xq, yq)) {
-      for (int32_t x = x0; x < end; ++x) out[x] = p.invalid;
+      for (int32_t x = lo; x < hi; ++x) out[x] = p.invalid;
       continue;
     }
-    for (int32_t x = x0; x < end; ++x) {
+    for (int32_t x = lo; x < hi; ++x) {
       out[x] = SampleCost(src, p, ref + 3 * x, Census(cref, w, x), xq[x - x0], yq[x - x0]);
     }
   }

@@ -36,9 +36,12 @@ struct WarpSource {
 bool WarpSpan(const PlaneHomography& h, int32_t x0, int32_t x1, int32_t y, int32_t* x_q16,
               int32_t* y_q16);
 
-// Pixel costs 0..255 of reference row y against the view seen through h (invalid_cost where a
-// sample needs a pixel outside the view, or the plane has no map there).
+// Pixel costs 0..255 of columns x0..x1-1 of reference row y (out indexed by x) against the view
+// seen through h (invalid_cost where a sample needs a pixel outside the view, or the plane has no
+// map there). The anchors stay at multiples of kAnchorStep, so a column's cost does not depend on
+// the range asked for.
 void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
-                  const DataTermParams& params, int32_t invalid_cost, uint8_t* out);
+                  const DataTermParams& params, int32_t invalid_cost, int32_t x0, int32_t x1,
+                  uint8_t* out);
 
 }  // namespace lb

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "algo/depth/data_term.h"
@@ -162,6 +163,30 @@ TEST(DataTermTest, RowBandsEqualTheWholeImage) {
     f.term.ComputeRows(300, y0, y1, bands.data() + y0 * 40, 40);
   }
   EXPECT_EQ(whole, bands);
+}
+
+// Restricted moves compute D over rectangles: every column range, at the borders and inside,
+// must give the whole image's values bit for bit, and write nothing outside it.
+TEST(DataTermTest, RectanglesEqualTheWholeImage) {
+  const int32_t w = 70, h = 20;
+  const synth::Burst b = synth::MakeBurst(w, h, 5, 2, 1, 4, 10, 50, 5, 16, 8u);
+  Fixed f;
+  PrepareTerm(f, b, DataTermParams{});
+  for (int32_t disp_q8 : {0, 300, 1000}) {
+    std::vector<uint16_t> whole(static_cast<size_t>(w) * h);
+    f.term.ComputeRows(disp_q8, 0, h, whole.data(), w);
+    for (const auto& [x0, x1] : {std::pair{0, 1}, {0, 33}, {1, 2}, {5, 40}, {17, 70}, {69, 70}}) {
+      std::vector<uint16_t> rect(whole.size(), 0xabcd);
+      f.term.ComputeRect(disp_q8, x0, x1, 3, 11, rect.data() + 3 * w, w);
+      for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+          const bool inside = y >= 3 && y < 11 && x >= x0 && x < x1;
+          ASSERT_EQ(rect[y * w + x], inside ? whole[y * w + x] : 0xabcd)
+              << "x " << x << " y " << y << " of [" << x0 << ", " << x1 << ")";
+        }
+      }
+    }
+  }
 }
 
 TEST(DataTermTest, TrueDisparityCostsLeastOnTexturedPlanes) {

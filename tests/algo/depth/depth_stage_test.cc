@@ -3,6 +3,8 @@
 // come out under qemu on ARM), the arena bound holds and bad input is refused.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+
 #include <cstdint>
 #include <vector>
 
@@ -57,18 +59,56 @@ TEST(DepthStageTest, EnergyNeverRisesAcrossExpansionMoves) {
       ASSERT_TRUE(s.Compute(b).ok());
       int64_t energy = s.depth.energy();
       ASSERT_EQ(s.depth.Energy(s.depth.labels()), energy);
-      for (int32_t cycle = 0; cycle < 2; ++cycle) {
+      // A full cycle, then cycles of moves restricted to labels near alpha (coarse to fine).
+      for (int32_t window : {255, 2, 1}) {
         for (int32_t alpha = 0; alpha < c.labels; ++alpha) {
-          s.depth.ExpandMove(alpha);
+          s.depth.ExpandMove(alpha, window);
           // Recomputed from scratch, not the stage's own bookkeeping.
           const int64_t after = s.depth.Energy(s.depth.labels());
           ASSERT_EQ(after, s.depth.energy());
-          ASSERT_LE(after, energy) << "alpha " << alpha << " trunc " << trunc;
+          ASSERT_LE(after, energy)
+              << "alpha " << alpha << " trunc " << trunc << " window " << window;
           energy = after;
         }
       }
     }
   }
+}
+
+// Two layers far apart in depth: a move restricted to labels near alpha looks only at the
+// rectangles around one layer, and the pixels around them keep their labels. Its bookkeeping
+// (the energy, the labels, the D kept for the refinement) must match a recomputation.
+TEST(DepthStageTest, RestrictedMovesLookOnlyNearTheirLabels) {
+  const synth::Burst b = synth::MakeBurst(64, 40, 5, 2, 1, 6, 20, 44, 10, 30, 5u);
+  DepthConfig c = SmallConfig(b, 33, 64);
+  c.max_cycles = 0;
+  c.smooth_weight = 40;
+  Stage s;
+  ASSERT_TRUE(s.Configure(c).ok());
+  ASSERT_TRUE(s.Compute(b).ok());
+  for (int32_t alpha = 0; alpha < c.labels; ++alpha) s.depth.ExpandMove(alpha);  // settle
+  const int64_t n = int64_t{b.width} * b.height;
+  int64_t energy = s.depth.energy();
+  int32_t small_moves = 0;
+  for (int32_t window : {1, 2, 3}) {
+    for (int32_t alpha = 0; alpha < c.labels; ++alpha) {
+      const int64_t cut_before = s.depth.stats().cut_pixels;
+      const std::vector<uint8_t> before(s.depth.labels(), s.depth.labels() + n);
+      s.depth.ExpandMove(alpha, window);
+      const int64_t after = s.depth.Energy(s.depth.labels());
+      ASSERT_EQ(after, s.depth.energy()) << "alpha " << alpha << " window " << window;
+      ASSERT_LE(after, energy);
+      energy = after;
+      for (int64_t p = 0; p < n; ++p) {
+        if (std::abs(before[p] - alpha) > window) {
+          ASSERT_EQ(s.depth.labels()[p], before[p]);
+        }
+      }
+      const int64_t cut = s.depth.stats().cut_pixels - cut_before;
+      small_moves += cut > 0 && cut < n / 2;
+    }
+  }
+  EXPECT_GT(small_moves, 0) << "no move was restricted to part of the image";
 }
 
 TEST(DepthStageTest, MoveResultBeatsEverySinglePixelSwitch) {
@@ -80,13 +120,16 @@ TEST(DepthStageTest, MoveResultBeatsEverySinglePixelSwitch) {
   ASSERT_TRUE(s.Configure(c).ok());
   ASSERT_TRUE(s.Compute(b).ok());
   const size_t n = static_cast<size_t>(b.width) * b.height;
-  for (int32_t alpha = 0; alpha < c.labels; ++alpha) {
-    s.depth.ExpandMove(alpha);
+  for (int32_t i = 0; i < 2 * c.labels; ++i) {
+    // A full cycle, then one restricted to labels next to alpha.
+    const int32_t alpha = i % c.labels, window = i < c.labels ? 255 : 1;
+    s.depth.ExpandMove(alpha, window);
     const int64_t energy = s.depth.energy();
     std::vector<uint8_t> labels(s.depth.labels(), s.depth.labels() + n);
-    // The move is optimal over all subsets switching to alpha, so over single pixels too.
+    // The move is optimal over all subsets of the pixels it frees switching to alpha, so over
+    // single pixels too.
     for (size_t p = 0; p < n; ++p) {
-      if (labels[p] == alpha) continue;
+      if (labels[p] == alpha || std::abs(labels[p] - alpha) > window) continue;
       const uint8_t keep = labels[p];
       labels[p] = static_cast<uint8_t>(alpha);
       ASSERT_GE(s.depth.Energy(labels.data()), energy) << "pixel " << p << " alpha " << alpha;
@@ -127,6 +170,8 @@ TEST(DepthStageTest, DepthMapBitsArePinned) {
   c.edge_threshold = 16;
   c.edge_weight_q8 = 96;
   c.max_cycles = 2;
+  c.coarse_step = 4;
+  c.fine_window = 2;
   c.subpixel = true;
   Stage s;
   ASSERT_TRUE(s.Configure(c).ok());

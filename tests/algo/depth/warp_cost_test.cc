@@ -332,5 +332,42 @@ TEST(WarpCostTest, FixedPointAgreesWithFloatReference) {
   }
 }
 
+// Restricted moves compute D over column ranges that start anywhere: the anchors stay on their
+// grid, so every range gives the whole row's values bit for bit (widths around the anchor step,
+// the last column as the end of the span before it).
+TEST(WarpCostTest, ColumnRangesEqualTheWholeRow) {
+  for (const int32_t w : {33, 40, 49}) {
+    motiontest::Burst b;
+    ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(5), w, 24, 3, &b));
+    const int32_t h = b.scene.height();
+    Fixed f;
+    PrepareTerm(f, b, DataTermParams{});
+    std::vector<PlaneHomography> planes(b.scene.views());
+    const double rho = b.scene.inverse_depth_min_q12() / 4096.0;
+    for (int32_t v = 0; v < b.scene.views(); ++v) {
+      const Pose& pose = b.scene.pose(v);
+      ViewMotion m;
+      std::copy(&pose.rotation[0][0], &pose.rotation[0][0] + 9, &m.rotation[0][0]);
+      std::copy(pose.translation, pose.translation + 3, m.translation);
+      planes[v] = MakePlaneHomography(b.intrinsics, m, rho);
+    }
+    f.term.SetPlanes(planes.data());
+    std::vector<uint16_t> whole(static_cast<size_t>(w) * h);
+    f.term.ComputeRows(0, 0, h, whole.data(), w);
+    for (int32_t x0 = 0; x0 < w; x0 += 3) {
+      for (const int32_t x1 : {x0 + 1, std::min(w, x0 + 17), w}) {
+        std::vector<uint16_t> rect(whole.size(), 0xabcd);
+        f.term.ComputeRect(0, x0, x1, 2, h - 2, rect.data() + 2 * w, w);
+        for (int32_t y = 2; y < h - 2; ++y) {
+          for (int32_t x = x0; x < x1; ++x) {
+            ASSERT_EQ(rect[y * w + x], whole[y * w + x])
+                << "width " << w << " x " << x << " of [" << x0 << ", " << x1 << ")";
+          }
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace lb
