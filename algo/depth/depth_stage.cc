@@ -61,26 +61,41 @@ size_t DepthStage::RequiredBytes(const DepthConfig& config) {
   return plan.used();
 }
 
+void DepthStage::CarveGrid(Arena& arena, Grid& g, int32_t width, int32_t height, bool prev_alpha) {
+  const size_t n = static_cast<size_t>(width) * height, rows = static_cast<size_t>(height);
+  g.width = width;
+  g.height = height;
+  g.labels = arena.Allocate<uint8_t>(n);
+  g.cost = arena.Allocate<uint16_t>(n);
+  g.cost_alpha = arena.Allocate<uint16_t>(n);
+  g.prev_alpha = prev_alpha ? arena.Allocate<uint16_t>(n) : nullptr;
+  g.weight_right = arena.Allocate<uint16_t>(n);
+  g.weight_down = arena.Allocate<uint16_t>(n);
+  g.state = arena.Allocate<uint8_t>(n);
+  g.row_labels = arena.Allocate<uint64_t>(4 * rows);
+  g.span = arena.Allocate<int32_t>(2 * rows);
+  g.prev_span = arena.Allocate<int32_t>(2 * rows);
+  g.rects = arena.Allocate<Rect>(rows);
+}
+
 Status DepthStage::Carve(Arena& arena) {
   const size_t start = arena.used();
   const int32_t w = config_.width, h = config_.height;
   const size_t n = static_cast<size_t>(w) * h;
   data_.Carve(arena, w, h, config_.views);
   maxflow_.Carve(arena, w, h);
-  labels_ = arena.Allocate<uint8_t>(n);
-  cost_ = arena.Allocate<uint16_t>(n);
-  cost_alpha_ = arena.Allocate<uint16_t>(n);
-  weight_right_ = arena.Allocate<uint16_t>(n);
-  weight_down_ = arena.Allocate<uint16_t>(n);
-  state_ = arena.Allocate<uint8_t>(n);
-  move_rows_ = arena.Allocate<int32_t>(10 * static_cast<size_t>(w));
-  prev_alpha_ = arena.Allocate<uint16_t>(n);
-  below_ = arena.Allocate<uint16_t>(n);
-  above_ = arena.Allocate<uint16_t>(n);
-  row_labels_ = arena.Allocate<uint64_t>(4 * static_cast<size_t>(h));
-  span_ = arena.Allocate<int32_t>(2 * static_cast<size_t>(h));
-  prev_span_ = arena.Allocate<int32_t>(2 * static_cast<size_t>(h));
-  rects_ = arena.Allocate<Rect>(static_cast<size_t>(h));
+  CarveGrid(arena, fine_, w, h, true);
+  move_rows_ = arena.Allocate<int32_t>(11 * static_cast<size_t>(w));
+  // The coarse grid is done with before the fine moves record anything in below_ and above_,
+  // so it lives in their memory (enlarged for the smallest images, where alignment dominates).
+  Arena plan;
+  CarveGrid(plan, coarse_, (w + 1) / 2, (h + 1) / 2, false);
+  const size_t refine_bytes = 4 * n > plan.used() ? 4 * n : plan.used();
+  uint8_t* refine = arena.Allocate<uint8_t>(refine_bytes);
+  below_ = reinterpret_cast<uint16_t*>(refine);
+  above_ = below_ + n;
+  Arena blocks(refine, refine == nullptr ? 0 : refine_bytes);
+  CarveGrid(blocks, coarse_, (w + 1) / 2, (h + 1) / 2, false);
   planes_ = nullptr;
   if (config_.geometry == DepthGeometry::kPlanes) {
     planes_ = arena.Allocate<PlaneHomography>(static_cast<size_t>(config_.labels) * config_.views);
@@ -135,11 +150,11 @@ void DepthStage::LabelCosts(int32_t label, uint16_t* out) {
   data_.ComputeRows(LabelDispQ8(label), 0, config_.height, out, config_.width);
 }
 
-void DepthStage::RowLabels(int32_t y) {
-  const int32_t w = config_.width;
-  uint64_t* m = row_labels_ + 4 * y;
+void DepthStage::RowLabels(Grid& g, int32_t y) {
+  const int32_t w = g.width;
+  uint64_t* m = g.row_labels + 4 * y;
   m[0] = m[1] = m[2] = m[3] = 0;
-  const uint8_t* f = labels_ + y * w;
+  const uint8_t* f = g.labels + y * w;
   for (int32_t x = 0; x < w; ++x) m[f[x] >> 6] |= uint64_t{1} << (f[x] & 63);
 }
 
@@ -160,18 +175,18 @@ void DepthStage::EdgeWeights(const ConstImageU8& ref) {
     const uint8_t* below = ref.Row(y + 1 < h ? y + 1 : y);
     for (int32_t x = 0; x < w; ++x) {
       const int32_t p = y * w + x;
-      weight_right_[p] = x + 1 < w ? weight(row + 3 * x, row + 3 * x + 3) : 0;
-      weight_down_[p] = y + 1 < h ? weight(row + 3 * x, below + 3 * x) : 0;
+      fine_.weight_right[p] = x + 1 < w ? weight(row + 3 * x, row + 3 * x + 3) : 0;
+      fine_.weight_down[p] = y + 1 < h ? weight(row + 3 * x, below + 3 * x) : 0;
     }
   }
 }
 
-// Energy of the current labels from the stored D_p(f_p) and the edge weights.
+// Energy of a grid's labels from its stored D_p(f_p) and edge weights.
 static int64_t LabelEnergy(const uint8_t* labels, const uint16_t* cost, const uint16_t* right,
                            const uint16_t* down, int32_t w, int32_t h, int32_t trunc) {
   int64_t e = 0;
   for (int32_t y = 0; y < h; ++y) {
-    int64_t row = 0;  // at most 8192 * (2295 + 2 * 4096 * 64): fits easily
+    int64_t row = 0;  // at most 8192 * (9180 + 2 * 8192 * 64): fits easily
     for (int32_t x = 0; x < w; ++x) {
       const int32_t p = y * w + x;
       const int32_t f = labels[p];
@@ -190,21 +205,27 @@ static int64_t LabelEnergy(const uint8_t* labels, const uint16_t* cost, const ui
   return e;
 }
 
+int64_t DepthStage::GridEnergy(const Grid& g) const {
+  return LabelEnergy(g.labels, g.cost, g.weight_right, g.weight_down, g.width, g.height,
+                     config_.smooth_trunc);
+}
+
 void DepthStage::WinnerTakeAll() {
-  const int32_t w = config_.width, h = config_.height;
-  const int32_t n = w * h;
+  const int32_t n = config_.width * config_.height;
+  uint8_t* labels = fine_.labels;
+  uint16_t* cost = fine_.cost;
   for (int32_t p = 0; p < n; ++p) {
-    cost_[p] = 0xffff;
-    labels_[p] = 0;
+    cost[p] = 0xffff;
+    labels[p] = 0;
   }
   // Coarse to fine starts from the best coarse label: the fine labels come in the fine moves.
   const int32_t step = config_.max_cycles > 0 ? config_.coarse_step : 1;
   for (int32_t label = 0; label < config_.labels; label += step) {
-    LabelCosts(label, cost_alpha_);
+    LabelCosts(label, fine_.cost_alpha);
     for (int32_t p = 0; p < n; ++p) {
-      if (cost_alpha_[p] < cost_[p]) {
-        cost_[p] = cost_alpha_[p];
-        labels_[p] = static_cast<uint8_t>(label);
+      if (fine_.cost_alpha[p] < cost[p]) {
+        cost[p] = fine_.cost_alpha[p];
+        labels[p] = static_cast<uint8_t>(label);
       }
     }
   }
@@ -212,18 +233,19 @@ void DepthStage::WinnerTakeAll() {
 
 int64_t DepthStage::Energy(const uint8_t* labels) {
   const int32_t w = config_.width, h = config_.height;
-  prev_label_ = -1;  // cost_alpha_ is used as scratch below
+  uint16_t* scratch = fine_.cost_alpha;
+  prev_label_ = -1;  // cost_alpha is used as scratch below
   int64_t data = 0;
   for (int32_t label = 0; label < config_.labels; ++label) {
-    LabelCosts(label, cost_alpha_);
+    LabelCosts(label, scratch);
     for (int32_t p = 0; p < w * h; ++p) {
-      if (labels[p] == label) data += cost_alpha_[p];
+      if (labels[p] == label) data += scratch[p];
     }
   }
   // The smoothness part with zero data costs: reuse LabelEnergy over a zero cost image.
-  for (int32_t p = 0; p < w * h; ++p) cost_alpha_[p] = 0;
-  return data +
-         LabelEnergy(labels, cost_alpha_, weight_right_, weight_down_, w, h, config_.smooth_trunc);
+  for (int32_t p = 0; p < w * h; ++p) scratch[p] = 0;
+  return data + LabelEnergy(labels, scratch, fine_.weight_right, fine_.weight_down, w, h,
+                            config_.smooth_trunc);
 }
 
 // Sub-label disparity: a parabola through D at f_p - 1, f_p, f_p + 1 (as recorded by the
@@ -235,10 +257,10 @@ void DepthStage::Refine(ImageU16 disp_q8) {
     uint16_t* out = disp_q8.Row(y);
     for (int32_t x = 0; x < w; ++x) {
       const int32_t p = y * w + x;
-      const int32_t f = labels_[p];
+      const int32_t f = fine_.labels[p];
       int32_t d_q8 = LabelDispQ8(f);
       if (config_.subpixel && f > 0 && f + 1 < config_.labels) {
-        const int32_t cm = below_[p], c0 = cost_[p], cp = above_[p];
+        const int32_t cm = below_[p], c0 = fine_.cost[p], cp = above_[p];
         const int32_t curvature = cm + cp - 2 * c0;
         if (cm != 0xffff && cp != 0xffff && c0 <= cm && c0 <= cp && curvature > 0) {
           const int32_t step_q8 = (LabelDispQ8(f + 1) - LabelDispQ8(f - 1)) / 2;
@@ -272,25 +294,31 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
   const int32_t w = c.width, h = c.height;
   data_.Prepare(views);
   EdgeWeights(views[c.reference]);
-  WinnerTakeAll();
-  energy_ = LabelEnergy(labels_, cost_, weight_right_, weight_down_, w, h, c.smooth_trunc);
-  stats_.initial_energy = energy_;
-  for (int32_t p = 0; p < w * h; ++p) below_[p] = above_[p] = 0xffff;
-  for (int32_t y = 0; y < h; ++y) {
-    RowLabels(y);
-    span_[2 * y] = span_[2 * y + 1] = 0;
-  }
   prev_label_ = -1;
   stats_.cycles = 0;
   stats_.moves = 0;
   stats_.cut_pixels = 0;
+  stats_.coarse_energy = stats_.handover_energy = 0;
   window_ = DepthConfig::kMaxLabels;
-  if (c.coarse_step > 1 && c.max_cycles > 0) {
+  const bool coarse = c.coarse_step > 1 && c.max_cycles > 0;
+  if (coarse && c.coarse_blocks) {
+    CoarsePass();  // ends with the pixels' labels, costs and energy
+  } else {
+    WinnerTakeAll();
+    energy_ = GridEnergy(fine_);
+    stats_.initial_energy = energy_;
+  }
+  for (int32_t p = 0; p < w * h; ++p) below_[p] = above_[p] = 0xffff;
+  for (int32_t y = 0; y < h; ++y) {
+    RowLabels(fine_, y);
+    fine_.span[2 * y] = fine_.span[2 * y + 1] = 0;
+  }
+  if (coarse && !c.coarse_blocks) {
     for (int32_t alpha = 0; alpha < c.labels; alpha += c.coarse_step) {
       if (Expand(alpha)) ++stats_.moves;
     }
-    window_ = c.fine_window;
   }
+  if (coarse) window_ = c.fine_window;
   for (int32_t cycle = 0; cycle < c.max_cycles; ++cycle) {
     bool lowered = false;
     for (int32_t alpha = 0; alpha < c.labels; ++alpha) {

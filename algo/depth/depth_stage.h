@@ -54,6 +54,11 @@ struct DepthConfig {
   // coarse pass settles the layout, the fine moves its sub-pixel steps, over far smaller graphs.
   int32_t coarse_step = 4;  // 1..16; 1: every move is a full move
   int32_t fine_window = 2;  // 1..255
+  // The coarse pass labels 2x2 blocks of pixels (its data costs the blocks' sums, its pair
+  // weights the sums across block edges, so it minimises the same energy over block-constant
+  // labels) on a quarter of the nodes; the fine moves then also free pixels next to a label
+  // within fine_window, which moves the block edges onto the image's.
+  bool coarse_blocks = true;
   // A move frees only pixels whose D(alpha) is at most this above D(f_p); 0 frees every pixel
   // that could gain (the full expansion move). 0..65535.
   int32_t move_margin = 0;
@@ -64,10 +69,14 @@ struct DepthStats {
   int32_t labels = 0;
   int32_t cycles = 0;          // expansion cycles run
   int32_t moves = 0;           // expansion moves that lowered the energy
-  int64_t cut_pixels = 0;      // pixels left free for the cuts, summed over the moves
+  int64_t cut_pixels = 0;      // nodes (pixels or blocks) left free for the cuts, summed
   int64_t initial_energy = 0;  // energy of the winner-take-all labels
-  int64_t energy = 0;          // final energy
-  size_t arena_bytes = 0;      // bytes this stage carved from the arena
+  // coarse_blocks: the energy of the coarse pass's labels as its moves tracked it on the blocks,
+  // and recomputed on the pixels that take them (the two agree: coarse_grid.cc).
+  int64_t coarse_energy = 0;
+  int64_t handover_energy = 0;
+  int64_t energy = 0;      // final energy
+  size_t arena_bytes = 0;  // bytes this stage carved from the arena
 };
 
 class DepthStage {
@@ -96,9 +105,9 @@ class DepthStage {
 
   // For tests, valid after Compute: the label map (row stride = width), its energy, one more
   // expansion move (applied whatever it gives; true when it lowered the energy), restricted to
-  // pixels whose label is within `window` of alpha, and the energy of any label map recomputed
-  // from scratch (slow: D for every label).
-  const uint8_t* labels() const { return labels_; }
+  // pixels with a label within `window` of alpha in their 3x3 neighbourhood, and the energy of
+  // any label map recomputed from scratch (slow: D for every label).
+  const uint8_t* labels() const { return fine_.labels; }
   int64_t energy() const { return energy_; }
   bool ExpandMove(int32_t alpha, int32_t window = DepthConfig::kMaxLabels) {
     window_ = window;
@@ -110,24 +119,53 @@ class DepthStage {
   static int32_t LabelDispQ8(const DepthConfig& config, int32_t label);
 
  private:
+  // The rectangles of a move: one for the whole grid, or, for a restricted move, one per run
+  // of rows near a label within the window of alpha, over the columns near such labels.
+  struct Rect {
+    int32_t x0, x1, y0, y1;
+  };
+  // A grid of labels the moves work on: the image's pixels, or the coarse pass's 2x2 blocks.
+  struct Grid {
+    int32_t width = 0, height = 0;
+    uint8_t* labels = nullptr;
+    uint16_t* cost = nullptr;          // D_p(f_p) of the current labels
+    uint16_t* cost_alpha = nullptr;    // D_p(alpha) of the move in progress
+    uint16_t* prev_alpha = nullptr;    // D of the previous move's label, prev_label_
+    uint16_t* weight_right = nullptr;  // w_pq to the right neighbour
+    uint16_t* weight_down = nullptr;
+    uint8_t* state = nullptr;  // per node in a move: free for the cut, or fixed
+    // Per row, the labels present (bit l of word l / 64), and the columns whose D the move in
+    // progress (span) and the one before (prev_span) computed: [x0, x1) as two entries.
+    uint64_t* row_labels = nullptr;
+    int32_t* span = nullptr;
+    int32_t* prev_span = nullptr;
+    Rect* rects = nullptr;
+  };
+  void CarveGrid(Arena& arena, Grid& g, int32_t width, int32_t height, bool prev_alpha);
+  Grid& grid() { return on_coarse_ ? coarse_ : fine_; }
+  int64_t GridEnergy(const Grid& g) const;
+
   Status Carve(Arena& arena);
   void EdgeWeights(const ConstImageU8& ref);
   void LabelCosts(int32_t label, uint16_t* out);  // D of one label for the whole image
   void WinnerTakeAll();
-  // One alpha-expansion move (expansion_move.cc); returns true when it lowered the energy.
+  // The coarse pass (coarse_grid.cc): block weights, block costs, the best coarse label of
+  // each block, the full moves over the blocks, and the pixels' labels and costs from them.
+  void BlockWeights();
+  void BlockCosts(int32_t label, const Rect& blocks, uint16_t* out);
+  void CoarseWinnerTakeAll();
+  void CoarsePass();
+  void FineFromBlocks();
+  // One alpha-expansion move (expansion_move.cc) on grid(); returns true when it lowered the
+  // energy.
   bool Expand(int32_t alpha);
-  // The rectangles of a move: one for the whole image, or, for a restricted move, one per run
-  // of rows holding a label near alpha, over the columns where such labels are (span_).
-  struct Rect {
-    int32_t x0, x1, y0, y1;
-  };
   int32_t MoveRects(int32_t alpha);
   int64_t CutRect(int32_t alpha, const Rect& r);  // returns the energy change
   int32_t ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1);
   void PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1);
   int32_t BuildRow(const Rect& r, int32_t y, int32_t node_row);
   int64_t MoveDelta(int32_t alpha, const Rect& r, int32_t y_lo, int32_t y_hi);
-  void RowLabels(int32_t y);
+  void RowLabels(Grid& g, int32_t y);
   enum : int32_t { kPairRight = 0, kPairDown = 1, kHigh = 2, kRowFree = 1, kRowTake = 2 };
   int32_t* Ring(int32_t y, int32_t kind) {
     return move_rows_ + ((y % 3) * 3 + kind) * config_.width;
@@ -139,28 +177,18 @@ class DepthStage {
   DepthStats stats_;
   DataTerm data_;
   GridMaxflow maxflow_;
-  uint8_t* labels_ = nullptr;
-  uint16_t* cost_ = nullptr;          // D_p(f_p) of the current labels
-  uint16_t* cost_alpha_ = nullptr;    // D_p(alpha) of the move in progress
-  uint16_t* weight_right_ = nullptr;  // w_pq to the right neighbour
-  uint16_t* weight_down_ = nullptr;
+  Grid fine_;    // the pixels
+  Grid coarse_;  // the coarse pass's blocks, in the memory of below_ and above_
+  bool on_coarse_ = false;
   enum : uint8_t { kFree = 0, kKeep = 1, kTake = 2 };
-  uint8_t* state_ = nullptr;                      // per pixel in a move: free for the cut, or fixed
   int32_t* move_rows_ = nullptr;                  // the moves' row ring (expansion_move.cc)
   int32_t smooth_[DepthConfig::kMaxLabels] = {};  // min(d, smooth_trunc) for a label distance d
-  uint16_t* prev_alpha_ = nullptr;                // D of the previous move's label, prev_label_
   int32_t prev_label_ = -1;
   uint16_t* below_ = nullptr;  // D_p(f_p - 1), 0xffff when not seen
   uint16_t* above_ = nullptr;  // D_p(f_p + 1)
   int64_t energy_ = 0;
-  int32_t window_ = 255;  // the move in progress frees labels within this of alpha
-  // Per row, the labels present (bit l of word l / 64), and the columns whose D the move in
-  // progress (span_) and the one before (prev_span_) computed: [x0, x1) as two entries.
-  uint64_t* row_labels_ = nullptr;
-  int32_t* span_ = nullptr;
-  int32_t* prev_span_ = nullptr;
-  Rect* rects_ = nullptr;
-  PlaneHomography* planes_ = nullptr;  // kPlanes: [label * views + view]
+  int32_t window_ = DepthConfig::kMaxLabels;  // the move in progress frees labels this near alpha
+  PlaneHomography* planes_ = nullptr;         // kPlanes: [label * views + view]
   bool planes_set_ = false;
 };
 

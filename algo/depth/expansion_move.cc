@@ -13,54 +13,78 @@ inline int32_t Abs(int32_t v) { return v < 0 ? -v : v; }
 
 }  // namespace
 
-// A move looks at rectangles: the whole image for a full move. A restricted move frees only
-// pixels whose label is within window_ of alpha, so it looks at the runs of rows holding such
-// a label, each over the columns from the first to the last of them. The rows between runs
-// keep their labels, which makes each rectangle's cut independent of the others.
+// A move looks at rectangles: the whole grid for a full move. A restricted move frees only
+// nodes with a label within window_ of alpha in their 3x3 neighbourhood, so it looks at the runs
+// of rows next to such a label, each over the columns from the first to the last of them. The
+// rows between runs keep their labels, which makes each rectangle's cut independent of the
+// others.
 int32_t DepthStage::MoveRects(int32_t alpha) {
-  const int32_t w = config_.width, h = config_.height;
-  int32_t* t = prev_span_;
-  prev_span_ = span_;
-  span_ = t;
+  Grid& g = grid();
+  const int32_t w = g.width, h = g.height;
+  int32_t* t = g.prev_span;
+  g.prev_span = g.span;
+  g.span = t;
+  int32_t* span = g.span;
   if (window_ >= config_.labels - 1) {
     for (int32_t y = 0; y < h; ++y) {
-      span_[2 * y] = 0;
-      span_[2 * y + 1] = w;
+      span[2 * y] = 0;
+      span[2 * y + 1] = w;
     }
-    rects_[0] = Rect{0, w, 0, h};
+    g.rects[0] = Rect{0, w, 0, h};
     return 1;
   }
   const int32_t lo = alpha - window_ > 0 ? alpha - window_ : 0;
   const int32_t hi = alpha + window_ < config_.labels - 1 ? alpha + window_ : config_.labels - 1;
   uint64_t want[4] = {};
   for (int32_t l = lo; l <= hi; ++l) want[l >> 6] |= uint64_t{1} << (l & 63);
-  auto near = [&](int32_t y) {
-    const uint64_t* m = row_labels_ + 4 * y;
-    return ((m[0] & want[0]) | (m[1] & want[1]) | (m[2] & want[2]) | (m[3] & want[3])) != 0;
-  };
   auto outside = [lo, hi](int32_t f) { return f < lo || f > hi; };
+  // Each row's own columns with such a label: [w, 0) when none.
+  for (int32_t y = 0; y < h; ++y) {
+    const uint64_t* m = g.row_labels + 4 * y;
+    int32_t x0 = w, x1 = 0;
+    if (((m[0] & want[0]) | (m[1] & want[1]) | (m[2] & want[2]) | (m[3] & want[3])) != 0) {
+      const uint8_t* f = g.labels + y * w;
+      x0 = 0;
+      x1 = w;
+      while (outside(f[x0])) ++x0;  // the row holds one
+      while (outside(f[x1 - 1])) --x1;
+    }
+    span[2 * y] = x0;
+    span[2 * y + 1] = x1;
+  }
+  // Runs of rows next to one, over the columns next to one.
+  auto row_near = [&](int32_t y) {
+    for (int32_t k = y > 0 ? y - 1 : 0; k <= y + 1 && k < h; ++k) {
+      if (span[2 * k] < span[2 * k + 1]) return true;
+    }
+    return false;
+  };
   int32_t count = 0;
   for (int32_t y = 0; y < h;) {
-    if (!near(y)) {
-      span_[2 * y] = span_[2 * y + 1] = 0;
+    if (!row_near(y)) {
       ++y;
       continue;
     }
     Rect r{w, 0, y, y};
-    for (; y < h && near(y); ++y) {
-      const uint8_t* f = labels_ + y * w;
-      int32_t x0 = 0, x1 = w;
-      while (outside(f[x0])) ++x0;  // near(y): some label of the row is inside
-      while (outside(f[x1 - 1])) --x1;
-      r.x0 = x0 < r.x0 ? x0 : r.x0;
-      r.x1 = x1 > r.x1 ? x1 : r.x1;
+    for (; y < h && row_near(y); ++y) {
+      for (int32_t k = y > 0 ? y - 1 : 0; k <= y + 1 && k < h; ++k) {
+        r.x0 = span[2 * k] < r.x0 ? span[2 * k] : r.x0;
+        r.x1 = span[2 * k + 1] > r.x1 ? span[2 * k + 1] : r.x1;
+      }
     }
     r.y1 = y;
-    for (int32_t ry = r.y0; ry < r.y1; ++ry) {
-      span_[2 * ry] = r.x0;
-      span_[2 * ry + 1] = r.x1;
+    r.x0 = r.x0 > 0 ? r.x0 - 1 : 0;
+    r.x1 = r.x1 < w ? r.x1 + 1 : w;
+    g.rects[count++] = r;
+  }
+  // The final columns per row: the rectangle's, none between them (no run reads the own
+  // columns of a row of another, as rows next to a run's rows belong to it or hold none).
+  for (int32_t y = 0; y < h; ++y) span[2 * y] = span[2 * y + 1] = 0;
+  for (int32_t i = 0; i < count; ++i) {
+    for (int32_t y = g.rects[i].y0; y < g.rects[i].y1; ++y) {
+      span[2 * y] = g.rects[i].x0;
+      span[2 * y + 1] = g.rects[i].x1;
     }
-    rects_[count++] = r;
   }
   return count;
 }
@@ -79,18 +103,19 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
 // branch-free pass per row. Row y keeps its e_pq to the right and down and that sum in the ring
 // slot y % 3 for pass 2. Returns kRowFree | kRowTake for the states present in the row.
 int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1) {
-  const int32_t w = config_.width, h = config_.height;
+  Grid& g = grid();
+  const int32_t w = g.width, h = g.height;
   const int32_t margin = config_.move_margin > 0 ? config_.move_margin : INT32_MAX;
   const int32_t k = config_.smooth_trunc;
   const int32_t row = y * w;
-  const uint8_t* f = labels_ + row;
+  const uint8_t* f = g.labels + row;
   const uint8_t* fd = y + 1 < h ? f + w : f;  // the last row's down weights are 0
-  const uint16_t* wr = weight_right_ + row;
-  const uint16_t* wd = weight_down_ + row;
+  const uint16_t* wr = g.weight_right + row;
+  const uint16_t* wd = g.weight_down + row;
   int32_t* er = Ring(y, kPairRight);
   int32_t* ed = Ring(y, kPairDown);
   int32_t* hi = Ring(y, kHigh);
-  int32_t* sw = move_rows_ + 9 * w;  // each pixel's pair weights summed
+  int32_t* sw = move_rows_ + 9 * config_.width;  // each node's pair weights summed
   auto v = [k](int32_t a, int32_t b) {
     const int32_t d = a > b ? a - b : b - a;
     return d < k ? d : k;
@@ -116,9 +141,22 @@ int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1
       hi[x] += eu[x];
     }
   }
-  const uint16_t* ca = cost_alpha_ + row;
-  const uint16_t* cc = cost_ + row;
-  uint8_t* state = state_ + row;
+  // Restricted moves: which columns hold a label near alpha in rows y - 1..y + 1.
+  uint8_t* near = reinterpret_cast<uint8_t*>(move_rows_ + 10 * config_.width) + 1;
+  const bool restricted = window_ < config_.labels - 1;
+  if (restricted) {
+    const int32_t lo = alpha - window_, top = alpha + window_;
+    const uint8_t* fu = y > 0 ? f - w : f;
+    for (int32_t x = x0 > 0 ? x0 - 1 : 0; x < x1 + 1 && x < w; ++x) {
+      near[x] = (fu[x] >= lo && fu[x] <= top) | (f[x] >= lo && f[x] <= top) |
+                (fd[x] >= lo && fd[x] <= top);
+    }
+    if (x0 == 0) near[-1] = 0;
+    if (x1 == w) near[w] = 0;
+  }
+  const uint16_t* ca = g.cost_alpha + row;
+  const uint16_t* cc = g.cost + row;
+  uint8_t* state = g.state + row;
   int32_t present = 0;
   for (int32_t x = x0; x < x1; ++x) {
     const int32_t u = ca[x] - cc[x];
@@ -127,7 +165,8 @@ int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1
     limit = limit < margin ? limit : margin;
     const int32_t lo = u - v(f[x], alpha) * sw[x];
     hi[x] += lo;
-    const bool keep = u > limit || f[x] == alpha || lo > 0 || Abs(f[x] - alpha) > window_;
+    const bool far = restricted && (near[x - 1] | near[x] | near[x + 1]) == 0;
+    const bool keep = u > limit || f[x] == alpha || lo > 0 || far;
     const uint8_t s = keep ? kKeep : (hi[x] < 0 ? kTake : kFree);
     state[x] = s;
     present |= (s == kFree ? kRowFree : 0) | (s == kTake ? kRowTake : 0);
@@ -137,10 +176,11 @@ int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1
 
 // The pairs from row y (fixed: above a rectangle) down into the rectangle's first row.
 void DepthStage::PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1) {
-  const int32_t w = config_.width, k = config_.smooth_trunc;
-  const uint8_t* f = labels_ + y * w;
+  Grid& g = grid();
+  const int32_t w = g.width, k = config_.smooth_trunc;
+  const uint8_t* f = g.labels + y * w;
   const uint8_t* fd = f + w;
-  const uint16_t* wd = weight_down_ + y * w;
+  const uint16_t* wd = g.weight_down + y * w;
   int32_t* ed = Ring(y, kPairDown);
   auto v = [k](int32_t a, int32_t b) {
     const int32_t d = a > b ? a - b : b - a;
@@ -158,8 +198,8 @@ void DepthStage::PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1) {
 // -C of the pair (q, p), here -B = C - A - e_pq, on p's balance. Neighbours outside the
 // rectangle keep their labels. Returns the free pixels.
 int32_t DepthStage::BuildRow(const Rect& r, int32_t y, int32_t node_row) {
-  const int32_t w = config_.width;
-  const uint8_t* st = state_ + y * w;
+  const int32_t w = grid().width;
+  const uint8_t* st = grid().state + y * w;
   const uint8_t* up = y > r.y0 ? st - w : nullptr;
   const uint8_t* down = y + 1 < r.y1 ? st + w : nullptr;
   const int32_t* er = Ring(y, kPairRight);
@@ -194,7 +234,8 @@ int32_t DepthStage::BuildRow(const Rect& r, int32_t y, int32_t node_row) {
 
 // Classifies and builds the rectangle's rows, cuts the graph and settles its free pixels.
 int64_t DepthStage::CutRect(int32_t alpha, const Rect& r) {
-  const int32_t w = config_.width, gw = r.x1 - r.x0;
+  Grid& g = grid();
+  const int32_t w = g.width, gw = r.x1 - r.x0;
   if (r.y0 > 0) PairsDown(alpha, r.y0 - 1, r.x0, r.x1);
   // Rows with free or switching pixels (y_lo..y_hi), and the graph's rows g_lo..: rows without
   // a free pixel are left out at either end, and written as empty rows only between two others.
@@ -230,7 +271,7 @@ int64_t DepthStage::CutRect(int32_t alpha, const Rect& r) {
     maxflow_.Truncate(rows);
     (void)maxflow_.Solve();
     for (int32_t gy = 0; gy < rows; ++gy) {
-      uint8_t* st = state_ + (g_lo + gy) * w;
+      uint8_t* st = g.state + (g_lo + gy) * w;
       for (int32_t x = r.x0; x < r.x1; ++x) {
         if (st[x] == kFree) st[x] = maxflow_.InSource(gy * gw + x - r.x0) ? kKeep : kTake;
       }
@@ -241,41 +282,48 @@ int64_t DepthStage::CutRect(int32_t alpha, const Rect& r) {
 
 // The energy change from the pixels that switch and their pair terms.
 int64_t DepthStage::MoveDelta(int32_t alpha, const Rect& r, int32_t y_lo, int32_t y_hi) {
-  const int32_t w = config_.width, h = config_.height;
+  const Grid& g = grid();
+  const int32_t w = g.width, h = g.height;
+  const uint8_t* state = g.state;
+  const uint8_t* labels = g.labels;
   int64_t delta = 0;
   for (int32_t y = y_lo; y <= y_hi; ++y) {
     for (int32_t x = r.x0; x < r.x1; ++x) {
       const int32_t p = y * w + x;
-      if (state_[p] != kTake) continue;
-      const int32_t fp = labels_[p];
-      delta += cost_alpha_[p] - cost_[p];
-      // Pairs with an unchanged neighbour; a pair of two switching pixels goes from
-      // V(fp, fq) to 0 and is counted once, from its left or upper pixel.
+      if (state[p] != kTake) continue;
+      const int32_t fp = labels[p];
+      delta += g.cost_alpha[p] - g.cost[p];
+      // Pairs with an unchanged neighbour; a pair of two switching nodes goes from
+      // V(fp, fq) to 0 and is counted once, from its left or upper node.
       auto pair = [&](int32_t q, int32_t wpq, bool first, bool inside) {
-        const bool takes = inside && state_[q] == kTake;
+        const bool takes = inside && state[q] == kTake;
         if (takes && !first) return;
-        const int32_t fq = labels_[q];
+        const int32_t fq = labels[q];
         const int32_t after = takes ? 0 : smooth_[Abs(alpha - fq)];
         delta += int64_t{wpq} * (after - smooth_[Abs(fp - fq)]);
       };
-      if (x + 1 < w) pair(p + 1, weight_right_[p], true, x + 1 < r.x1);
-      if (x > 0) pair(p - 1, weight_right_[p - 1], false, x > r.x0);
-      if (y + 1 < h) pair(p + w, weight_down_[p], true, y + 1 < r.y1);
-      if (y > 0) pair(p - w, weight_down_[p - w], false, y > r.y0);
+      if (x + 1 < w) pair(p + 1, g.weight_right[p], true, x + 1 < r.x1);
+      if (x > 0) pair(p - 1, g.weight_right[p - 1], false, x > r.x0);
+      if (y + 1 < h) pair(p + w, g.weight_down[p], true, y + 1 < r.y1);
+      if (y > 0) pair(p - w, g.weight_down[p - w], false, y > r.y0);
     }
   }
   return delta;
 }
 
 bool DepthStage::Expand(int32_t alpha) {
-  const int32_t w = config_.width;
+  Grid& g = grid();
   const int32_t count = MoveRects(alpha);
   if (config_.geometry == DepthGeometry::kPlanes) data_.SetPlanes(planes_ + alpha * config_.views);
   const int32_t disp_q8 = LabelDispQ8(alpha);
   int64_t delta = 0;
   for (int32_t i = 0; i < count; ++i) {
-    const Rect& r = rects_[i];
-    data_.ComputeRect(disp_q8, r.x0, r.x1, r.y0, r.y1, cost_alpha_ + r.y0 * w, w);
+    const Rect& r = g.rects[i];
+    if (on_coarse_) {
+      BlockCosts(alpha, r, g.cost_alpha);
+    } else {
+      data_.ComputeRect(disp_q8, r.x0, r.x1, r.y0, r.y1, g.cost_alpha + r.y0 * g.width, g.width);
+    }
     delta += CutRect(alpha, r);
   }
   energy_ += delta;
@@ -283,41 +331,46 @@ bool DepthStage::Expand(int32_t alpha) {
   return delta < 0;
 }
 
-// Applies the move's switches and keeps D_p(f_p - 1) and D_p(f_p + 1) for the sub-label fit
-// without another pass of the data term: moves run in label order, so a pixel that keeps label
-// f saw D(f - 1) and D(f + 1) in the moves before and after f, and one that just took alpha saw
-// D(alpha - 1) in the move before (kept in prev_alpha_, where that move looked) and will see
-// D(alpha + 1) in the next. A restricted move looks at every pixel within its window, so at
-// every pixel of label alpha - 1 and alpha + 1.
+// Applies the move's switches. On the pixels it also keeps D_p(f_p - 1) and D_p(f_p + 1) for
+// the sub-label fit without another pass of the data term: moves run in label order, so a pixel
+// that keeps label f saw D(f - 1) and D(f + 1) in the moves before and after f, and one that
+// just took alpha saw D(alpha - 1) in the move before (kept in prev_alpha, where that move
+// looked) and will see D(alpha + 1) in the next. A restricted move looks at every pixel within
+// its window, so at every pixel of label alpha - 1 and alpha + 1.
 void DepthStage::Record(int32_t alpha) {
-  const int32_t w = config_.width, h = config_.height;
-  const bool have_prev = prev_label_ == alpha - 1;
+  Grid& g = grid();
+  const int32_t w = g.width, h = g.height;
+  const bool refine = !on_coarse_;
+  const bool have_prev = refine && prev_label_ == alpha - 1;
   for (int32_t y = 0; y < h; ++y) {
-    const int32_t x0 = span_[2 * y], x1 = span_[2 * y + 1];
-    const int32_t px0 = have_prev ? prev_span_[2 * y] : 0;
-    const int32_t px1 = have_prev ? prev_span_[2 * y + 1] : 0;
+    const int32_t x0 = g.span[2 * y], x1 = g.span[2 * y + 1];
+    const int32_t px0 = have_prev ? g.prev_span[2 * y] : 0;
+    const int32_t px1 = have_prev ? g.prev_span[2 * y + 1] : 0;
     bool took = false;
     for (int32_t x = x0; x < x1; ++x) {
       const int32_t p = y * w + x;
-      const int32_t f = labels_[p];
-      if (state_[p] == kTake) {
-        labels_[p] = static_cast<uint8_t>(alpha);
-        cost_[p] = cost_alpha_[p];
-        below_[p] = x >= px0 && x < px1 ? prev_alpha_[p] : 0xffff;
-        above_[p] = 0xffff;
+      const int32_t f = g.labels[p];
+      if (g.state[p] == kTake) {
+        g.labels[p] = static_cast<uint8_t>(alpha);
+        g.cost[p] = g.cost_alpha[p];
         took = true;
-      } else if (f == alpha + 1) {
-        below_[p] = cost_alpha_[p];
-      } else if (f + 1 == alpha) {
-        above_[p] = cost_alpha_[p];
+        if (!refine) continue;
+        below_[p] = x >= px0 && x < px1 ? g.prev_alpha[p] : 0xffff;
+        above_[p] = 0xffff;
+      } else if (refine && f == alpha + 1) {
+        below_[p] = g.cost_alpha[p];
+      } else if (refine && f + 1 == alpha) {
+        above_[p] = g.cost_alpha[p];
       }
     }
-    if (took) RowLabels(y);
+    if (took) RowLabels(g, y);
   }
-  uint16_t* t = prev_alpha_;
-  prev_alpha_ = cost_alpha_;
-  cost_alpha_ = t;
-  prev_label_ = alpha;
+  if (refine) {
+    uint16_t* t = g.prev_alpha;
+    g.prev_alpha = g.cost_alpha;
+    g.cost_alpha = t;
+    prev_label_ = alpha;
+  }
 }
 
 }  // namespace lb

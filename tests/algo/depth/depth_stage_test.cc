@@ -3,6 +3,9 @@
 // come out under qemu on ARM), the arena bound holds and bad input is refused.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <utility>
+
 #include <cstdlib>
 
 #include <cstdint>
@@ -76,8 +79,8 @@ TEST(DepthStageTest, EnergyNeverRisesAcrossExpansionMoves) {
 }
 
 // Two layers far apart in depth: a move restricted to labels near alpha looks only at the
-// rectangles around one layer, and the pixels around them keep their labels. Its bookkeeping
-// (the energy, the labels, the D kept for the refinement) must match a recomputation.
+// rectangles around one layer, and the pixels with no such label in their 3x3 neighbourhood
+// keep theirs. Its bookkeeping (the energy, the labels) must match a recomputation.
 TEST(DepthStageTest, RestrictedMovesLookOnlyNearTheirLabels) {
   const synth::Burst b = synth::MakeBurst(64, 40, 5, 2, 1, 6, 20, 44, 10, 30, 5u);
   DepthConfig c = SmallConfig(b, 33, 64);
@@ -87,7 +90,8 @@ TEST(DepthStageTest, RestrictedMovesLookOnlyNearTheirLabels) {
   ASSERT_TRUE(s.Configure(c).ok());
   ASSERT_TRUE(s.Compute(b).ok());
   for (int32_t alpha = 0; alpha < c.labels; ++alpha) s.depth.ExpandMove(alpha);  // settle
-  const int64_t n = int64_t{b.width} * b.height;
+  const int32_t w = b.width, h = b.height;
+  const int64_t n = int64_t{w} * h;
   int64_t energy = s.depth.energy();
   int32_t small_moves = 0;
   for (int32_t window : {1, 2, 3}) {
@@ -99,9 +103,18 @@ TEST(DepthStageTest, RestrictedMovesLookOnlyNearTheirLabels) {
       ASSERT_EQ(after, s.depth.energy()) << "alpha " << alpha << " window " << window;
       ASSERT_LE(after, energy);
       energy = after;
-      for (int64_t p = 0; p < n; ++p) {
-        if (std::abs(before[p] - alpha) > window) {
-          ASSERT_EQ(s.depth.labels()[p], before[p]);
+      for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+          bool near = false;
+          for (int32_t dy = -1; dy <= 1; ++dy) {
+            for (int32_t dx = -1; dx <= 1; ++dx) {
+              const int32_t qx = std::clamp(x + dx, 0, w - 1), qy = std::clamp(y + dy, 0, h - 1);
+              near |= std::abs(before[qy * w + qx] - alpha) <= window;
+            }
+          }
+          if (!near) {
+            ASSERT_EQ(s.depth.labels()[y * w + x], before[y * w + x]) << x << "," << y;
+          }
         }
       }
       const int64_t cut = s.depth.stats().cut_pixels - cut_before;
@@ -109,6 +122,27 @@ TEST(DepthStageTest, RestrictedMovesLookOnlyNearTheirLabels) {
     }
   }
   EXPECT_GT(small_moves, 0) << "no move was restricted to part of the image";
+}
+
+// Coarse to fine with the coarse pass on 2x2 blocks (the default), odd sizes included: the
+// blocks' energy as the coarse moves tracked it equals the energy of the same labels on the
+// pixels, recomputed; the fine moves only lower it, and their bookkeeping matches a
+// recomputation from scratch.
+TEST(DepthStageTest, CoarseBlocksHaveThePixelsEnergy) {
+  for (const auto& [w, h] : {std::pair{64, 40}, {63, 41}, {9, 8}}) {
+    const synth::Burst b = synth::MakeBurst(w, h, 5, 2, 1, 6, w / 3, 2 * w / 3, h / 4, h / 2, 9u);
+    DepthConfig c = SmallConfig(b, 33, 64);
+    ASSERT_TRUE(c.coarse_blocks);
+    ASSERT_GT(c.coarse_step, 1);
+    Stage s;
+    ASSERT_TRUE(s.Configure(c).ok());
+    ASSERT_TRUE(s.Compute(b).ok());
+    const DepthStats& st = s.depth.stats();
+    EXPECT_EQ(st.coarse_energy, st.handover_energy) << w << "x" << h;
+    EXPECT_LE(st.coarse_energy, st.initial_energy);
+    EXPECT_LE(st.energy, st.handover_energy);
+    EXPECT_EQ(s.depth.Energy(s.depth.labels()), st.energy);
+  }
 }
 
 TEST(DepthStageTest, MoveResultBeatsEverySinglePixelSwitch) {

@@ -1,0 +1,120 @@
+// The coarse pass of coarse-to-fine depth (DepthConfig::coarse_blocks): full expansion moves
+// over every coarse_step-th label on a grid of 2x2 pixel blocks. A block's D is the sum of its
+// pixels' D and the pair weight between two blocks the sum of the pixel pairs across their
+// edge, so the energy of block labels is exactly that of the same labels on the pixels: the
+// pass minimises the real energy over block-constant labels, on a quarter of the nodes.
+#include "algo/depth/depth_stage.h"
+
+namespace lb {
+
+void DepthStage::BlockWeights() {
+  const int32_t w = config_.width, h = config_.height, bw = coarse_.width, bh = coarse_.height;
+  for (int32_t by = 0; by < bh; ++by) {
+    for (int32_t bx = 0; bx < bw; ++bx) {
+      const int32_t x = 2 * bx, y = 2 * by;
+      int32_t right = 0, down = 0;  // at most 2 * 4096
+      if (x + 2 < w) {
+        for (int32_t yy = y; yy < y + 2 && yy < h; ++yy)
+          right += fine_.weight_right[yy * w + x + 1];
+      }
+      if (y + 2 < h) {
+        for (int32_t xx = x; xx < x + 2 && xx < w; ++xx)
+          down += fine_.weight_down[(y + 1) * w + xx];
+      }
+      coarse_.weight_right[by * bw + bx] = static_cast<uint16_t>(right);
+      coarse_.weight_down[by * bw + bx] = static_cast<uint16_t>(down);
+    }
+  }
+}
+
+// D of `label` for the blocks of rectangle b into out (block grid), through the pixels' D in
+// fine_.cost_alpha (scratch until the fine moves). At most 4 * 2295.
+void DepthStage::BlockCosts(int32_t label, const Rect& b, uint16_t* out) {
+  const int32_t w = config_.width, h = config_.height, bw = coarse_.width;
+  const int32_t x0 = 2 * b.x0, x1 = 2 * b.x1 < w ? 2 * b.x1 : w;
+  const int32_t y0 = 2 * b.y0, y1 = 2 * b.y1 < h ? 2 * b.y1 : h;
+  if (config_.geometry == DepthGeometry::kPlanes) data_.SetPlanes(planes_ + label * config_.views);
+  uint16_t* d = fine_.cost_alpha;
+  data_.ComputeRect(LabelDispQ8(label), x0, x1, y0, y1, d + y0 * w, w);
+  for (int32_t by = b.y0; by < b.y1; ++by) {
+    const uint16_t* r0 = d + 2 * by * w;
+    const uint16_t* r1 = 2 * by + 1 < h ? r0 + w : nullptr;
+    for (int32_t bx = b.x0; bx < b.x1; ++bx) {
+      const int32_t x = 2 * bx;
+      int32_t sum = r0[x] + (r1 ? r1[x] : 0);
+      if (x + 1 < w) sum += r0[x + 1] + (r1 ? r1[x + 1] : 0);
+      out[by * bw + bx] = static_cast<uint16_t>(sum);
+    }
+  }
+}
+
+void DepthStage::CoarseWinnerTakeAll() {
+  Grid& g = coarse_;
+  const int32_t n = g.width * g.height;
+  for (int32_t p = 0; p < n; ++p) {
+    g.cost[p] = 0xffff;
+    g.labels[p] = 0;
+  }
+  const Rect all{0, g.width, 0, g.height};
+  for (int32_t label = 0; label < config_.labels; label += config_.coarse_step) {
+    BlockCosts(label, all, g.cost_alpha);
+    for (int32_t p = 0; p < n; ++p) {
+      if (g.cost_alpha[p] < g.cost[p]) {
+        g.cost[p] = g.cost_alpha[p];
+        g.labels[p] = static_cast<uint8_t>(label);
+      }
+    }
+  }
+}
+
+void DepthStage::CoarsePass() {
+  BlockWeights();
+  on_coarse_ = true;
+  CoarseWinnerTakeAll();
+  energy_ = GridEnergy(coarse_);
+  stats_.initial_energy = energy_;
+  for (int32_t y = 0; y < coarse_.height; ++y) {
+    RowLabels(coarse_, y);
+    coarse_.span[2 * y] = coarse_.span[2 * y + 1] = 0;
+  }
+  window_ = DepthConfig::kMaxLabels;
+  for (int32_t alpha = 0; alpha < config_.labels; alpha += config_.coarse_step) {
+    if (Expand(alpha)) ++stats_.moves;
+  }
+  stats_.coarse_energy = energy_;
+  on_coarse_ = false;
+  FineFromBlocks();
+}
+
+// Every pixel takes its block's label; its D comes from one pass per label present, over the
+// rectangles holding that label.
+void DepthStage::FineFromBlocks() {
+  const int32_t w = config_.width, h = config_.height, bw = coarse_.width;
+  uint64_t present[4] = {};
+  for (int32_t y = 0; y < h; ++y) {
+    const uint8_t* block = coarse_.labels + (y / 2) * bw;
+    uint8_t* f = fine_.labels + y * w;
+    for (int32_t x = 0; x < w; ++x) f[x] = block[x / 2];
+    RowLabels(fine_, y);
+    for (int32_t i = 0; i < 4; ++i) present[i] |= fine_.row_labels[4 * y + i];
+  }
+  window_ = 0;
+  for (int32_t l = 0; l < config_.labels; ++l) {
+    if (((present[l >> 6] >> (l & 63)) & 1) == 0) continue;
+    if (config_.geometry == DepthGeometry::kPlanes) data_.SetPlanes(planes_ + l * config_.views);
+    const int32_t count = MoveRects(l);
+    for (int32_t i = 0; i < count; ++i) {
+      const Rect& r = fine_.rects[i];
+      data_.ComputeRect(LabelDispQ8(l), r.x0, r.x1, r.y0, r.y1, fine_.cost_alpha + r.y0 * w, w);
+      for (int32_t y = r.y0; y < r.y1; ++y) {
+        for (int32_t p = y * w + r.x0; p < y * w + r.x1; ++p) {
+          if (fine_.labels[p] == l) fine_.cost[p] = fine_.cost_alpha[p];
+        }
+      }
+    }
+  }
+  energy_ = GridEnergy(fine_);
+  stats_.handover_energy = energy_;
+}
+
+}  // namespace lb
