@@ -204,7 +204,7 @@ int32_t DepthStage::BuildRow(const Rect& r, int32_t y, int32_t node_row) {
   const uint8_t* down = y + 1 < r.y1 ? st + w : nullptr;
   const int32_t* er = Ring(y, kPairRight);
   const int32_t* ed = Ring(y, kPairDown);
-  const int32_t* eu = y > 0 ? Ring(y - 1, kPairDown) : nullptr;
+  const int32_t* eu = up != nullptr ? Ring(y - 1, kPairDown) : nullptr;
   const int32_t* hi = Ring(y, kHigh);
   const int32_t base = node_row * (r.x1 - r.x0) - r.x0;
   int32_t free_pixels = 0;
@@ -225,7 +225,7 @@ int32_t DepthStage::BuildRow(const Rect& r, int32_t y, int32_t node_row) {
       if (down[x] == kFree) cap_down = ed[x];
       if (down[x] == kTake) balance -= ed[x];
     }
-    if (up && up[x] != kKeep) balance -= eu[x];
+    if (eu && up[x] != kKeep) balance -= eu[x];
     maxflow_.SetNode(base + x, balance, cap_right, cap_down);
   }
   maxflow_.RowDone(node_row);
