@@ -1,7 +1,9 @@
-// Depth by graph cuts: labels start at the winner-take-all choice of the data term, then
-// alpha-expansion cycles lower E(f) = sum D_p(f_p) + sum w_pq min(|f_p - f_q|, K), each move an
-// exact minimum cut on the pixel grid (expansion_move.cc), until a cycle changes nothing or the
-// cycle cap.
+// Depth by graph cuts: alpha-expansion moves lower E(f) = sum D_p(f_p) + sum w_pq
+// min(|f_p - f_q|, K), each move an exact minimum cut (expansion_move.cc). Coarse to fine (the
+// default): the best of every coarse_step-th label per 2x2 block, full moves over those labels
+// on the blocks (coarse_grid.cc), then cycles of moves over every label restricted to pixels
+// near labels within fine_window of alpha, until a cycle changes nothing or the cycle cap.
+// With coarse_step 1: the winner-take-all labels, then cycles of full moves over every label.
 #include "algo/depth/depth_stage.h"
 
 namespace lb {

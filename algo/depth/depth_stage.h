@@ -47,11 +47,13 @@ struct DepthConfig {
   int32_t smooth_trunc = 8;     // 1..64
   int32_t edge_threshold = 16;  // 0..255
   int32_t edge_weight_q8 = 64;  // 0..256
-  int32_t max_cycles = 1;       // expansion cycles after the winner-take-all start, 0..32
+  int32_t max_cycles = 1;       // expansion cycles over every label, 0..32 (0: winner-take-all)
   // Coarse to fine: with coarse_step > 1, one pass of full moves over every coarse_step-th
   // label comes first, and the cycles' moves then free only pixels whose label is within
   // fine_window of alpha (a restricted move: still an exact cut over the pixels it frees). The
   // coarse pass settles the layout, the fine moves its sub-pixel steps, over far smaller graphs.
+  // Measured on the Middlebury sets (README): 4 and 2 lose at most 0.25 points of bad pixels
+  // against full moves over every label, for 4x less time; window 1 loses up to 0.5.
   int32_t coarse_step = 4;  // 1..16; 1: every move is a full move
   int32_t fine_window = 2;  // 1..255
   // The coarse pass labels 2x2 blocks of pixels (its data costs the blocks' sums, its pair
