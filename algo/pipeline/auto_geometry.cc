@@ -1,5 +1,7 @@
 #include "algo/pipeline/auto_geometry.h"
 
+#include "algo/depth/planes.h"
+
 namespace lb {
 
 Status PlanLabelRange(const MotionResult& m, int32_t labels, LabelRange* out) {
@@ -29,6 +31,16 @@ Status PlanLabelRange(const MotionResult& m, int32_t labels, LabelRange* out) {
   out->disp_max_q8 = static_cast<int32_t>(hi + 0.999);
   out->px_per_inv_depth = s;
   return Status::Ok();
+}
+
+Status SetDepthGeometry(const MotionResult& motion, bool keep_range, DepthStage* depth,
+                        PlaneHomography* planes, LabelRange* range) {
+  LB_RETURN_IF_ERROR(PlanLabelRange(motion, depth->config().labels, range));
+  if (!keep_range) {
+    LB_RETURN_IF_ERROR(depth->SetDisparityRange(range->disp_min_q8, range->disp_max_q8));
+  }
+  MakeLabelPlanes(motion, depth->config(), range->px_per_inv_depth, planes);
+  return depth->SetPlanes(planes);
 }
 
 }  // namespace lb

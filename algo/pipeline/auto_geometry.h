@@ -13,6 +13,7 @@
 #include <cstdint>
 
 #include "algo/core/status.h"
+#include "algo/depth/depth_stage.h"
 #include "algo/motion/motion_stage.h"
 
 namespace lb {
@@ -25,5 +26,11 @@ struct LabelRange {
 
 // kDegenerate when the estimate has no baseline or no depth range to label.
 Status PlanLabelRange(const MotionResult& motion, int32_t labels, LabelRange* out);
+
+// Hands a motion estimate to a kPlanes depth stage for its next Compute: the label range
+// PlanLabelRange plans (set on the stage unless keep_range, for a range the caller chose) and the
+// planes of those labels, built in `planes` (views x labels entries). `range` receives the plan.
+Status SetDepthGeometry(const MotionResult& motion, bool keep_range, DepthStage* depth,
+                        PlaneHomography* planes, LabelRange* range);
 
 }  // namespace lb

@@ -3,7 +3,6 @@
 #include <cstring>
 
 #include "algo/core/color.h"
-#include "algo/depth/planes.h"
 #include "algo/pipeline/auto_geometry.h"
 
 namespace lb {
@@ -299,12 +298,10 @@ Status Pipeline::EstimateGeometry(const ConstImageU8* views) {
   if (config_.focal_px > 0) k.fx = k.fy = config_.focal_px / scale_;
   LB_RETURN_IF_ERROR(motion_.Estimate(views, config_.reference, k, &motion_result_));
   LabelRange range;
-  LB_RETURN_IF_ERROR(PlanLabelRange(motion_result_, config_.labels, &range));
+  LB_RETURN_IF_ERROR(SetDepthGeometry(motion_result_, false, &depth_, planes_, &range));
   disp_min_q8_ = range.disp_min_q8;
   disp_max_q8_ = range.disp_max_q8;
-  LB_RETURN_IF_ERROR(depth_.SetDisparityRange(disp_min_q8_, disp_max_q8_));
-  MakeLabelPlanes(motion_result_, depth_.config(), range.px_per_inv_depth, planes_);
-  return depth_.SetPlanes(planes_);
+  return Status::Ok();
 }
 
 Status Pipeline::BeginRender(const RenderParams& params) {

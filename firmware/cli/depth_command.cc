@@ -9,7 +9,6 @@
 
 #include "algo/core/color.h"
 #include "algo/depth/depth_stage.h"
-#include "algo/depth/planes.h"
 #include "algo/motion/motion_stage.h"
 #include "algo/pipeline/auto_geometry.h"
 #include "firmware/cli/commands.h"
@@ -83,16 +82,14 @@ Status EstimatePlanes(const std::vector<ConstImageU8>& views, double focal_px, b
   if (focal_px > 0) k.fx = k.fy = focal_px;
   MotionResult m;
   LB_RETURN_IF_ERROR(motion.Estimate(views.data(), c->reference, k, &m));
+  std::vector<PlaneHomography> planes(static_cast<size_t>(c->views) * c->labels);
   LabelRange range;
-  LB_RETURN_IF_ERROR(PlanLabelRange(m, c->labels, &range));
+  LB_RETURN_IF_ERROR(SetDepthGeometry(m, range_given, stage, planes.data(), &range));
   if (!range_given) {
     c->disp_min_q8 = range.disp_min_q8;
     c->disp_max_q8 = range.disp_max_q8;
   }
-  LB_RETURN_IF_ERROR(stage->SetDisparityRange(c->disp_min_q8, c->disp_max_q8));
-  std::vector<PlaneHomography> planes(static_cast<size_t>(c->views) * c->labels);
-  MakeLabelPlanes(m, stage->config(), range.px_per_inv_depth, planes.data());
-  return stage->SetPlanes(planes.data());
+  return Status::Ok();
 }
 
 }  // namespace
