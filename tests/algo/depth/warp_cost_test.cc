@@ -280,6 +280,19 @@ void PrepareTerm(Fixed& f, const motiontest::Burst& b, const DataTermParams& par
   f.term.Prepare(b.views.data());
 }
 
+// Every view's homography of the plane at inverse depth rho, from the scene's true poses.
+std::vector<PlaneHomography> TruePlanes(const motiontest::Burst& b, double rho) {
+  std::vector<PlaneHomography> planes(b.scene.views());
+  for (int32_t v = 0; v < b.scene.views(); ++v) {
+    const Pose& pose = b.scene.pose(v);
+    ViewMotion m;
+    std::copy(&pose.rotation[0][0], &pose.rotation[0][0] + 9, &m.rotation[0][0]);
+    std::copy(pose.translation, pose.translation + 3, m.translation);
+    planes[v] = MakePlaneHomography(b.intrinsics, m, rho);
+  }
+  return planes;
+}
+
 // Stated tolerance: every fixed-point D lies within the reference's interval (above) for a
 // position error delta = 1/512 (Q8 weights) + 2^-16 (Map) + the anchors' chord bound for this
 // focal length and the burst's rotations of at most 1 degree (warp_cost.h; 1/109 px at
@@ -289,7 +302,7 @@ void PrepareTerm(Fixed& f, const motiontest::Burst& b, const DataTermParams& par
 TEST(WarpCostTest, FixedPointAgreesWithFloatReference) {
   motiontest::Burst b;
   ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(3), 160, 120, 4, &b));
-  const int32_t w = b.scene.width(), h = b.scene.height(), views = b.scene.views();
+  const int32_t w = b.scene.width(), h = b.scene.height();
   const double rho_min = b.scene.inverse_depth_min_q12() / 4096.0;
   const double rho_max = b.scene.inverse_depth_max_q12() / 4096.0;
   const double chord =
@@ -302,14 +315,7 @@ TEST(WarpCostTest, FixedPointAgreesWithFloatReference) {
     PrepareTerm(f, b, params);
     for (const double t : {0.0, 0.3, 0.7, 1.0}) {
       const double rho = rho_min + t * (rho_max - rho_min);
-      std::vector<PlaneHomography> planes(views);
-      for (int32_t v = 0; v < views; ++v) {
-        const Pose& pose = b.scene.pose(v);
-        ViewMotion m;
-        std::copy(&pose.rotation[0][0], &pose.rotation[0][0] + 9, &m.rotation[0][0]);
-        std::copy(pose.translation, pose.translation + 3, m.translation);
-        planes[v] = MakePlaneHomography(b.intrinsics, m, rho);
-      }
+      const std::vector<PlaneHomography> planes = TruePlanes(b, rho);
       f.term.SetPlanes(planes.data());
       std::vector<uint16_t> fixed(static_cast<size_t>(w) * h);
       f.term.ComputeRows(0, 0, h, fixed.data(), w);
@@ -342,15 +348,8 @@ TEST(WarpCostTest, ColumnRangesEqualTheWholeRow) {
     const int32_t h = b.scene.height();
     Fixed f;
     PrepareTerm(f, b, DataTermParams{});
-    std::vector<PlaneHomography> planes(b.scene.views());
-    const double rho = b.scene.inverse_depth_min_q12() / 4096.0;
-    for (int32_t v = 0; v < b.scene.views(); ++v) {
-      const Pose& pose = b.scene.pose(v);
-      ViewMotion m;
-      std::copy(&pose.rotation[0][0], &pose.rotation[0][0] + 9, &m.rotation[0][0]);
-      std::copy(pose.translation, pose.translation + 3, m.translation);
-      planes[v] = MakePlaneHomography(b.intrinsics, m, rho);
-    }
+    const std::vector<PlaneHomography> planes =
+        TruePlanes(b, b.scene.inverse_depth_min_q12() / 4096.0);
     f.term.SetPlanes(planes.data());
     std::vector<uint16_t> whole(static_cast<size_t>(w) * h);
     f.term.ComputeRows(0, 0, h, whole.data(), w);
