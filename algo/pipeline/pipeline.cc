@@ -104,8 +104,7 @@ Status Pipeline::Carve(Arena& arena) {
   rgb_rows_[0] = arena.Allocate<uint8_t>(static_cast<size_t>(c.width) * 3);
   rgb_rows_[1] = arena.Allocate<uint8_t>(static_cast<size_t>(c.width) * 3);
   acc_ = arena.Allocate<uint32_t>(static_cast<size_t>(work_w_) * 3);
-  const bool auto_geometry = c.geometry == Geometry::kAuto;
-  if (auto_geometry) {
+  if (UsesMotion(c, work_w_, work_h_)) {
     planes_ = arena.Allocate<PlaneHomography>(static_cast<size_t>(c.frames) * c.labels);
   }
   if (arena.planning()) {
