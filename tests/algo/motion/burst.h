@@ -2,6 +2,7 @@
 // the errors of an estimate against the scene's true poses. Host-side; allocates freely.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -16,21 +17,50 @@ struct Burst {
   Scene scene;
   std::vector<std::vector<uint8_t>> pixels;
   std::vector<ConstImageU8> views;
-  CameraIntrinsics intrinsics;
+  CameraIntrinsics intrinsics;  // of the views
+  int32_t width = 0, height = 0;
+  // The scene renders at truth_scale times the views' size (scene.width() is that size): pass
+  // truth_scale times the wanted scale to its ground-truth calls.
+  int32_t truth_scale = 1;
 };
 
-// Renders `views` frames of a seeded handheld scene at width x height. False on failure.
+// Renders `views` frames of a seeded handheld scene at width x height. With pixel_samples s > 1
+// the scene is rendered at s times the size and each pixel is the mean of its s x s samples:
+// the pixel integrates the light over its area, as a sensor's does (behind its lens and
+// anti-aliasing filter), instead of point-sampling the hard-edged patterns at its centre, which
+// moves the tracked corners by up to ~0.3 px (tests/algo/motion/accuracy_test.cc). False on
+// failure.
 inline bool MakeBurst(const SceneParams& params, int32_t width, int32_t height, int32_t views,
-                      Burst* b) {
-  if (!b->scene.Configure(params, width, height, views).ok()) return false;
+                      Burst* b, int32_t pixel_samples = 1) {
+  const int32_t s = pixel_samples, sw = width * s, sh = height * s;
+  if (s < 1 || !b->scene.Configure(params, sw, sh, views).ok()) return false;
+  b->width = width;
+  b->height = height;
+  b->truth_scale = s;
   b->pixels.assign(views, std::vector<uint8_t>(static_cast<size_t>(width) * height * 3));
   b->views.clear();
+  std::vector<uint8_t> rows(static_cast<size_t>(sw) * s * 3);
+  std::vector<int32_t> sum(static_cast<size_t>(width) * 3);
   for (int32_t v = 0; v < views; ++v) {
-    if (!b->scene.RenderRows(v, 0, height, b->pixels[v].data(), width * 3).ok()) return false;
+    for (int32_t y = 0; y < height; ++y) {
+      if (!b->scene.RenderRows(v, y * s, s, rows.data(), sw * 3).ok()) return false;
+      std::fill(sum.begin(), sum.end(), 0);
+      for (int32_t j = 0; j < s; ++j) {
+        const uint8_t* r = rows.data() + static_cast<size_t>(j) * sw * 3;
+        for (int32_t x = 0; x < sw; ++x) {
+          for (int32_t c = 0; c < 3; ++c) sum[(x / s) * 3 + c] += r[x * 3 + c];
+        }
+      }
+      uint8_t* out = b->pixels[v].data() + static_cast<size_t>(y) * width * 3;
+      for (int32_t i = 0; i < width * 3; ++i) {
+        out[i] = static_cast<uint8_t>((sum[i] + s * s / 2) / (s * s));
+      }
+    }
     b->views.push_back(MakeView(b->pixels[v].data(), width, height, 3).AsConst());
   }
+  // Pixel (i, j) covers [s i, s i + s) of the render: the same continuous coordinates / s.
   const Intrinsics& k = b->scene.intrinsics();
-  b->intrinsics = {k.fx, k.fy, k.cx, k.cy};
+  b->intrinsics = {k.fx / s, k.fy / s, k.cx / s, k.cy / s};
   return true;
 }
 
