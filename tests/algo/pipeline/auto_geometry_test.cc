@@ -1,9 +1,10 @@
 // Depth with auto geometry, as the product runs on a handheld burst: motion estimated from the
 // frames, labels from the tracked points' depths, each view warped through the planes'
 // homographies. Against what the product could do if it knew the answer:
-// - synthetic handheld bursts at the working resolution (640x480, 5-7 frames): over the seeds
-//   (LB_AUTO_SEEDS, default 6), the median bad-pixel rate with the estimated poses is within 1.5x
-//   of the same bursts with the true poses; every seed is printed;
+// - synthetic handheld bursts at the working resolution (640x480, 5-7 frames; each pixel the
+//   mean of 4 x 4 samples, as a sensor integrates its area: LB_PIXEL_SAMPLES): for every seed
+//   (LB_AUTO_SEEDS, default 6), the bad-pixel rate with the estimated poses is within 1.5x of
+//   the same burst's with the true poses; every seed is printed;
 // - Middlebury tsukuba (nothing said about the rig), after fitting the one global scale that
 //   auto geometry cannot know, against the rectified result. Issue 6 asks for 1.5x; measured
 //   3.6 % against 1.24 % with the focal length right and 15.6 % with the default field of view,
@@ -82,6 +83,11 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+int32_t PixelSamples() {
+  const char* env = std::getenv("LB_PIXEL_SAMPLES");
+  return env ? std::atoi(env) : 4;
+}
+
 TEST(AutoGeometry, HandheldDepthWithEstimatedPosesIsCloseToTruePoses) {
   const char* env = std::getenv("LB_AUTO_SEEDS");
   const int32_t seeds = env ? std::atoi(env) : 6;
@@ -90,7 +96,8 @@ TEST(AutoGeometry, HandheldDepthWithEstimatedPosesIsCloseToTruePoses) {
   for (int32_t s = 0; s < seeds; ++s) {
     const int32_t n = 5 + s % 3;
     motiontest::Burst b;
-    ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(200 + s), kW, kH, n, &b));
+    ASSERT_TRUE(
+        motiontest::MakeBurst(motiontest::Handheld(200 + s), kW, kH, n, &b, PixelSamples()));
     const int32_t ref = b.scene.reference();
     MotionResult truth;
     truth.views = n;
@@ -111,7 +118,7 @@ TEST(AutoGeometry, HandheldDepthWithEstimatedPosesIsCloseToTruePoses) {
 
     // Truth in the unit both runs write: px of parallax per view step (auto_geometry.h).
     std::vector<uint16_t> rho_q12(static_cast<size_t>(kW) * kH);
-    ASSERT_TRUE(b.scene.InverseDepthRows(1, 0, kH, rho_q12.data(), kW).ok());
+    ASSERT_TRUE(b.scene.InverseDepthRows(b.truth_scale, 0, kH, rho_q12.data(), kW).ok());
     std::vector<uint16_t> disp;
     LabelRange true_range, est_range;
     ASSERT_TRUE(PlaneDepth(b.views, truth, kLabels, &disp, &true_range).ok());
@@ -133,6 +140,7 @@ TEST(AutoGeometry, HandheldDepthWithEstimatedPosesIsCloseToTruePoses) {
     };
     true_bad.push_back(bad(disp_true_poses));
     est_bad.push_back(bad(disp));
+    EXPECT_LE(est_bad.back(), 1.5 * true_bad.back()) << "seed " << 200 + s;
     printf("seed %d (%d frames): bad %.2f %% with estimated poses, %.2f %% with true poses\n",
            200 + s, n, est_bad.back(), true_bad.back());
   }
