@@ -42,6 +42,11 @@ class Arena {
   void* AllocateBytes(size_t bytes);
 
   static constexpr size_t RoundUp(size_t n) { return (n + kAlign - 1) & ~(kAlign - 1); }
+  // The first kAlign boundary at or after p: for an arena in a buffer with no alignment of its
+  // own, which then needs kAlign - 1 bytes more than the arena.
+  static void* AlignUp(void* p) {
+    return reinterpret_cast<void*>(RoundUp(reinterpret_cast<uintptr_t>(p)));
+  }
 
  private:
   uint8_t* base_ = nullptr;

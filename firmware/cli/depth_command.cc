@@ -73,9 +73,8 @@ Status EstimatePlanes(const std::vector<ConstImageU8>& views, double focal_px, b
   mc.views = c->views;
   LB_RETURN_IF_ERROR(MotionStage::Validate(mc));
   std::vector<uint8_t> memory(MotionStage::RequiredBytes(mc) + Arena::kAlign);
-  const uintptr_t base = (reinterpret_cast<uintptr_t>(memory.data()) + Arena::kAlign - 1) &
-                         ~uintptr_t{Arena::kAlign - 1};
-  Arena arena(reinterpret_cast<void*>(base), memory.size() - Arena::kAlign);
+  void* const base = Arena::AlignUp(memory.data());
+  Arena arena(base, memory.size() - Arena::kAlign);
   MotionStage motion;
   LB_RETURN_IF_ERROR(motion.Configure(mc, arena));
   CameraIntrinsics k = DefaultIntrinsics(c->width, c->height);
@@ -192,9 +191,8 @@ int DepthCommand(int argc, char** argv) {
 
   const size_t bytes = DepthStage::RequiredBytes(c);
   std::vector<uint8_t> memory(bytes + Arena::kAlign);
-  const uintptr_t base = (reinterpret_cast<uintptr_t>(memory.data()) + Arena::kAlign - 1) &
-                         ~uintptr_t{Arena::kAlign - 1};
-  Arena arena(reinterpret_cast<void*>(base), bytes);
+  void* const base = Arena::AlignUp(memory.data());
+  Arena arena(base, bytes);
   DepthStage stage;
   Status s = stage.Configure(c, arena);
   if (!s.ok()) return Fail(s.message());

@@ -107,9 +107,8 @@ void CarveTerm(Fixed& f, int32_t width, int32_t height, int32_t views) {
   DataTerm planner;
   planner.Carve(plan, width, height, views);
   f.memory.assign(plan.used() + Arena::kAlign, 0);
-  const uintptr_t base = (reinterpret_cast<uintptr_t>(f.memory.data()) + Arena::kAlign - 1) &
-                         ~uintptr_t{Arena::kAlign - 1};
-  Arena arena(reinterpret_cast<void*>(base), plan.used());
+  void* const base = Arena::AlignUp(f.memory.data());
+  Arena arena(base, plan.used());
   f.term.Carve(arena, width, height, views);
   ASSERT_FALSE(arena.overflowed());
 }

@@ -25,9 +25,8 @@ struct Stage {
   Status Configure(const DepthConfig& c) {
     const size_t bytes = DepthStage::RequiredBytes(c);
     memory.assign(bytes + Arena::kAlign, 0);
-    const uintptr_t base = (reinterpret_cast<uintptr_t>(memory.data()) + Arena::kAlign - 1) &
-                           ~uintptr_t{Arena::kAlign - 1};
-    Arena arena(reinterpret_cast<void*>(base), bytes);
+    void* const base = Arena::AlignUp(memory.data());
+    Arena arena(base, bytes);
     disp.assign(static_cast<size_t>(c.width) * c.height, 0);
     return depth.Configure(c, arena);
   }

@@ -38,8 +38,7 @@ void Check(const char* name, double bound) {
   const DepthConfig c = MiddleburyConfig(set);
   const size_t bytes = DepthStage::RequiredBytes(c);
   std::vector<uint8_t> memory(bytes + Arena::kAlign);
-  const uintptr_t base = (reinterpret_cast<uintptr_t>(memory.data()) + Arena::kAlign - 1) &
-                         ~uintptr_t{Arena::kAlign - 1};
+  void* const base = Arena::AlignUp(memory.data());
   const std::vector<ConstImageU8> views = set.Views();
   std::vector<uint16_t> disp(static_cast<size_t>(set.width) * set.height);
   const ImageU16 out = MakeView(disp.data(), set.width, set.height);
@@ -47,7 +46,7 @@ void Check(const char* name, double bound) {
   for (int refine = 0; refine < 2; ++refine) {
     DepthConfig rc = c;
     rc.subpixel = refine == 1;
-    Arena arena(reinterpret_cast<void*>(base), bytes);
+    Arena arena(base, bytes);
     DepthStage stage;
     ASSERT_TRUE(stage.Configure(rc, arena).ok());
     const Status computed = stage.Compute(views.data(), out);

@@ -271,9 +271,8 @@ void PrepareTerm(Fixed& f, const motiontest::Burst& b, const DataTermParams& par
   DataTerm planner;
   planner.Carve(plan, w, h, n);
   f.memory.assign(plan.used() + Arena::kAlign, 0);
-  const uintptr_t base = (reinterpret_cast<uintptr_t>(f.memory.data()) + Arena::kAlign - 1) &
-                         ~uintptr_t{Arena::kAlign - 1};
-  Arena arena(reinterpret_cast<void*>(base), plan.used());
+  void* const base = Arena::AlignUp(f.memory.data());
+  Arena arena(base, plan.used());
   f.term.Carve(arena, w, h, n);
   ASSERT_FALSE(arena.overflowed());
   f.term.SetParams(params, b.scene.reference());

@@ -34,9 +34,8 @@ struct Memory {
   std::vector<uint8_t> bytes;
   Arena Make(size_t n) {
     bytes.assign(n + Arena::kAlign, 0);
-    const uintptr_t base = (reinterpret_cast<uintptr_t>(bytes.data()) + Arena::kAlign - 1) &
-                           ~uintptr_t{Arena::kAlign - 1};
-    return Arena(reinterpret_cast<void*>(base), n);
+    void* const base = Arena::AlignUp(bytes.data());
+    return Arena(base, n);
   }
 };
 

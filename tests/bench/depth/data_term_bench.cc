@@ -32,9 +32,8 @@ Fixture& Teddy() {
   DataTerm planner;
   planner.Carve(plan, f.set.width, f.set.height, n);
   f.memory.assign(plan.used() + Arena::kAlign, 0);
-  const uintptr_t base = (reinterpret_cast<uintptr_t>(f.memory.data()) + Arena::kAlign - 1) &
-                         ~uintptr_t{Arena::kAlign - 1};
-  Arena arena(reinterpret_cast<void*>(base), plan.used());
+  void* const base = Arena::AlignUp(f.memory.data());
+  Arena arena(base, plan.used());
   f.term.Carve(arena, f.set.width, f.set.height, n);
   f.term.SetParams(DataTermParams{}, f.set.reference);
   f.term.Prepare(f.views.data());

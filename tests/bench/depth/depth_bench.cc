@@ -46,9 +46,8 @@ void BM_DepthStageTeddy(benchmark::State& state) {
   c.subpixel = state.range(0) != 0;  // the refinement costs one more pass of the data term
   const size_t bytes = DepthStage::RequiredBytes(c);
   std::vector<uint8_t> memory(bytes + Arena::kAlign);
-  const uintptr_t base = (reinterpret_cast<uintptr_t>(memory.data()) + Arena::kAlign - 1) &
-                         ~uintptr_t{Arena::kAlign - 1};
-  Arena arena(reinterpret_cast<void*>(base), bytes);
+  void* const base = Arena::AlignUp(memory.data());
+  Arena arena(base, bytes);
   DepthStage stage;
   if (!stage.Configure(c, arena).ok()) {
     state.SkipWithError("configure failed");
@@ -101,9 +100,8 @@ void BM_DepthStage640x480(benchmark::State& state) {
   }
   const size_t bytes = DepthStage::RequiredBytes(c);
   std::vector<uint8_t> memory(bytes + Arena::kAlign);
-  const uintptr_t base = (reinterpret_cast<uintptr_t>(memory.data()) + Arena::kAlign - 1) &
-                         ~uintptr_t{Arena::kAlign - 1};
-  Arena arena(reinterpret_cast<void*>(base), bytes);
+  void* const base = Arena::AlignUp(memory.data());
+  Arena arena(base, bytes);
   DepthStage stage;
   if (!stage.Configure(c, arena).ok()) {
     state.SkipWithError("configure failed");

@@ -68,9 +68,7 @@ void BM_PipelineAuto7x640x480(benchmark::State& state) {
     return;
   }
   std::vector<uint8_t> memory(bytes + Arena::kAlign);
-  void* base =
-      reinterpret_cast<void*>((reinterpret_cast<uintptr_t>(memory.data()) + Arena::kAlign - 1) &
-                              ~uintptr_t{Arena::kAlign - 1});
+  void* const base = Arena::AlignUp(memory.data());
   Pipeline p;
   if (!p.Configure(c, base, bytes).ok()) {
     state.SkipWithError("configure");
