@@ -45,7 +45,8 @@ class Arena {
   // The first kAlign boundary at or after p: for an arena in a buffer with no alignment of its
   // own, which then needs kAlign - 1 bytes more than the arena.
   static void* AlignUp(void* p) {
-    return reinterpret_cast<void*>(RoundUp(reinterpret_cast<uintptr_t>(p)));
+    const uintptr_t at = reinterpret_cast<uintptr_t>(p);
+    return static_cast<uint8_t*>(p) + (RoundUp(at) - at);
   }
 
  private:
