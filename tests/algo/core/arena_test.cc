@@ -36,5 +36,16 @@ TEST(Arena, OverflowIsReportedNotHidden) {
   EXPECT_TRUE(arena.overflowed());
 }
 
+TEST(Arena, AlignUpFindsTheNextBoundaryInsideTheBuffer) {
+  alignas(Arena::kAlign) uint8_t buffer[3 * Arena::kAlign];
+  for (size_t offset = 0; offset <= Arena::kAlign; ++offset) {
+    uint8_t* p = buffer + offset;
+    const auto* q = static_cast<uint8_t*>(Arena::AlignUp(p));
+    EXPECT_EQ(reinterpret_cast<uintptr_t>(q) % Arena::kAlign, 0u) << offset;
+    EXPECT_GE(q, p);
+    EXPECT_LT(q - p, static_cast<ptrdiff_t>(Arena::kAlign)) << offset;
+  }
+}
+
 }  // namespace
 }  // namespace lb
