@@ -33,7 +33,7 @@ void DepthStage::BlockCosts(int32_t label, const Rect& b, uint16_t* out) {
   const int32_t w = config_.width, h = config_.height, bw = coarse_.width;
   const int32_t x0 = 2 * b.x0, x1 = 2 * b.x1 < w ? 2 * b.x1 : w;
   const int32_t y0 = 2 * b.y0, y1 = 2 * b.y1 < h ? 2 * b.y1 : h;
-  if (config_.geometry == DepthGeometry::kPlanes) data_.SetPlanes(planes_ + label * config_.views);
+  UseLabelPlanes(label);
   uint16_t* d = fine_.cost_alpha;
   data_.ComputeRect(LabelDispQ8(label), x0, x1, y0, y1, d + y0 * w, w);
   for (int32_t by = b.y0; by < b.y1; ++by) {
@@ -101,7 +101,7 @@ void DepthStage::FineFromBlocks() {
   window_ = 0;
   for (int32_t l = 0; l < config_.labels; ++l) {
     if (((present[l >> 6] >> (l & 63)) & 1) == 0) continue;
-    if (config_.geometry == DepthGeometry::kPlanes) data_.SetPlanes(planes_ + l * config_.views);
+    UseLabelPlanes(l);
     const int32_t count = MoveRects(l);
     for (int32_t i = 0; i < count; ++i) {
       const Rect& r = fine_.rects[i];

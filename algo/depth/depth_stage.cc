@@ -148,7 +148,7 @@ Status DepthStage::SetDisparityRange(int32_t disp_min_q8, int32_t disp_max_q8) {
 }
 
 void DepthStage::LabelCosts(int32_t label, uint16_t* out) {
-  if (config_.geometry == DepthGeometry::kPlanes) data_.SetPlanes(planes_ + label * config_.views);
+  UseLabelPlanes(label);
   data_.ComputeRows(LabelDispQ8(label), 0, config_.height, out, config_.width);
 }
 
@@ -304,17 +304,15 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
   window_ = DepthConfig::kMaxLabels;
   const bool coarse = c.coarse_step > 1 && c.max_cycles > 0;
   if (coarse && c.coarse_blocks) {
-    CoarsePass();  // ends with the pixels' labels, costs and energy
+    CoarsePass();  // ends with the pixels' labels, their row masks, costs and energy
   } else {
     WinnerTakeAll();
+    for (int32_t y = 0; y < h; ++y) RowLabels(fine_, y);
     energy_ = GridEnergy(fine_);
     stats_.initial_energy = energy_;
   }
   for (int32_t p = 0; p < w * h; ++p) below_[p] = above_[p] = 0xffff;
-  for (int32_t y = 0; y < h; ++y) {
-    RowLabels(fine_, y);
-    fine_.span[2 * y] = fine_.span[2 * y + 1] = 0;
-  }
+  for (int32_t y = 0; y < h; ++y) fine_.span[2 * y] = fine_.span[2 * y + 1] = 0;
   if (coarse && !c.coarse_blocks) {
     for (int32_t alpha = 0; alpha < c.labels; alpha += c.coarse_step) {
       if (Expand(alpha)) ++stats_.moves;

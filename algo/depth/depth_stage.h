@@ -149,6 +149,11 @@ class DepthStage {
 
   Status Carve(Arena& arena);
   void EdgeWeights(const ConstImageU8& ref);
+  // kPlanes: points the data term at one label's planes (a no-op for rectified shifts).
+  void UseLabelPlanes(int32_t label) {
+    if (config_.geometry == DepthGeometry::kPlanes)
+      data_.SetPlanes(planes_ + label * config_.views);
+  }
   void LabelCosts(int32_t label, uint16_t* out);  // D of one label for the whole image
   void WinnerTakeAll();
   // The coarse pass (coarse_grid.cc): block weights, block costs, the best coarse label of

@@ -238,7 +238,7 @@ int64_t DepthStage::MoveDelta(int32_t alpha, const Rect& r, int32_t y_lo, int32_
 bool DepthStage::Expand(int32_t alpha) {
   Grid& g = grid();
   const int32_t count = MoveRects(alpha);
-  if (config_.geometry == DepthGeometry::kPlanes) data_.SetPlanes(planes_ + alpha * config_.views);
+  UseLabelPlanes(alpha);
   const int32_t disp_q8 = LabelDispQ8(alpha);
   int64_t delta = 0;
   for (int32_t i = 0; i < count; ++i) {
