@@ -11,10 +11,16 @@ using Mat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
 
 Mat3 Rot(const ViewMotion& m) { return Eigen::Map<const Mat3>(&m.rotation[0][0]); }
 
-// Point on the reference ray of `point` at inverse depth w, in view coordinates (up to scale).
-Vec3 Ray(const BundleInput& in, const ViewMotion& m, double w, int32_t point, Vec3* rr) {
-  const Vec3 r(in.ref_xy[2 * point], in.ref_xy[2 * point + 1], 1.0);
-  *rr = Rot(m) * r;
+// Undistorted normalised coordinates of a distorted observation p: p (1 + k1 |p|^2).
+Eigen::Vector2d Undistort(const double* p, double k1) {
+  return Eigen::Vector2d(p[0], p[1]) * (1 + k1 * (p[0] * p[0] + p[1] * p[1]));
+}
+
+// Point on the reference ray of `point` at inverse depth w, in view coordinates (up to scale);
+// rr receives R r.
+Vec3 Ray(const BundleInput& in, const ViewMotion& m, double w, double k1, int32_t point, Vec3* rr) {
+  const Eigen::Vector2d u = Undistort(in.ref_xy + 2 * point, k1);
+  *rr = Rot(m) * Vec3(u[0], u[1], 1.0);
   return *rr + w * Eigen::Map<const Vec3>(m.translation);
 }
 
@@ -42,6 +48,24 @@ void RotateBy(const double d[3], ViewMotion* m) {
   Eigen::Map<Mat3>(&m->rotation[0][0]) = (q * Rot(*m)).eval();
 }
 
+// Small-angle rotation vector of R: vee((R - R^T) / 2), sin(angle) times the axis.
+Vec3 AngleVector(const ViewMotion& m) {
+  const double(*r)[3] = m.rotation;
+  return Vec3(0.5 * (r[2][1] - r[1][2]), 0.5 * (r[0][2] - r[2][0]), 0.5 * (r[1][0] - r[0][1]));
+}
+
+double PriorCost(const BundleInput& in, const ViewMotion* motion) {
+  double cost = 0;
+  if (in.rotation_prior > 0) {
+    for (int32_t v = 0; v < in.views; ++v) {
+      if (v == in.reference) continue;
+      const double a = AngleVector(motion[v]).dot(Eigen::Map<const Vec3>(in.prior_axis));
+      cost += 0.5 * in.rotation_prior * in.fx * in.fx * a * a;
+    }
+  }
+  return cost;
+}
+
 }  // namespace
 
 Status Bundle::Carve(int32_t max_views, int32_t max_points, Arena& arena) {
@@ -51,36 +75,37 @@ Status Bundle::Carve(int32_t max_views, int32_t max_points, Arena& arena) {
   }
   max_views_ = max_views;
   max_points_ = max_points;
-  const size_t nc = 6 * static_cast<size_t>(max_views - 1);
+  const size_t nc = 6 * static_cast<size_t>(max_views - 1), nr = nc + 1;
   hcc_ = arena.Allocate<double>(nc * 6);
-  g_ = arena.Allocate<double>(nc);
-  s_ = arena.Allocate<double>(nc * nc);
-  g2_ = arena.Allocate<double>(nc);
+  hck_ = arena.Allocate<double>(nr);
+  g_ = arena.Allocate<double>(nr);
+  s_ = arena.Allocate<double>(nr * nr);
+  g2_ = arena.Allocate<double>(nr);
   hww_ = arena.Allocate<double>(max_points);
   gw_ = arena.Allocate<double>(max_points);
-  hcw_ = arena.Allocate<double>(nc * max_points);
+  hcw_ = arena.Allocate<double>(nr * max_points);
   w_try_ = arena.Allocate<double>(max_points);
   return Status::Ok();
 }
 
-double Bundle::ErrorPx(const BundleInput& in, const ViewMotion& m, double w, int32_t view,
-                       int32_t point) {
+double Bundle::ErrorPx(const BundleInput& in, const ViewMotion& m, double w, double k1,
+                       int32_t view, int32_t point) {
   Vec3 rr;
-  const Vec3 a = Ray(in, m, w, point, &rr);
-  const double* o = Obs(in, view, point);
+  const Vec3 a = Ray(in, m, w, k1, point, &rr);
+  const Eigen::Vector2d o = Undistort(Obs(in, view, point), k1);
   const double ex = in.fx * (a[0] / a[2] - o[0]), ey = in.fy * (a[1] / a[2] - o[1]);
   return __builtin_sqrt(ex * ex + ey * ey);
 }
 
-double Bundle::Cost(const BundleInput& in, const ViewMotion* motion, const double* w, double huber,
-                    int32_t* count) const {
+double Bundle::Cost(const BundleInput& in, const ViewMotion* motion, const double* w, double k1,
+                    double huber, int32_t* count) const {
   double cost = 0;
   int32_t n = 0;
   for (int32_t j = 0; j < in.points; ++j) {
     if (!in.point_ok[j]) continue;
     for (int32_t v = 0; v < in.views; ++v) {
       if (v == in.reference || !ObsOk(in, v, j)) continue;
-      const double e = ErrorPx(in, motion[v], w[j], v, j);
+      const double e = ErrorPx(in, motion[v], w[j], k1, v, j);
       cost += Huber(e * e, huber);
       ++n;
     }
@@ -90,26 +115,32 @@ double Bundle::Cost(const BundleInput& in, const ViewMotion* motion, const doubl
 }
 
 Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber,
-                     ViewMotion* motion, double* w, BundleReport* report) {
+                     ViewMotion* motion, double* w, double* k1, BundleReport* report) {
   if (in.views < 2 || in.views > max_views_ || in.points > max_points_ || in.reference < 0 ||
       in.reference >= in.views) {
     return Status(Code::kInvalidArgument, "bundle: %d views, %d points beyond the configuration",
                   in.views, in.points);
   }
   const int32_t nc = 6 * (in.views - 1);
-  // Hcc is block diagonal (an observation involves one camera): kept as nc x 6 undamped blocks.
+  // The reduced system: the camera blocks, then k1 when it is estimated.
+  double kd = k1 ? *k1 : 0;
+  const int32_t nr = nc + (k1 ? 1 : 0);
+  // Hcc is block diagonal (an observation involves one camera): kept as nc x 6 undamped blocks;
+  // the k1 row of the camera part is hck (nr: its last entry is Hkk).
   Eigen::Map<Eigen::MatrixXd> hcc(hcc_, nc, 6);
-  Eigen::Map<Eigen::VectorXd> g(g_, nc);
-  Eigen::Map<Eigen::MatrixXd> s(s_, nc, nc);
-  Eigen::Map<Eigen::VectorXd> g2(g2_, nc);
+  Eigen::Map<Eigen::VectorXd> hck(hck_, nr);
+  Eigen::Map<Eigen::VectorXd> g(g_, nr);
+  Eigen::Map<Eigen::MatrixXd> s(s_, nr, nr);
+  Eigen::Map<Eigen::VectorXd> g2(g2_, nr);
   // Camera block index of a view (the reference has none).
   auto block = [&](int32_t v) { return 6 * (v < in.reference ? v : v - 1); };
   int32_t count = 0;
-  double cost = Cost(in, motion, w, huber, &count);
+  double cost = Cost(in, motion, w, kd, huber, &count);
   *report = BundleReport{};
   report->observations = count;
   report->initial_rms_px = count ? __builtin_sqrt(2 * cost / count) : 0;
   if (count == 0) return Status(Code::kDegenerate, "bundle: no observations");
+  cost += PriorCost(in, motion);
   double lambda = 1e-3;
   const double eps = 1e-12 * in.fx * in.fx;
   ViewMotion trial[kMaxViews];
@@ -117,18 +148,22 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
   for (; it < max_iterations; ++it) {
     // Normal equations of the IRLS-weighted problem; the point unknowns are eliminated below.
     hcc.setZero();
+    hck.setZero();
     g.setZero();
     for (int32_t j = 0; j < in.points; ++j) {
       hww_[j] = 0;
       gw_[j] = 0;
-      Eigen::Map<Eigen::VectorXd> hcw(hcw_ + static_cast<size_t>(nc) * j, nc);
+      Eigen::Map<Eigen::VectorXd> hcw(hcw_ + static_cast<size_t>(nr) * j, nr);
       hcw.setZero();
       if (!in.point_ok[j]) continue;
+      const double* rd = in.ref_xy + 2 * j;
+      const double rd2 = rd[0] * rd[0] + rd[1] * rd[1];
       for (int32_t v = 0; v < in.views; ++v) {
         if (v == in.reference || !ObsOk(in, v, j)) continue;
         Vec3 rr;
-        const Vec3 a = Ray(in, motion[v], w[j], j, &rr);
-        const double* o = Obs(in, v, j);
+        const Vec3 a = Ray(in, motion[v], w[j], kd, j, &rr);
+        const double* od = Obs(in, v, j);
+        const Eigen::Vector2d o = Undistort(od, kd);
         const double iz = 1.0 / a[2];
         const Eigen::Vector2d e(in.fx * (a[0] * iz - o[0]), in.fy * (a[1] * iz - o[1]));
         const double en = e.norm();
@@ -147,6 +182,27 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
         hcw.segment<6>(b) += rw * jc.transpose() * jw;
         hww_[j] += rw * jw.squaredNorm();
         gw_[j] -= rw * jw.dot(e);
+        if (k1) {
+          // k1 moves the reference ray (R (rd |rd|^2, 0)) and the observation (od |od|^2).
+          const double od2 = od[0] * od[0] + od[1] * od[1];
+          const Eigen::Vector2d jk = ja * (Rot(motion[v]) * Vec3(rd[0] * rd2, rd[1] * rd2, 0)) -
+                                     Eigen::Vector2d(in.fx * od[0] * od2, in.fy * od[1] * od2);
+          hck.segment<6>(b) += rw * jc.transpose() * jk;
+          hck[nc] += rw * jk.squaredNorm();
+          g[nc] -= rw * jk.dot(e);
+          hcw[nc] += rw * jk.dot(jw);
+        }
+      }
+    }
+    if (in.rotation_prior > 0) {
+      // The left update d turns the angle vector by d (small angles).
+      const double pw = in.rotation_prior * in.fx * in.fx;
+      const Eigen::Map<const Vec3> axis(in.prior_axis);
+      for (int32_t v = 0; v < in.views; ++v) {
+        if (v == in.reference) continue;
+        const int32_t b = block(v);
+        hcc.block<3, 3>(b, 0) += pw * axis * axis.transpose();
+        g.segment<3>(b) -= pw * AngleVector(motion[v]).dot(axis) * axis;
       }
     }
     bool accepted = false;
@@ -154,12 +210,16 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
       // Damped reduced system S = Hcc - sum_j Hcw_j Hww_j^-1 Hwc_j (Marquardt: diagonal scaled).
       s.setZero();
       for (int32_t b = 0; b < nc; b += 6) s.block<6, 6>(b, b) = hcc.block<6, 6>(b, 0);
-      for (int32_t k = 0; k < nc; ++k) s(k, k) = s(k, k) * (1 + lambda) + eps;
+      if (k1) {
+        s.col(nc) = hck;
+        s.row(nc) = hck.transpose();
+      }
+      for (int32_t k = 0; k < nr; ++k) s(k, k) = s(k, k) * (1 + lambda) + eps;
       g2 = g;
       for (int32_t j = 0; j < in.points; ++j) {
         if (!in.point_ok[j]) continue;
         const double hd = hww_[j] * (1 + lambda) + eps;
-        Eigen::Map<const Eigen::VectorXd> hcw(hcw_ + static_cast<size_t>(nc) * j, nc);
+        Eigen::Map<const Eigen::VectorXd> hcw(hcw_ + static_cast<size_t>(nr) * j, nr);
         s.noalias() -= (hcw / hd) * hcw.transpose();
         g2 -= hcw * (gw_[j] / hd);
       }
@@ -177,22 +237,24 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
         RotateBy(d, &trial[v]);
         for (int32_t k = 0; k < 3; ++k) trial[v].translation[k] += g2[b + 3 + k];
       }
+      const double k_try = k1 ? kd + g2[nc] : kd;
       double mean = 0;
       int32_t used = 0;
       for (int32_t j = 0; j < in.points; ++j) {
         w_try_[j] = w[j];
         if (!in.point_ok[j]) continue;
         const double hd = hww_[j] * (1 + lambda) + eps;
-        Eigen::Map<const Eigen::VectorXd> hcw(hcw_ + static_cast<size_t>(nc) * j, nc);
+        Eigen::Map<const Eigen::VectorXd> hcw(hcw_ + static_cast<size_t>(nr) * j, nr);
         w_try_[j] = w[j] + (gw_[j] - hcw.dot(g2)) / hd;
         mean += w_try_[j];
         ++used;
       }
-      const double new_cost = Cost(in, trial, w_try_, huber, nullptr);
+      const double new_cost = Cost(in, trial, w_try_, k_try, huber, nullptr) + PriorCost(in, trial);
       if (new_cost < cost) {
         accepted = true;
         const double rel = (cost - new_cost) / cost;
         cost = new_cost;
+        kd = k_try;
         lambda = lambda / 3 > 1e-9 ? lambda / 3 : 1e-9;
         // Gauge: mean inverse depth 1 (a positive mean; a sign flip would put points behind).
         mean = used ? mean / used : 1;
@@ -209,8 +271,9 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
     }
     if (!accepted) break;
   }
+  if (k1) *k1 = kd;
   report->iterations = it;
-  report->rms_px = __builtin_sqrt(2 * Cost(in, motion, w, huber, nullptr) / count);
+  report->rms_px = __builtin_sqrt(2 * Cost(in, motion, w, kd, huber, nullptr) / count);
   return Status::Ok();
 }
 

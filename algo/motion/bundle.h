@@ -5,13 +5,19 @@
 //
 // Model: a point on the reference ray r = (x, y, 1) at inverse depth w is seen in view v along
 // R_v r + w t_v; residuals are in pixels (normalised error times fx, fy) under a Huber loss.
+// Lens distortion, optionally estimated: one radial term k1 shared by all views (one lens), as an
+// undistortion of the observed normalised points, p (1 + k1 |p|^2), in the reference and in the
+// views. Without it, the barrel distortion of a real lens (a vertical motion growing as x y times
+// the disparity) is fitted as a rotation about y, which small motion trades against an offset of
+// every inverse depth: the dense depth then comes out shifted.
 // Rotations are updated by a unit quaternion (1, d/2) normalised, so no sin/cos is needed and the
 // same bits come out on every target. Start: identity rotations, zero translations, w = 1; small
 // motion makes that close enough. Gauge: after every accepted step the inverse depths are scaled
 // to mean 1 (translations scaled inversely), so a unit is the harmonic mean depth of the points.
 //
 // Linear algebra: the point block is diagonal (one unknown per point), so each step solves the
-// reduced camera system (6 per view, <= 90 unknowns) with an in-place Cholesky in arena memory.
+// reduced camera system (6 per view and k1, <= 91 unknowns) with an in-place Cholesky in arena
+// memory.
 #pragma once
 
 #include <cstdint>
@@ -31,6 +37,11 @@ struct BundleInput {
   const double* obs_xy = nullptr;     // 2 per (view, point), view-major: normalised
   const uint8_t* obs_ok = nullptr;    // per (view, point), view-major
   const uint8_t* point_ok = nullptr;  // per point
+  // Weight of a prior pulling each view's rotation about `prior_axis` (a unit vector) towards
+  // none: 0.5 w (fx theta . axis)^2 is added to the cost, as if w observations had seen that
+  // rotation's shift of the image centre.
+  double rotation_prior = 0;
+  double prior_axis[3] = {0, 1, 0};
 };
 
 struct BundleReport {
@@ -46,27 +57,29 @@ class Bundle {
 
   Status Carve(int32_t max_views, int32_t max_points, Arena& arena);
 
-  // Refines `motion` (one per view; the reference's is left the identity) and `inv_depth` (one
-  // per point) from their current values.
+  // Refines `motion` (one per view; the reference's is left the identity), `inv_depth` (one
+  // per point) and the radial distortion `k1` (nullptr: none, held at 0) from their current
+  // values.
   Status Solve(const BundleInput& in, int32_t max_iterations, double huber_px, ViewMotion* motion,
-               double* inv_depth, BundleReport* report);
+               double* inv_depth, double* k1, BundleReport* report);
 
   // Reprojection error in px of one observation under the given parameters.
-  static double ErrorPx(const BundleInput& in, const ViewMotion& m, double w, int32_t view,
-                        int32_t point);
+  static double ErrorPx(const BundleInput& in, const ViewMotion& m, double w, double k1,
+                        int32_t view, int32_t point);
 
  private:
-  double Cost(const BundleInput& in, const ViewMotion* motion, const double* w, double huber,
-              int32_t* count) const;
+  double Cost(const BundleInput& in, const ViewMotion* motion, const double* w, double k1,
+              double huber, int32_t* count) const;
 
   int32_t max_views_ = 0, max_points_ = 0;
   double* hcc_ = nullptr;    // camera blocks, 6(V-1) x 6
-  double* g_ = nullptr;      // camera gradient, 6(V-1)
-  double* s_ = nullptr;      // damped reduced camera matrix, 6(V-1) squared
+  double* hck_ = nullptr;    // k1 row of the camera matrix, 6(V-1) + 1 (the last is Hkk)
+  double* g_ = nullptr;      // camera (and k1) gradient, 6(V-1) + 1
+  double* s_ = nullptr;      // damped reduced camera matrix, (6(V-1) + 1) squared
   double* g2_ = nullptr;     // its right-hand side, then the camera step
   double* hww_ = nullptr;    // per point
   double* gw_ = nullptr;     // per point
-  double* hcw_ = nullptr;    // per point: 6(V-1)
+  double* hcw_ = nullptr;    // per point: 6(V-1) + 1
   double* w_try_ = nullptr;  // per point
 };
 

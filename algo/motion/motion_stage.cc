@@ -24,6 +24,46 @@ double RotationChord(const ViewMotion& m) {
 
 }  // namespace
 
+bool MotionStage::IsRail(const MotionResult& r, double axis[3]) const {
+  const MotionConfig& c = config_;
+  if (!(c.rail_off_axis > 0) || r.views < 3) return false;
+  // The rail's direction: the translations, each turned to point the way of later frames.
+  double u[3] = {0, 0, 0};
+  for (int32_t v = 0; v < r.views; ++v) {
+    const double sign = v > r.reference ? 1.0 : -1.0;
+    for (int32_t k = 0; k < 3; ++k)
+      u[k] += v == r.reference ? 0 : sign * r.motion[v].translation[k];
+  }
+  const double uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+  if (!(uu > 0)) return false;
+  double spacing[MotionConfig::kMaxViews] = {}, mean = 0;
+  for (int32_t v = 0; v < r.views; ++v) {
+    if (v == r.reference) continue;
+    const double* t = r.motion[v].translation;
+    const double sign = v > r.reference ? 1.0 : -1.0;
+    const double tt = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
+    const double along = sign * (t[0] * u[0] + t[1] * u[1] + t[2] * u[2]);
+    // Off the line by more than rail_off_axis of its length (sin of the angle), or backwards.
+    if (!(along > 0) || tt * uu - along * along > c.rail_off_axis * c.rail_off_axis * tt * uu) {
+      return false;
+    }
+    spacing[v] = __builtin_sqrt(tt) / (sign * (v - r.reference));
+    mean += spacing[v] / (r.views - 1);
+  }
+  for (int32_t v = 0; v < r.views; ++v) {
+    if (v == r.reference) continue;
+    const double d = spacing[v] - mean;
+    if ((d < 0 ? -d : d) > c.rail_spacing * mean) return false;
+  }
+  // The turn small motion confuses with depth: about z x u, the axis that shifts the image
+  // along the rail. Turns about the rail itself and about the optical axis show on their own.
+  const double a[3] = {-u[1], u[0], 0};
+  const double aa = a[0] * a[0] + a[1] * a[1];
+  if (!(aa > 1e-6 * uu)) return false;  // a rail along the optical axis: nothing confused
+  for (int32_t k = 0; k < 3; ++k) axis[k] = a[k] / __builtin_sqrt(aa);
+  return true;
+}
+
 const char* MotionDiagnosisName(MotionDiagnosis d) {
   switch (d) {
     case MotionDiagnosis::kOk:
@@ -210,8 +250,12 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
   in.point_ok = point_ok_;
   BundleReport report;
   for (int32_t round = 0; round < c.bundle_rounds; ++round) {
-    LB_RETURN_IF_ERROR(
-        bundle_.Solve(in, c.bundle_iterations, c.huber_px, result->motion, inv_depth_, &report));
+    // The distortion joins once the poses have settled without it: from the identity start a
+    // free k1 can run off before the rotations have taken their share.
+    const bool settled = round > 0 || c.bundle_rounds == 1;
+    double* k1 = c.estimate_distortion && settled ? &result->k1 : nullptr;
+    LB_RETURN_IF_ERROR(bundle_.Solve(in, c.bundle_iterations, c.huber_px, result->motion,
+                                     inv_depth_, k1, &report));
     if (round + 1 == c.bundle_rounds) break;
     // Drop the observations the fit cannot explain (mismatched corners, moving things), and
     // points left with none or seen behind a camera.
@@ -221,11 +265,27 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
       for (int32_t v = 0; v < c.views; ++v) {
         uint8_t& ok = obs_ok_[static_cast<size_t>(v) * n + i];
         if (!ok) continue;
-        if (Bundle::ErrorPx(in, result->motion[v], inv_depth_[i], v, i) > c.outlier_px) ok = 0;
+        if (Bundle::ErrorPx(in, result->motion[v], inv_depth_[i], result->k1, v, i) >
+            c.outlier_px) {
+          ok = 0;
+        }
         any = any || ok;
       }
       if (!any || !(inv_depth_[i] > 0)) point_ok_[i] = 0;
     }
+  }
+  // Small motion cannot tell a turn about the axis across the baseline from an offset of every
+  // inverse depth, nor either from a lens or a rectification the pinhole misses by a tenth of a
+  // pixel: real frames can slide along that valley to a turned, depth-shifted fit. A burst whose
+  // frames lie on one line at equal steps came from a rail (a slider, a rig) that holds the
+  // camera's orientation: it is solved again with that turn held, and with the lens's radial
+  // distortion, which the turn no longer absorbs (on tsukuba it is k1 = -0.046).
+  result->rail = IsRail(*result, in.prior_axis);
+  if (result->rail && c.rail_rotation_prior > 0) {
+    in.rotation_prior = c.rail_rotation_prior;
+    double* k1 = &result->k1;
+    LB_RETURN_IF_ERROR(bundle_.Solve(in, c.bundle_iterations, c.huber_px, result->motion,
+                                     inv_depth_, k1, &report));
   }
   result->rms_px = report.rms_px;
   int32_t m = 0;
@@ -255,8 +315,11 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
     if (v == reference) continue;
     for (int32_t j = 0; j < m; ++j) {
       double p[2][3];
-      const double r[3] = {(out_xy_[2 * j] + 0.5 - k.cx) / k.fx,
-                           (out_xy_[2 * j + 1] + 0.5 - k.cy) / k.fy, 1.0};
+      double r[3] = {(out_xy_[2 * j] + 0.5 - k.cx) / k.fx, (out_xy_[2 * j + 1] + 0.5 - k.cy) / k.fy,
+                     1.0};
+      const double u = 1 + result->k1 * (r[0] * r[0] + r[1] * r[1]);
+      r[0] *= u;
+      r[1] *= u;
       const ViewMotion& mo = result->motion[v];
       const double ws[2] = {out_w_[j], w_med};
       for (int s = 0; s < 2; ++s) {

@@ -47,6 +47,17 @@ struct MotionConfig {
   int32_t bundle_iterations = 100;  // per round
   int32_t bundle_rounds = 3;        // adjust, drop observations off by > outlier_px, adjust again
   double huber_px = 0.5;
+  // Radial k1 in every burst's adjustment (bundle.h; a rail's always has it). Off by default:
+  // on a handheld burst k1, the turn across the baseline and the depth offset share one flat
+  // valley, and real frames can slide along it (README, "Motion and auto geometry").
+  bool estimate_distortion = false;
+  // A rail (motion_stage.cc): every frame's translation within rail_off_axis (the sine of the
+  // angle) of one line and its length per frame step within rail_spacing of their mean. The
+  // adjustment then runs once more, with k1, and with this prior weight (bundle.h) on the turn
+  // that shifts the image along the rail, which holds it at ~0. rail_off_axis 0: never a rail.
+  double rail_off_axis = 0.05;  // ~2.9 degrees
+  double rail_spacing = 0.1;
+  double rail_rotation_prior = 1000;
   double outlier_px = 0.8;
   double min_parallax_px = 1.0;  // depth-dependent motion the best view must show
   int32_t blur_percent = 55;     // a frame whose sharpness is below this % of the median: blurred
@@ -82,6 +93,11 @@ struct MotionResult {
   // caller adds its own margin).
   double inv_depth_min = 0, inv_depth_max = 0;
   double rms_px = 0;  // reprojection error of the final adjustment
+  // Radial distortion of the frames' normalised coordinates (bundle.h), 0 when not estimated.
+  // The depth stage's plane homographies leave it out: it moves points by a fraction of a pixel
+  // over a burst's baseline.
+  double k1 = 0;
+  bool rail = false;  // the frames lie on a line at equal steps: the rotations were held
   int32_t corners = 0;
 
   // Plane homography of `view` for a plane at `inv_depth` (in this result's units).
@@ -110,6 +126,8 @@ class MotionStage {
   Status Track(const ConstImageU8* views, int32_t reference, MotionResult* result);
   Status Adjust(const CameraIntrinsics& k, int32_t reference, MotionResult* result);
   Status Check(MotionResult* result);
+  // True for a rail; `axis` receives the unit axis of the turn its prior holds.
+  bool IsRail(const MotionResult& result, double axis[3]) const;
 
   MotionConfig config_;
   size_t arena_bytes_ = 0;

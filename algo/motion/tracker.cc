@@ -64,9 +64,24 @@ bool Tracker::TrackOne(const GreyPyramid& ref, const GreyPyramid& view, int32_t 
   for (int32_t level = top; level >= 0; --level) {
     const ImageU8& ti = ref.level(level);
     const ImageU8& vi = view.level(level);
-    const int32_t px = ((x_q16 + kHalfQ16) >> level) - kHalfQ16;
-    const int32_t py = ((y_q16 + kHalfQ16) >> level) - kHalfQ16;
-    if (!Inside(ti, px, py, r + 1)) return false;
+    int32_t px = ((x_q16 + kHalfQ16) >> level) - kHalfQ16;
+    int32_t py = ((y_q16 + kHalfQ16) >> level) - kHalfQ16;
+    // Near the border a coarse level's window is moved inward until it fits: it measures the
+    // motion of the neighbouring patch, a start the finer levels correct. Only level 0 must
+    // hold the point's own window.
+    const bool coarse = level > 0;
+    if (!Inside(ti, px, py, r + 1)) {
+      const int32_t lo = (r + 1) << 16;
+      const int32_t hx = (ti.width - r - 3) << 16, hy = (ti.height - r - 3) << 16;
+      if (!coarse || hx < lo || hy < lo) {
+        if (!coarse) return false;
+        dx *= 2;
+        dy *= 2;
+        continue;
+      }
+      px = px < lo ? lo : (px > hx ? hx : px);
+      py = py < lo ? lo : (py > hy ? hy : py);
+    }
     for (int32_t j = 0; j < tw; ++j) {
       for (int32_t i = 0; i < tw; ++i) {
         tmpl_[j * tw + i] = SampleQ4(ti, px + ((i - r - 1) << 16), py + ((j - r - 1) << 16));
@@ -89,10 +104,14 @@ bool Tracker::TrackOne(const GreyPyramid& ref, const GreyPyramid& view, int32_t 
     const double c = static_cast<double>(gyy);
     const double det = a * c - b * b;
     // A flat or edge-only window has no 2D position: its smaller eigenvalue is ~0.
-    if (!(det > 1e-6 * (a + c) * (a + c)) || a + c <= 0) return false;
-    for (int32_t it = 0; it < params_.max_iterations; ++it) {
+    const bool flat = !(det > 1e-6 * (a + c) * (a + c)) || a + c <= 0;
+    if (flat && !coarse) return false;
+    for (int32_t it = 0; it < params_.max_iterations && !flat; ++it) {
       const int32_t qx = px + dx, qy = py + dy;
-      if (!Inside(vi, qx, qy, r)) return false;
+      if (!Inside(vi, qx, qy, r)) {
+        if (!coarse) return false;
+        break;
+      }
       int64_t bx = 0, by = 0, abs_err = 0;
       for (int32_t j = 0; j < ww; ++j) {
         for (int32_t i = 0; i < ww; ++i) {

@@ -4,7 +4,7 @@
 
 namespace lb {
 
-Status PlanLabelRange(const MotionResult& m, int32_t labels, LabelRange* out) {
+Status PlanLabelRange(const MotionResult& m, const LabelPlan& plan, LabelRange* out) {
   double baseline = 0;
   int32_t steps = 0;
   for (int32_t v = 0; v < m.views; ++v) {
@@ -15,7 +15,8 @@ Status PlanLabelRange(const MotionResult& m, int32_t labels, LabelRange* out) {
   }
   const double s = steps > 0 ? m.intrinsics.fx * baseline / steps : 0;
   const double span = m.inv_depth_max - m.inv_depth_min;
-  if (!(s > 0) || !(span >= 0) || !(m.inv_depth_max > 0)) {
+  if (!(s > 0) || !(span >= 0) || !(m.inv_depth_max > 0) || plan.labels < 2 ||
+      plan.quantum_q8 < 1 || plan.lattice < 1 || plan.lattice >= plan.labels) {
     return Status(Code::kDegenerate,
                   "the camera did not move between frames: move it a little sideways between "
                   "frames");
@@ -23,19 +24,35 @@ Status PlanLabelRange(const MotionResult& m, int32_t labels, LabelRange* out) {
   double lo = (m.inv_depth_min - 0.2 * span) * s * 256.0;
   double hi = (m.inv_depth_max + 0.2 * span) * s * 256.0;
   lo = lo > 0 ? lo : 0;
-  // At least one Q8 step per label, and within the depth stage's 16-bit disparities.
-  if (hi < lo + labels) hi = lo + labels;
-  if (hi > 65535) hi = 65535;
-  if (lo > hi - labels) lo = hi - labels;
-  out->disp_min_q8 = static_cast<int32_t>(lo);
-  out->disp_max_q8 = static_cast<int32_t>(hi + 0.999);
+  hi = hi < 65535 ? hi : 65535;
+  lo = lo < hi ? lo : hi;
+  // A whole number of quanta, so every label lies on the lattice and points a little different
+  // keep the same one; the snap onto it may cost `lattice` labels of the range.
+  const int64_t free_labels = plan.labels - 1 - plan.lattice;
+  const int64_t q = plan.quantum_q8;
+  int64_t step = (static_cast<int64_t>((hi - lo) / static_cast<double>(free_labels)) / q + 1) * q;
+  if (step * (plan.labels - 1) > 65535) step = 65535 / (plan.labels - 1);
+  const int64_t width = step * (plan.labels - 1);
+  // The slack (at least one lattice cell) split around the points, label 0 snapped down onto
+  // the lattice, inside 16 bits.
+  const int64_t cell = step * plan.lattice;
+  double first = lo - 0.5 * (static_cast<double>(width - cell) - (hi - lo));
+  first = first > 0 ? first : 0;
+  int64_t label0 = static_cast<int64_t>(first) / cell * cell;
+  while (label0 > 0 && label0 + width > 65535) label0 -= cell;
+  label0 = label0 > 0 ? label0 : 0;
+  out->disp_min_q8 = static_cast<int32_t>(label0);
+  out->disp_max_q8 = static_cast<int32_t>(label0 + width);
   out->px_per_inv_depth = s;
   return Status::Ok();
 }
 
 Status SetDepthGeometry(const MotionResult& motion, bool keep_range, DepthStage* depth,
                         PlaneHomography* planes, LabelRange* range) {
-  LB_RETURN_IF_ERROR(PlanLabelRange(motion, depth->config().labels, range));
+  LabelPlan plan;
+  plan.labels = depth->config().labels;
+  plan.lattice = depth->config().coarse_step < plan.labels ? depth->config().coarse_step : 1;
+  LB_RETURN_IF_ERROR(PlanLabelRange(motion, plan, range));
   if (!keep_range) {
     LB_RETURN_IF_ERROR(depth->SetDisparityRange(range->disp_min_q8, range->disp_max_q8));
   }

@@ -1,8 +1,10 @@
 #include "tests/algo/depth/middlebury.h"
 
 #include <sys/stat.h>
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <utility>
 
 #include "sim/files/image_file.h"
 
@@ -96,6 +98,39 @@ double BadPixelPercent(const Set& set, ConstImageU16 disp_q8) {
     }
   }
   return total ? 100.0 * static_cast<double>(bad) / static_cast<double>(total) : 100.0;
+}
+
+double BestScaleBadPixelPercent(const Set& set, ConstImageU16 disp_q8, double* best_scale) {
+  // Pixel i is good for the scales s with |s d_i - t_i| e <= 1: an interval. The best scale is
+  // where most intervals overlap: a sweep over their ends, starts before ends at a tie (closed).
+  std::vector<std::pair<double, int>> ends;
+  int64_t total = 0, always = 0;
+  for (int32_t y = 0; y < set.height; ++y) {
+    for (int32_t x = 0; x < set.width; ++x) {
+      const size_t i = static_cast<size_t>(y) * set.width + x;
+      if (set.mask[i] != 255 || set.truth[i] <= 0) continue;
+      ++total;
+      const double d = disp_q8.Row(y)[x] / 256.0, t = set.truth[i], tol = 1.0 / set.eval_steps;
+      if (d <= 0) {
+        always += t <= tol;
+        continue;
+      }
+      ends.push_back({(t - tol) / d, -1});
+      ends.push_back({(t + tol) / d, +1});
+    }
+  }
+  std::sort(ends.begin(), ends.end());
+  int64_t open = 0, best = 0;
+  *best_scale = 1;
+  for (size_t k = 0; k < ends.size(); ++k) {
+    open -= ends[k].second;
+    if (open > best) {
+      best = open;
+      *best_scale = k + 1 < ends.size() ? 0.5 * (ends[k].first + ends[k + 1].first) : ends[k].first;
+    }
+  }
+  return total ? 100.0 * static_cast<double>(total - always - best) / static_cast<double>(total)
+               : 100.0;
 }
 
 }  // namespace lb::middlebury

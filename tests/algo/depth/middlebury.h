@@ -29,5 +29,8 @@ std::string DataDir();
 Status Load(const std::string& dir, const std::string& name, Set* set);
 // Percentage of bad pixels of disparities in px per view step, Q8.
 double BadPixelPercent(const Set& set, ConstImageU16 disp_q8);
+// The same after the one global scale that scores best (for depth known only up to scale):
+// exact, over every scale; `best_scale` receives it.
+double BestScaleBadPixelPercent(const Set& set, ConstImageU16 disp_q8, double* best_scale);
 
 }  // namespace lb::middlebury

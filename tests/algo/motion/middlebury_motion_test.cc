@@ -1,6 +1,7 @@
 // The motion stage on the Middlebury sets, told nothing about the rig (default intrinsics): the
 // views are a rectified, equally spaced horizontal rig, so every estimate should be a near-pure
-// translation along x, proportional to the view's distance from the reference, with no rotation.
+// translation along x, proportional to the view's distance from the reference, with no rotation,
+// and the stage should find the rail (motion_stage.h).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -44,7 +45,9 @@ TEST_P(MiddleburyMotion, HorizontalEquallySpacedTranslation) {
     ++n;
   }
   step /= n;
-  printf("%s: %d points, rms %.3f px, step %.4f\n", GetParam(), r.points, r.rms_px, step);
+  printf("%s: %d points, rms %.3f px, step %.4f, k1 %.4f, rail %d\n", GetParam(), r.points,
+         r.rms_px, step, r.k1, r.rail);
+  EXPECT_TRUE(r.rail);
   for (int32_t v = 0; v < config.views; ++v) {
     if (v == set.reference) continue;
     const double* t = r.motion[v].translation;
@@ -54,16 +57,17 @@ TEST_P(MiddleburyMotion, HorizontalEquallySpacedTranslation) {
     const double spacing = -t[0] / (v - set.reference) / step;
     printf("  view %d: rotation %.4f deg, off-axis %.3f deg, spacing %.4f of the mean\n", v, rot,
            dir_deg, spacing);
-    // The default field of view is not the rig's: a wrong focal length shows as a little rotation.
-    EXPECT_LT(rot, 0.25) << "view " << v;
-    EXPECT_LT(dir_deg, 2.0) << "view " << v;
-    EXPECT_NEAR(spacing, 1.0, 0.03) << "view " << v;
+    EXPECT_LT(rot, 0.05) << "view " << v;
+    EXPECT_LT(dir_deg, 1.0) << "view " << v;
+    // venus's im1 is 4.4 % short: its tracked points, against the ground truth itself, move
+    // 0.16 px less than the truth's disparity says, where the other views agree to 0.04 px.
+    EXPECT_NEAR(spacing, 1.0, 0.05) << "view " << v;
   }
 }
 
 // venus (slanted planes) converges to a rotated minimum and teddy's outer views move beyond the
 // tracker's reach: both open work (see the motion notes in the README).
-INSTANTIATE_TEST_SUITE_P(Sets, MiddleburyMotion, ::testing::Values("tsukuba"));
+INSTANTIATE_TEST_SUITE_P(Sets, MiddleburyMotion, ::testing::Values("tsukuba", "venus", "teddy"));
 
 }  // namespace
 }  // namespace lb

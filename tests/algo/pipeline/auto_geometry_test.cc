@@ -5,12 +5,9 @@
 //   mean of 4 x 4 samples, as a sensor integrates its area: LB_PIXEL_SAMPLES): for every seed
 //   (LB_AUTO_SEEDS, default 6), the bad-pixel rate with the estimated poses is within 1.5x of
 //   the same burst's with the true poses; every seed is printed;
-// - Middlebury tsukuba (nothing said about the rig), after fitting the one global scale that
-//   auto geometry cannot know, against the rectified result. Issue 6 asks for 1.5x; measured
-//   15.1 % with the default field of view against 1.48 % rectified (README), so this asserts
-//   only that it stays under 20 %, to catch regressions while the motion work goes on. venus
-//   (converges to a rotated minimum) and teddy (outer views beyond the tracker) fail in the motion
-//   stage: see tests/algo/motion/middlebury_motion_test.cc.
+// - the Middlebury sets (nothing said about the rig, the default field of view), after fitting
+//   the one global scale that auto geometry cannot know, within 1.5x of the rectified result's
+//   bad pixels: both the scale that scores best and the median ratio of truth to estimate.
 // Release only (label accuracy); the Middlebury part skips without ../shared/data/middlebury.
 #include <gtest/gtest.h>
 
@@ -42,7 +39,9 @@ struct Memory {
 // Depth of `views` in kPlanes mode for the poses of `m`; fills disp (Q8) and the range used.
 Status PlaneDepth(const std::vector<ConstImageU8>& views, const MotionResult& m, int32_t labels,
                   std::vector<uint16_t>* disp, LabelRange* range) {
-  LB_RETURN_IF_ERROR(PlanLabelRange(m, labels, range));
+  LabelPlan plan;
+  plan.labels = labels;
+  LB_RETURN_IF_ERROR(PlanLabelRange(m, plan, range));
   DepthConfig c;
   c.width = views[0].width;
   c.height = views[0].height;
@@ -179,7 +178,8 @@ TEST_P(MiddleburyAuto, GivesSaneDepthAfterTheGlobalScale) {
   ASSERT_TRUE(st.ok()) << st.message();
   LabelRange range;
   ASSERT_TRUE(PlaneDepth(views, m, 64, &disp, &range).ok());
-  // The one global scale: the median ratio of truth to estimate over the evaluated pixels.
+  // The one global scale auto geometry cannot know: the one that scores best, and the median
+  // ratio of truth to estimate for comparison.
   std::vector<double> ratio;
   for (size_t i = 0; i < disp.size(); ++i) {
     if (set.mask[i] == 255 && set.truth[i] > 0 && disp[i] > 0) {
@@ -187,17 +187,26 @@ TEST_P(MiddleburyAuto, GivesSaneDepthAfterTheGlobalScale) {
     }
   }
   ASSERT_FALSE(ratio.empty());
-  const double scale = Median(ratio);
-  for (auto& d : disp) d = static_cast<uint16_t>(std::min(65535.0, d * scale + 0.5));
-  const double auto_bad = middlebury::BadPixelPercent(set, MakeView(disp.data(), w, h).AsConst());
+  const double median_scale = Median(ratio);
+  std::vector<uint16_t> scaled(disp.size());
+  for (size_t i = 0; i < disp.size(); ++i) {
+    scaled[i] = static_cast<uint16_t>(std::min(65535.0, disp[i] * median_scale + 0.5));
+  }
+  const double median_bad =
+      middlebury::BadPixelPercent(set, MakeView(scaled.data(), w, h).AsConst());
+  double scale = 1;
+  const double auto_bad =
+      middlebury::BestScaleBadPixelPercent(set, MakeView(disp.data(), w, h).AsConst(), &scale);
   printf(
-      "%s: auto geometry %.2f %% bad (scale %.4f, labels %.2f..%.2f px/step), rectified %.2f %%\n",
-      GetParam(), auto_bad, scale, range.disp_min_q8 / 256.0, range.disp_max_q8 / 256.0,
-      rectified_bad);
-  EXPECT_LE(auto_bad, 20.0);
+      "%s: auto geometry %.2f %% bad (scale %.4f; median ratio %.4f: %.2f %%), rectified %.2f "
+      "%%; labels %.2f..%.2f px/step, k1 %.4f, rail %d\n",
+      GetParam(), auto_bad, scale, median_scale, median_bad, rectified_bad,
+      range.disp_min_q8 / 256.0, range.disp_max_q8 / 256.0, m.k1, m.rail);
+  EXPECT_LE(auto_bad, 1.5 * rectified_bad);
+  EXPECT_LE(median_bad, 1.5 * rectified_bad);
 }
 
-INSTANTIATE_TEST_SUITE_P(Sets, MiddleburyAuto, ::testing::Values("tsukuba"));
+INSTANTIATE_TEST_SUITE_P(Sets, MiddleburyAuto, ::testing::Values("tsukuba", "venus", "teddy"));
 
 }  // namespace
 }  // namespace lb

@@ -19,37 +19,81 @@ MotionResult Rig(int32_t n, double b, double f, double lo, double hi) {
   return m;
 }
 
+LabelPlan Plan(int32_t labels) {
+  LabelPlan p;
+  p.labels = labels;
+  return p;
+}
+
+int32_t Step(const LabelRange& r, int32_t labels) {
+  return (r.disp_max_q8 - r.disp_min_q8) / (labels - 1);
+}
+
 TEST(LabelRange, ARigGivesItsDisparityPerViewStepWhateverTheScale) {
   for (const double scale : {1.0, 0.01, 250.0}) {
     // Translation scaled up, inverse depth down: the same pixels, the same labels.
     const MotionResult m = Rig(5, 0.1 * scale, 400, 0.1 / scale, 0.3 / scale);
     LabelRange r;
-    ASSERT_TRUE(PlanLabelRange(m, 32, &r).ok());
+    ASSERT_TRUE(PlanLabelRange(m, Plan(32), &r).ok());
     EXPECT_NEAR(r.px_per_inv_depth * 0.1 / scale, 4.0, 1e-9);  // f * b * rho at the near end
-    // Points span 4..12 px per step; a fifth of the span is added on each side.
-    EXPECT_NEAR(r.disp_min_q8 / 256.0, 4.0 - 1.6, 1.0 / 256);
-    EXPECT_NEAR(r.disp_max_q8 / 256.0, 12.0 + 1.6, 1.0 / 256);
+    // Points span 4..12 px per step; a fifth of the span more on each side is covered.
+    EXPECT_LE(r.disp_min_q8, (4.0 - 1.6) * 256);
+    EXPECT_GE(r.disp_max_q8, (12.0 + 1.6) * 256);
+    // Not much more: 32 labels, 4 of them spent on the lattice's snap, the spacing rounded up
+    // to a sixteenth of a pixel.
+    EXPECT_LE(r.disp_max_q8 - r.disp_min_q8, (11.2 * 256 / 27 + 16) * 31);
   }
+}
+
+TEST(LabelRange, LabelsLieOnALatticeFromInfinity) {
+  // Every label a whole Q8 step apart, label 0 a multiple of 4 steps: the same lattice for
+  // points that differ a little, so the coarse pass's labels do not move with the percentiles.
+  LabelRange a, b;
+  ASSERT_TRUE(PlanLabelRange(Rig(5, 1, 400, 0.02, 0.05), Plan(64), &a).ok());
+  ASSERT_TRUE(PlanLabelRange(Rig(5, 1, 400, 0.0201, 0.0499), Plan(64), &b).ok());
+  for (const LabelRange& r : {a, b}) {
+    const int32_t step = Step(r, 64);
+    EXPECT_EQ(r.disp_min_q8 + 63 * step, r.disp_max_q8);
+    EXPECT_EQ(r.disp_min_q8 % (4 * step), 0) << r.disp_min_q8 << " step " << step;
+  }
+  EXPECT_EQ(a.disp_min_q8, b.disp_min_q8);
+  EXPECT_EQ(a.disp_max_q8, b.disp_max_q8);
+}
+
+TEST(LabelRange, AShallowSceneGetsTheFinestSpacingAroundItsPoints) {
+  // Points at 40..41 px per step, 1.4 px with the margins: one sixteenth of a pixel per label,
+  // the window around the points.
+  LabelRange r;
+  ASSERT_TRUE(PlanLabelRange(Rig(5, 1, 400, 0.1, 0.1025), Plan(64), &r).ok());
+  EXPECT_EQ(Step(r, 64), 16);
+  EXPECT_LE(r.disp_min_q8, (40 - 0.2) * 256);
+  EXPECT_GE(r.disp_max_q8, (41 + 0.2) * 256);
+  EXPECT_EQ(r.disp_min_q8 % (4 * 16), 0);
+  // Near infinity the window stops at 0.
+  ASSERT_TRUE(PlanLabelRange(Rig(5, 1, 400, 0.001, 0.003), Plan(64), &r).ok());
+  EXPECT_EQ(r.disp_min_q8, 0);
+  EXPECT_GE(r.disp_max_q8, (1.2 + 0.16) * 256);
 }
 
 TEST(LabelRange, StaysInsideTheDepthStagesLimits) {
   LabelRange r;
   // Points at infinity and close: the far end stops at 0.
-  ASSERT_TRUE(PlanLabelRange(Rig(5, 1, 400, 0.0, 0.05), 16, &r).ok());
+  ASSERT_TRUE(PlanLabelRange(Rig(5, 1, 400, 0.0, 0.05), Plan(16), &r).ok());
   EXPECT_EQ(r.disp_min_q8, 0);
   EXPECT_GT(r.disp_max_q8, r.disp_min_q8);
-  // All points at one depth: still one Q8 step per label.
-  ASSERT_TRUE(PlanLabelRange(Rig(5, 1, 400, 0.02, 0.02), 64, &r).ok());
-  EXPECT_GE(r.disp_max_q8 - r.disp_min_q8, 64);
-  // Enormous parallax: clamped to 16 bits.
-  ASSERT_TRUE(PlanLabelRange(Rig(5, 100, 4000, 1, 2), 64, &r).ok());
+  // All points at one depth: still a quantum per label.
+  ASSERT_TRUE(PlanLabelRange(Rig(5, 1, 400, 0.02, 0.02), Plan(64), &r).ok());
+  EXPECT_EQ(Step(r, 64), 16);
+  // Enormous parallax: clamped to 16 bits, labels still a whole step apart.
+  ASSERT_TRUE(PlanLabelRange(Rig(5, 100, 4000, 1, 2), Plan(64), &r).ok());
   EXPECT_LE(r.disp_max_q8, 65535);
-  EXPECT_GE(r.disp_max_q8 - r.disp_min_q8, 64);
+  EXPECT_GE(Step(r, 64), 1);
+  EXPECT_EQ(r.disp_min_q8 + 63 * Step(r, 64), r.disp_max_q8);
 }
 
 TEST(LabelRange, NoBaselineIsDegenerate) {
   LabelRange r;
-  const Status s = PlanLabelRange(Rig(5, 0, 400, 0.1, 0.3), 32, &r);
+  const Status s = PlanLabelRange(Rig(5, 0, 400, 0.1, 0.3), Plan(32), &r);
   EXPECT_EQ(s.code(), Code::kDegenerate);
   EXPECT_NE(std::string(s.message()).find("sideways"), std::string::npos) << s.message();
 }
