@@ -99,6 +99,11 @@ Status MotionStage::Validate(const MotionConfig& c) {
                   "motion: min_features >= 8, iterations >= 1, 1..10 rounds, positive "
                   "thresholds and blur_percent 0..100 expected");
   }
+  if (!(c.rail_off_axis >= 0 && c.rail_off_axis < 1) || !(c.rail_spacing >= 0) ||
+      !(c.rail_rotation_prior >= 0)) {
+    return Status(Code::kInvalidArgument,
+                  "motion: rail_off_axis 0..1, rail_spacing and rail_rotation_prior >= 0 expected");
+  }
   return Status::Ok();
 }
 

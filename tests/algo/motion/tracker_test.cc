@@ -125,6 +125,19 @@ void Smooth(std::vector<uint8_t>* img, int32_t w, int32_t h, double sx, double s
   }
 }
 
+// The smooth texture plus coarse waves (periods of 50..120 px), which the coarse levels see.
+void Multiscale(std::vector<uint8_t>* img, int32_t w, int32_t h, double sx, double sy) {
+  Smooth(img, w, h, sx, sy);
+  for (int32_t y = 0; y < h; ++y) {
+    for (int32_t x = 0; x < w; ++x) {
+      const double u = x + sx, v = y + sy;
+      const double f = 0.5 * (*img)[static_cast<size_t>(y) * w + x] + 64 +
+                       30 * std::sin(u * 0.07 + 0.03 * v) + 25 * std::cos(v * 0.11 - 0.05 * u);
+      (*img)[static_cast<size_t>(y) * w + x] = static_cast<uint8_t>(std::lround(f));
+    }
+  }
+}
+
 TEST(Tracker, RecoversASubpixelShift) {
   constexpr int32_t kW = 320, kH = 240;
   std::vector<uint8_t> a, b;
@@ -156,6 +169,46 @@ TEST(Tracker, RecoversASubpixelShift) {
     // Bilinear sampling of the 9 px periods costs a little: 1/16 px.
     EXPECT_NEAR(dx[i] / 65536.0, sx, 1.0 / 16) << i;
     EXPECT_NEAR(dy[i] / 65536.0, sy, 1.0 / 16) << i;
+  }
+}
+
+// Points close to the frame's edge, moved further than the finest levels alone can follow: the
+// coarse levels, too small for the point's own window there, measure the patch next to it.
+TEST(Tracker, FollowsPointsNearTheBorderOverLongMotions) {
+  constexpr int32_t kW = 320, kH = 240;
+  std::vector<uint8_t> a, b;
+  const double sx = 13.4, sy = 7.6;  // beyond the ~5 px that levels 0 and 1 reach on their own
+  Multiscale(&a, kW, kH, 0, 0);
+  Multiscale(&b, kW, kH, -sx, -sy);
+  std::vector<uint8_t> memory(1 << 20);
+  Arena arena(memory.data(), memory.size());
+  GreyPyramid pa, pb;
+  Tracker tracker;
+  ASSERT_TRUE(pa.Carve(kW, kH, 4, arena).ok());
+  ASSERT_TRUE(pb.Carve(kW, kH, 4, arena).ok());
+  ASSERT_TRUE(tracker.Carve(TrackerParams(), arena).ok());
+  ASSERT_TRUE(pa.Build(MakeView(a.data(), kW, kH).AsConst()).ok());
+  ASSERT_TRUE(pb.Build(MakeView(b.data(), kW, kH).AsConst()).ok());
+  // 8 px from the left and top edges: level 3's window (11 px wide on a 40x30 image) cannot be
+  // centred there; the far edges are left out, where the content moves out of the frame.
+  std::vector<int32_t> xs, ys;
+  for (int32_t y = 8; y < kH - 40; y += 16) {
+    xs.push_back(8 << 16);
+    ys.push_back(y << 16);
+  }
+  for (int32_t x = 24; x < kW - 40; x += 16) {
+    xs.push_back(x << 16);
+    ys.push_back(8 << 16);
+  }
+  const int32_t n = static_cast<int32_t>(xs.size());
+  std::vector<int32_t> dx(n, 0), dy(n, 0);
+  std::vector<uint8_t> ok(n);
+  tracker.Track(pa, pb, xs.data(), ys.data(), n, dx.data(), dy.data(), ok.data());
+  for (int32_t i = 0; i < n; ++i) {
+    ASSERT_TRUE(ok[i]) << "point " << (xs[i] >> 16) << "," << (ys[i] >> 16);
+    // Half the window hangs over a 9 px period at the edge: 1/8 px.
+    EXPECT_NEAR(dx[i] / 65536.0, sx, 1.0 / 8) << i;
+    EXPECT_NEAR(dy[i] / 65536.0, sy, 1.0 / 8) << i;
   }
 }
 
