@@ -4,7 +4,9 @@
 //
 // Steps: grey pyramids (pyramid.h), corners on the reference (corners.h), pyramidal
 // Lucas-Kanade into every view (tracker.h), small-motion bundle adjustment under a Huber loss
-// with the worst observations dropped and the adjustment rerun (bundle.h), then the checks.
+// with the worst observations dropped and the adjustment rerun (bundle.h), the rail test (frames
+// on a line at equal steps: adjusted again with the turn across the rail held and the lens's
+// radial distortion fitted), then the checks.
 //
 // Scale convention: inverse depths are scaled to mean 1 over the inlier points, so their unit is
 // 1 / (harmonic mean depth of the points), and translations are in units of that depth. Only

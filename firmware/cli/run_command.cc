@@ -227,8 +227,11 @@ int RunCommand(int argc, char** argv) {
   const Pipeline& p = runner.pipeline();
   if (job.pipeline.geometry == Geometry::kAuto && report.warning.ok()) {
     printf(
-        "motion: %d points followed (reprojection %.2f px), depth labels %.2f..%.2f px per frame\n",
-        p.motion().points, p.motion().rms_px, p.disp_min_q8() / 256.0, p.disp_max_q8() / 256.0);
+        "motion: %d points followed (reprojection %.2f px)%s, depth labels %.2f..%.2f px per "
+        "frame\n",
+        p.motion().points, p.motion().rms_px,
+        p.motion().rail ? ", on a rail (orientation held, lens k1 fitted)" : "",
+        p.disp_min_q8() / 256.0, p.disp_max_q8() / 256.0);
   }
   return 0;
 }

@@ -46,6 +46,7 @@ void RunSeeds(int32_t pixel_samples, Figures* f) {
     MotionResult r;
     const Status st = stage.Estimate(b.views.data(), b.scene.reference(), b.intrinsics, &r);
     ASSERT_TRUE(st.ok()) << "seed " << 100 + s << ": " << st.message();
+    EXPECT_FALSE(r.rail) << "seed " << 100 + s << ": a hand does not move on a line at equal steps";
     double worst_rot = 0, worst_dir = 0;
     for (int32_t v = 0; v < views; ++v) {
       if (v == b.scene.reference()) continue;

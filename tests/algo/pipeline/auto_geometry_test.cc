@@ -113,6 +113,7 @@ TEST(AutoGeometry, HandheldDepthWithEstimatedPosesIsCloseToTruePoses) {
     MotionResult est;
     const Status st = Estimate(b.views, ref, b.intrinsics, &est);
     ASSERT_TRUE(st.ok()) << "seed " << 200 + s << ": " << st.message();
+    EXPECT_FALSE(est.rail) << "seed " << 200 + s;
 
     // Truth in the unit both runs write: px of parallax per view step (auto_geometry.h).
     std::vector<uint16_t> rho_q12(static_cast<size_t>(kW) * kH);
