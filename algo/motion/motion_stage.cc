@@ -31,8 +31,8 @@ bool MotionStage::IsRail(const MotionResult& r, double axis[3]) const {
   double u[3] = {0, 0, 0};
   for (int32_t v = 0; v < r.views; ++v) {
     const double sign = v > r.reference ? 1.0 : -1.0;
-    for (int32_t k = 0; k < 3; ++k)
-      u[k] += v == r.reference ? 0 : sign * r.motion[v].translation[k];
+    if (v == r.reference) continue;
+    for (int32_t k = 0; k < 3; ++k) u[k] += sign * r.motion[v].translation[k];
   }
   const double uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
   if (!(uu > 0)) return false;

@@ -15,8 +15,12 @@ Status PlanLabelRange(const MotionResult& m, const LabelPlan& plan, LabelRange* 
   }
   const double s = steps > 0 ? m.intrinsics.fx * baseline / steps : 0;
   const double span = m.inv_depth_max - m.inv_depth_min;
-  if (!(s > 0) || !(span >= 0) || !(m.inv_depth_max > 0) || plan.labels < 2 ||
-      plan.quantum_q8 < 1 || plan.lattice < 1 || plan.lattice >= plan.labels) {
+  if (plan.labels < 2 || plan.quantum_q8 < 1 || plan.lattice < 0 ||
+      (plan.lattice > 0 && plan.lattice > plan.labels - 2)) {
+    return Status(Code::kInvalidArgument, "label plan: %d labels, quantum %d, lattice %d",
+                  plan.labels, plan.quantum_q8, plan.lattice);
+  }
+  if (!(s > 0) || !(span >= 0) || !(m.inv_depth_max > 0)) {
     return Status(Code::kDegenerate,
                   "the camera did not move between frames: move it a little sideways between "
                   "frames");
@@ -28,17 +32,19 @@ Status PlanLabelRange(const MotionResult& m, const LabelPlan& plan, LabelRange* 
   lo = lo < hi ? lo : hi;
   // A whole number of quanta, so every label lies on the lattice and points a little different
   // keep the same one; the snap onto it may cost `lattice` labels of the range.
-  const int64_t free_labels = plan.labels - 1 - plan.lattice;
+  const int64_t free_labels =
+      plan.labels - 1 - plan.lattice > 0 ? plan.labels - 1 - plan.lattice : 1;
   const int64_t q = plan.quantum_q8;
   int64_t step = (static_cast<int64_t>((hi - lo) / static_cast<double>(free_labels)) / q + 1) * q;
   if (step * (plan.labels - 1) > 65535) step = 65535 / (plan.labels - 1);
   const int64_t width = step * (plan.labels - 1);
   // The slack (at least one lattice cell) split around the points, label 0 snapped down onto
   // the lattice, inside 16 bits.
-  const int64_t cell = step * plan.lattice;
-  double first = lo - 0.5 * (static_cast<double>(width - cell) - (hi - lo));
+  const int64_t cell = step * (plan.lattice > 0 ? plan.lattice : 1);
+  double first = lo - 0.5 * (static_cast<double>(width - step * plan.lattice) - (hi - lo));
   first = first > 0 ? first : 0;
-  int64_t label0 = static_cast<int64_t>(first) / cell * cell;
+  int64_t label0 =
+      plan.lattice > 0 ? static_cast<int64_t>(first) / cell * cell : static_cast<int64_t>(first);
   while (label0 > 0 && label0 + width > 65535) label0 -= cell;
   label0 = label0 > 0 ? label0 : 0;
   out->disp_min_q8 = static_cast<int32_t>(label0);
@@ -51,7 +57,8 @@ Status SetDepthGeometry(const MotionResult& motion, bool keep_range, DepthStage*
                         PlaneHomography* planes, LabelRange* range) {
   LabelPlan plan;
   plan.labels = depth->config().labels;
-  plan.lattice = depth->config().coarse_step < plan.labels ? depth->config().coarse_step : 1;
+  const int32_t coarse = depth->config().coarse_step;
+  plan.lattice = coarse <= plan.labels - 2 ? coarse : 0;
   LB_RETURN_IF_ERROR(PlanLabelRange(motion, plan, range));
   if (!keep_range) {
     LB_RETURN_IF_ERROR(depth->SetDisparityRange(range->disp_min_q8, range->disp_max_q8));

@@ -36,7 +36,7 @@ struct LabelRange {
 struct LabelPlan {
   int32_t labels = 64;
   int32_t quantum_q8 = 16;  // the spacing is a multiple of this, Q8.8 px per view step
-  int32_t lattice = 4;      // label 0 on a multiple of this many spacings (1..labels - 1)
+  int32_t lattice = 4;  // label 0 on a multiple of this many spacings (0: anywhere; <= labels - 2)
 };
 
 // kDegenerate when the estimate has no baseline or no depth range to label.

@@ -91,6 +91,21 @@ TEST(LabelRange, StaysInsideTheDepthStagesLimits) {
   EXPECT_EQ(r.disp_min_q8 + 63 * Step(r, 64), r.disp_max_q8);
 }
 
+TEST(LabelRange, ABadPlanIsAnInvalidArgument) {
+  LabelRange r;
+  LabelPlan p = Plan(16);
+  p.lattice = 15;
+  EXPECT_EQ(PlanLabelRange(Rig(5, 1, 400, 0.1, 0.3), p, &r).code(), Code::kInvalidArgument);
+  p = Plan(1);
+  EXPECT_EQ(PlanLabelRange(Rig(5, 1, 400, 0.1, 0.3), p, &r).code(), Code::kInvalidArgument);
+  // Two labels, no lattice: still a range that covers the points.
+  p = Plan(2);
+  p.lattice = 0;
+  ASSERT_TRUE(PlanLabelRange(Rig(5, 1, 400, 0.1, 0.3), p, &r).ok());
+  EXPECT_LE(r.disp_min_q8, 40 * 256);
+  EXPECT_GE(r.disp_max_q8, 120 * 256);
+}
+
 TEST(LabelRange, NoBaselineIsDegenerate) {
   LabelRange r;
   const Status s = PlanLabelRange(Rig(5, 0, 400, 0.1, 0.3), Plan(32), &r);
