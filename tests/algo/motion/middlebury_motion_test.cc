@@ -65,8 +65,6 @@ TEST_P(MiddleburyMotion, HorizontalEquallySpacedTranslation) {
   }
 }
 
-// venus (slanted planes) converges to a rotated minimum and teddy's outer views move beyond the
-// tracker's reach: both open work (see the motion notes in the README).
 INSTANTIATE_TEST_SUITE_P(Sets, MiddleburyMotion, ::testing::Values("tsukuba", "venus", "teddy"));
 
 }  // namespace
