@@ -138,21 +138,39 @@ void Multiscale(std::vector<uint8_t>* img, int32_t w, int32_t h, double sx, doub
   }
 }
 
-TEST(Tracker, RecoversASubpixelShift) {
-  constexpr int32_t kW = 320, kH = 240;
-  std::vector<uint8_t> a, b;
-  const double sx = 5.37, sy = -3.81;
-  Smooth(&a, kW, kH, 0, 0);
-  Smooth(&b, kW, kH, -sx, -sy);  // content moves by (+sx, +sy)
+// Tracks the points (xs, ys) from grey image a into b (kW x kH) over `levels` pyramid levels.
+struct Tracked {
+  std::vector<int32_t> dx, dy;
+  std::vector<uint8_t> ok;
+};
+constexpr int32_t kW = 320, kH = 240;
+Tracked TrackPoints(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b, int32_t levels,
+                    const std::vector<int32_t>& xs, const std::vector<int32_t>& ys) {
   std::vector<uint8_t> memory(1 << 20);
   Arena arena(memory.data(), memory.size());
   GreyPyramid pa, pb;
   Tracker tracker;
-  ASSERT_TRUE(pa.Carve(kW, kH, 3, arena).ok());
-  ASSERT_TRUE(pb.Carve(kW, kH, 3, arena).ok());
-  ASSERT_TRUE(tracker.Carve(TrackerParams(), arena).ok());
-  ASSERT_TRUE(pa.Build(MakeView(a.data(), kW, kH).AsConst()).ok());
-  ASSERT_TRUE(pb.Build(MakeView(b.data(), kW, kH).AsConst()).ok());
+  Tracked t;
+  if (!pa.Carve(kW, kH, levels, arena).ok() || !pb.Carve(kW, kH, levels, arena).ok() ||
+      !tracker.Carve(TrackerParams(), arena).ok() ||
+      !pa.Build(MakeView(a.data(), kW, kH).AsConst()).ok() ||
+      !pb.Build(MakeView(b.data(), kW, kH).AsConst()).ok()) {
+    ADD_FAILURE() << "tracker set-up";
+    return t;
+  }
+  const int32_t n = static_cast<int32_t>(xs.size());
+  t.dx.assign(n, 0);
+  t.dy.assign(n, 0);
+  t.ok.assign(n, 0);
+  tracker.Track(pa, pb, xs.data(), ys.data(), n, t.dx.data(), t.dy.data(), t.ok.data());
+  return t;
+}
+
+TEST(Tracker, RecoversASubpixelShift) {
+  std::vector<uint8_t> a, b;
+  const double sx = 5.37, sy = -3.81;
+  Smooth(&a, kW, kH, 0, 0);
+  Smooth(&b, kW, kH, -sx, -sy);  // content moves by (+sx, +sy)
   std::vector<int32_t> xs, ys;
   for (int32_t y = 40; y < kH - 40; y += 20) {
     for (int32_t x = 40; x < kW - 40; x += 20) {
@@ -160,35 +178,23 @@ TEST(Tracker, RecoversASubpixelShift) {
       ys.push_back(y << 16);
     }
   }
-  const int32_t n = static_cast<int32_t>(xs.size());
-  std::vector<int32_t> dx(n, 0), dy(n, 0);
-  std::vector<uint8_t> ok(n);
-  tracker.Track(pa, pb, xs.data(), ys.data(), n, dx.data(), dy.data(), ok.data());
-  for (int32_t i = 0; i < n; ++i) {
-    ASSERT_TRUE(ok[i]) << i;
+  const Tracked t = TrackPoints(a, b, 3, xs, ys);
+  ASSERT_EQ(t.ok.size(), xs.size());
+  for (size_t i = 0; i < xs.size(); ++i) {
+    ASSERT_TRUE(t.ok[i]) << i;
     // Bilinear sampling of the 9 px periods costs a little: 1/16 px.
-    EXPECT_NEAR(dx[i] / 65536.0, sx, 1.0 / 16) << i;
-    EXPECT_NEAR(dy[i] / 65536.0, sy, 1.0 / 16) << i;
+    EXPECT_NEAR(t.dx[i] / 65536.0, sx, 1.0 / 16) << i;
+    EXPECT_NEAR(t.dy[i] / 65536.0, sy, 1.0 / 16) << i;
   }
 }
 
 // Points close to the frame's edge, moved further than the finest levels alone can follow: the
 // coarse levels, too small for the point's own window there, measure the patch next to it.
 TEST(Tracker, FollowsPointsNearTheBorderOverLongMotions) {
-  constexpr int32_t kW = 320, kH = 240;
   std::vector<uint8_t> a, b;
   const double sx = 13.4, sy = 7.6;  // beyond the ~5 px that levels 0 and 1 reach on their own
   Multiscale(&a, kW, kH, 0, 0);
   Multiscale(&b, kW, kH, -sx, -sy);
-  std::vector<uint8_t> memory(1 << 20);
-  Arena arena(memory.data(), memory.size());
-  GreyPyramid pa, pb;
-  Tracker tracker;
-  ASSERT_TRUE(pa.Carve(kW, kH, 4, arena).ok());
-  ASSERT_TRUE(pb.Carve(kW, kH, 4, arena).ok());
-  ASSERT_TRUE(tracker.Carve(TrackerParams(), arena).ok());
-  ASSERT_TRUE(pa.Build(MakeView(a.data(), kW, kH).AsConst()).ok());
-  ASSERT_TRUE(pb.Build(MakeView(b.data(), kW, kH).AsConst()).ok());
   // 8 px from the left and top edges: level 3's window (11 px wide on a 40x30 image) cannot be
   // centred there; the far edges are left out, where the content moves out of the frame.
   std::vector<int32_t> xs, ys;
@@ -200,15 +206,13 @@ TEST(Tracker, FollowsPointsNearTheBorderOverLongMotions) {
     xs.push_back(x << 16);
     ys.push_back(8 << 16);
   }
-  const int32_t n = static_cast<int32_t>(xs.size());
-  std::vector<int32_t> dx(n, 0), dy(n, 0);
-  std::vector<uint8_t> ok(n);
-  tracker.Track(pa, pb, xs.data(), ys.data(), n, dx.data(), dy.data(), ok.data());
-  for (int32_t i = 0; i < n; ++i) {
-    ASSERT_TRUE(ok[i]) << "point " << (xs[i] >> 16) << "," << (ys[i] >> 16);
+  const Tracked t = TrackPoints(a, b, 4, xs, ys);
+  ASSERT_EQ(t.ok.size(), xs.size());
+  for (size_t i = 0; i < xs.size(); ++i) {
+    ASSERT_TRUE(t.ok[i]) << "point " << (xs[i] >> 16) << "," << (ys[i] >> 16);
     // Half the window hangs over a 9 px period at the edge: 1/8 px.
-    EXPECT_NEAR(dx[i] / 65536.0, sx, 1.0 / 8) << i;
-    EXPECT_NEAR(dy[i] / 65536.0, sy, 1.0 / 8) << i;
+    EXPECT_NEAR(t.dx[i] / 65536.0, sx, 1.0 / 8) << i;
+    EXPECT_NEAR(t.dy[i] / 65536.0, sy, 1.0 / 8) << i;
   }
 }
 
