@@ -13,7 +13,7 @@ Mat3 Rot(const ViewMotion& m) { return Eigen::Map<const Mat3>(&m.rotation[0][0])
 
 // Undistorted normalised coordinates of a distorted observation p: p (1 + k1 |p|^2).
 Eigen::Vector2d Undistort(const double* p, double k1) {
-  return Eigen::Vector2d(p[0], p[1]) * (1 + k1 * (p[0] * p[0] + p[1] * p[1]));
+  return Eigen::Vector2d(p[0], p[1]) * UndistortScale(k1, p[0], p[1]);
 }
 
 // Point on the reference ray of `point` at inverse depth w, in view coordinates (up to scale);

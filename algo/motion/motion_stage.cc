@@ -288,9 +288,8 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
   result->rail = IsRail(*result, in.prior_axis);
   if (result->rail && c.rail_rotation_prior > 0) {
     in.rotation_prior = c.rail_rotation_prior;
-    double* k1 = &result->k1;
     LB_RETURN_IF_ERROR(bundle_.Solve(in, c.bundle_iterations, c.huber_px, result->motion,
-                                     inv_depth_, k1, &report));
+                                     inv_depth_, &result->k1, &report));
   }
   result->rms_px = report.rms_px;
   int32_t m = 0;
@@ -322,7 +321,7 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
       double p[2][3];
       double r[3] = {(out_xy_[2 * j] + 0.5 - k.cx) / k.fx, (out_xy_[2 * j + 1] + 0.5 - k.cy) / k.fy,
                      1.0};
-      const double u = 1 + result->k1 * (r[0] * r[0] + r[1] * r[1]);
+      const double u = UndistortScale(result->k1, r[0], r[1]);
       r[0] *= u;
       r[1] *= u;
       const ViewMotion& mo = result->motion[v];

@@ -32,8 +32,7 @@ Status PlanLabelRange(const MotionResult& m, const LabelPlan& plan, LabelRange* 
   lo = lo < hi ? lo : hi;
   // A whole number of quanta, so every label lies on the lattice and points a little different
   // keep the same one; the snap onto it may cost `lattice` labels of the range.
-  const int64_t free_labels =
-      plan.labels - 1 - plan.lattice > 0 ? plan.labels - 1 - plan.lattice : 1;
+  const int64_t free_labels = plan.labels - 1 - plan.lattice;  // >= 1: the plan was checked
   const int64_t q = plan.quantum_q8;
   int64_t step = (static_cast<int64_t>((hi - lo) / static_cast<double>(free_labels)) / q + 1) * q;
   if (step * (plan.labels - 1) > 65535) step = 65535 / (plan.labels - 1);
