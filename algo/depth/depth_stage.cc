@@ -30,7 +30,8 @@ Status DepthStage::Validate(const DepthConfig& c) {
     return Status(Code::kInvalidArgument, "depth: %d labels (needs 2 to %d)", c.labels,
                   DepthConfig::kMaxLabels);
   }
-  if (c.disp_min_q8 < 0 || c.disp_max_q8 <= c.disp_min_q8 || c.disp_max_q8 > 0xffff) {
+  if (c.disp_min_q8 < -0xffff || c.disp_max_q8 <= c.disp_min_q8 || c.disp_max_q8 > 0xffff ||
+      c.disp_max_q8 - c.disp_min_q8 > 0xffff) {
     return Status(Code::kInvalidArgument, "depth: disparity range %d..%d (Q8) is empty or too wide",
                   c.disp_min_q8, c.disp_max_q8);
   }
@@ -255,6 +256,7 @@ int64_t DepthStage::Energy(const uint8_t* labels) {
 // recorded and the output is the labels' disparities.
 void DepthStage::Refine(ImageU16 disp_q8) {
   const int32_t w = config_.width, h = config_.height;
+  const int32_t bias = MapBiasQ8(config_);
   for (int32_t y = 0; y < h; ++y) {
     uint16_t* out = disp_q8.Row(y);
     for (int32_t x = 0; x < w; ++x) {
@@ -271,7 +273,7 @@ void DepthStage::Refine(ImageU16 disp_q8) {
           d_q8 += ((cm - cp) * step_q8) / (2 * curvature);
         }
       }
-      out[x] = static_cast<uint16_t>(d_q8);
+      out[x] = static_cast<uint16_t>(d_q8 + bias);
     }
   }
 }

@@ -1,7 +1,10 @@
 // Depth stage: from the working-resolution views of a burst to a disparity map of the reference
-// view. Disparity is in working-resolution pixels per view step, unsigned Q8.8 (`dispQ8`): a
-// point at disparity d appears at x - k*d in the view k steps to the right of the reference and
-// at x + k*d in the view k steps to its left (the views are rectified and equally spaced).
+// view. Disparity is in working-resolution pixels per view step, Q8.8 (`dispQ8`): a point at
+// disparity d appears at x - k*d in the view k steps to the right of the reference and at
+// x + k*d in the view k steps to its left (the views are rectified and equally spaced).
+// Signed: a converged rig (a light field, a hand that turns toward the subject) has its zero at
+// the focus plane, and the points behind it have negative disparities. The map is unsigned: it
+// holds d + MapBiasQ8, the bias lifting the farthest label of a signed range to 0.
 //
 // Plane sweep (DepthGeometry::kPlanes, for handheld bursts): label l is instead a fronto-parallel
 // plane of the reference camera, given per view as its plane-induced homography (SetPlanes,
@@ -30,9 +33,11 @@ struct DepthConfig {
   int32_t width = 0;  // working resolution
   int32_t height = 0;
   int32_t views = 0;
-  int32_t reference = 0;    // index of the reference among the views
-  int32_t labels = 0;       // number of disparity planes
-  int32_t disp_min_q8 = 0;  // disparity of label 0 and of the last label, px per view step, Q8.8
+  int32_t reference = 0;  // index of the reference among the views
+  int32_t labels = 0;     // number of disparity planes
+  // Disparity of label 0 and of the last label, px per view step, Q8.8: -65535..65535, at
+  // most 65535 apart.
+  int32_t disp_min_q8 = 0;
   int32_t disp_max_q8 = 0;
   DepthGeometry geometry = DepthGeometry::kRectified;
 
@@ -98,8 +103,8 @@ class DepthStage {
   // within Validate's limits; the memory does not depend on it.
   Status SetDisparityRange(int32_t disp_min_q8, int32_t disp_max_q8);
 
-  // `views[i]` are RGB8 working-resolution images, left to right. Writes dispQ8 for every pixel
-  // of the reference view into `disp_q8` (width x height, one channel).
+  // `views[i]` are RGB8 working-resolution images, left to right. Writes dispQ8 + MapBiasQ8 for
+  // every pixel of the reference view into `disp_q8` (width x height, one channel).
   Status Compute(const ConstImageU8* views, ImageU16 disp_q8);
 
   const DepthStats& stats() const { return stats_; }
@@ -119,6 +124,11 @@ class DepthStage {
   int32_t LabelDispQ8(int32_t label) const { return LabelDispQ8(config_, label); }
   // The disparity of a label, Q8.8, for any valid configuration.
   static int32_t LabelDispQ8(const DepthConfig& config, int32_t label);
+  // What the output map adds to every disparity so that it fits 16 unsigned bits: 0 for a range
+  // that starts at 0 or above, -disp_min_q8 for a signed one.
+  static int32_t MapBiasQ8(const DepthConfig& config) {
+    return config.disp_min_q8 < 0 ? -config.disp_min_q8 : 0;
+  }
 
  private:
   // The rectangles of a move: one for the whole grid, or, for a restricted move, one per run

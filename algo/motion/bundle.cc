@@ -54,8 +54,9 @@ Vec3 AngleVector(const ViewMotion& m) {
   return Vec3(0.5 * (r[2][1] - r[1][2]), 0.5 * (r[0][2] - r[2][0]), 0.5 * (r[1][0] - r[0][1]));
 }
 
-double PriorCost(const BundleInput& in, const ViewMotion* motion) {
-  double cost = 0;
+double PriorCost(const BundleInput& in, const ViewMotion* motion, double k1) {
+  const double reach = k1 * in.k1_reach_px;
+  double cost = 0.5 * in.k1_prior * reach * reach;
   if (in.rotation_prior > 0) {
     for (int32_t v = 0; v < in.views; ++v) {
       if (v == in.reference) continue;
@@ -140,7 +141,7 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
   report->observations = count;
   report->initial_rms_px = count ? __builtin_sqrt(2 * cost / count) : 0;
   if (count == 0) return Status(Code::kDegenerate, "bundle: no observations");
-  cost += PriorCost(in, motion);
+  cost += PriorCost(in, motion, kd);
   double lambda = 1e-3;
   const double eps = 1e-12 * in.fx * in.fx;
   ViewMotion trial[kMaxViews];
@@ -205,6 +206,11 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
         g.segment<3>(b) -= pw * AngleVector(motion[v]).dot(axis) * axis;
       }
     }
+    if (k1 && in.k1_prior > 0) {
+      const double pk = in.k1_prior * in.k1_reach_px * in.k1_reach_px;
+      hck[nc] += pk;
+      g[nc] -= pk * kd;
+    }
     bool accepted = false;
     for (int32_t tries = 0; tries < 10 && !accepted; ++tries) {
       // Damped reduced system S = Hcc - sum_j Hcw_j Hww_j^-1 Hwc_j (Marquardt: diagonal scaled).
@@ -238,7 +244,7 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
         for (int32_t k = 0; k < 3; ++k) trial[v].translation[k] += g2[b + 3 + k];
       }
       const double k_try = k1 ? kd + g2[nc] : kd;
-      double mean = 0;
+      double sum = 0, sum_abs = 0;
       int32_t used = 0;
       for (int32_t j = 0; j < in.points; ++j) {
         w_try_[j] = w[j];
@@ -246,19 +252,24 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
         const double hd = hww_[j] * (1 + lambda) + eps;
         Eigen::Map<const Eigen::VectorXd> hcw(hcw_ + static_cast<size_t>(nr) * j, nr);
         w_try_[j] = w[j] + (gw_[j] - hcw.dot(g2)) / hd;
-        mean += w_try_[j];
+        sum += w_try_[j];
+        sum_abs += w_try_[j] < 0 ? -w_try_[j] : w_try_[j];
         ++used;
       }
-      const double new_cost = Cost(in, trial, w_try_, k_try, huber, nullptr) + PriorCost(in, trial);
+      const double new_cost =
+          Cost(in, trial, w_try_, k_try, huber, nullptr) + PriorCost(in, trial, k_try);
       if (new_cost < cost) {
         accepted = true;
         const double rel = (cost - new_cost) / cost;
         cost = new_cost;
         kd = k_try;
         lambda = lambda / 3 > 1e-9 ? lambda / 3 : 1e-9;
-        // Gauge: mean inverse depth 1 (a positive mean; a sign flip would put points behind).
-        mean = used ? mean / used : 1;
-        const double scale = mean > 1e-9 ? mean : 1;
+        // Gauge: mean |inverse depth| 1, and a mean >= 0 (w -> -w, t -> -t leaves every w t, so
+        // every pixel, unchanged). Signed: at a narrow field of view a turn across the baseline
+        // looks like an offset of every inverse depth, so the fit may put some points beyond
+        // infinity; only differences of w matter downstream (auto_geometry.h).
+        const double mean_abs = used ? sum_abs / used : 1;
+        const double scale = (mean_abs > 1e-12 ? mean_abs : 1) * (sum < 0 ? -1 : 1);
         for (int32_t j = 0; j < in.points; ++j) w[j] = w_try_[j] / scale;
         for (int32_t v = 0; v < in.views; ++v) {
           motion[v] = trial[v];

@@ -42,6 +42,11 @@ struct BundleInput {
   // rotation's shift of the image centre.
   double rotation_prior = 0;
   double prior_axis[3] = {0, 1, 0};
+  // Weight of a prior pulling k1 towards 0: 0.5 w (k1 k1_reach_px)^2, as if w observations had
+  // seen what k1 does at the frame's corner (k1_reach_px = fx |corner|^3, normalised). At a
+  // narrow field of view k1 barely moves a pixel and would otherwise run off along the turn.
+  double k1_prior = 0;
+  double k1_reach_px = 0;
 };
 
 struct BundleReport {

@@ -60,6 +60,9 @@ struct MotionConfig {
   double rail_off_axis = 0.05;  // ~2.9 degrees
   double rail_spacing = 0.1;
   double rail_rotation_prior = 1000;
+  // Weight of the prior that holds k1 near 0 (bundle.h): what k1 does at the frame's corner
+  // counts as this many observations.
+  double k1_prior = 0.01;
   double outlier_px = 0.8;
   double min_parallax_px = 1.0;  // depth-dependent motion the best view must show
   int32_t blur_percent = 55;     // a frame whose sharpness is below this % of the median: blurred

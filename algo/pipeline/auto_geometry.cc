@@ -20,16 +20,17 @@ Status PlanLabelRange(const MotionResult& m, const LabelPlan& plan, LabelRange* 
     return Status(Code::kInvalidArgument, "label plan: %d labels, quantum %d, lattice %d",
                   plan.labels, plan.quantum_q8, plan.lattice);
   }
-  if (!(s > 0) || !(span >= 0) || !(m.inv_depth_max > 0)) {
+  if (!(s > 0) || !(span >= 0)) {
     return Status(Code::kDegenerate,
                   "the camera did not move between frames: move it a little sideways between "
                   "frames");
   }
+  // Signed: the points may lie on both sides of what the motion's gauge calls infinity.
+  constexpr double kLimit = 65535;
   double lo = (m.inv_depth_min - 0.2 * span) * s * 256.0;
   double hi = (m.inv_depth_max + 0.2 * span) * s * 256.0;
-  lo = lo > 0 ? lo : 0;
-  hi = hi < 65535 ? hi : 65535;
-  lo = lo < hi ? lo : hi;
+  lo = lo > -kLimit ? (lo < kLimit ? lo : kLimit) : -kLimit;
+  hi = hi > -kLimit ? (hi < kLimit ? hi : kLimit) : -kLimit;
   // A whole number of quanta, so every label lies on the lattice and points a little different
   // keep the same one; the snap onto it may cost `lattice` labels of the range.
   const int64_t free_labels = plan.labels - 1 - plan.lattice;  // >= 1: the plan was checked
@@ -38,14 +39,13 @@ Status PlanLabelRange(const MotionResult& m, const LabelPlan& plan, LabelRange* 
   if (step * (plan.labels - 1) > 65535) step = 65535 / (plan.labels - 1);
   const int64_t width = step * (plan.labels - 1);
   // The slack (at least one lattice cell) split around the points, label 0 snapped down onto
-  // the lattice, inside 16 bits.
+  // the lattice (floor, also below 0), inside -65535..65535.
   const int64_t cell = step * (plan.lattice > 0 ? plan.lattice : 1);
-  double first = lo - 0.5 * (static_cast<double>(width - step * plan.lattice) - (hi - lo));
-  first = first > 0 ? first : 0;
-  int64_t label0 =
-      plan.lattice > 0 ? static_cast<int64_t>(first) / cell * cell : static_cast<int64_t>(first);
-  while (label0 > 0 && label0 + width > 65535) label0 -= cell;
-  label0 = label0 > 0 ? label0 : 0;
+  const double first = lo - 0.5 * (static_cast<double>(width - step * plan.lattice) - (hi - lo));
+  int64_t label0 = static_cast<int64_t>(__builtin_floor(first / static_cast<double>(cell))) * cell;
+  if (plan.lattice == 0) label0 = static_cast<int64_t>(__builtin_floor(first));
+  while (label0 + width > 65535) label0 -= cell;
+  while (label0 < -65535) label0 += cell;
   out->disp_min_q8 = static_cast<int32_t>(label0);
   out->disp_max_q8 = static_cast<int32_t>(label0 + width);
   out->px_per_inv_depth = s;

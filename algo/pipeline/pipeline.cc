@@ -264,8 +264,9 @@ Status Pipeline::ComputeDepth() {
   ConstImageU8 views[PipelineConfig::kMaxFrames];
   for (int32_t i = 0; i < config_.frames; ++i) views[i] = working_[i].AsConst();
   depth_warning_ = Status::Ok();
-  disp_min_q8_ = config_.disp_min_q8;
-  disp_max_q8_ = config_.disp_max_q8;
+  const int32_t config_bias = config_.disp_min_q8 < 0 ? -config_.disp_min_q8 : 0;
+  disp_min_q8_ = config_.disp_min_q8 + config_bias;
+  disp_max_q8_ = config_.disp_max_q8 + config_bias;
   if (config_.geometry == Geometry::kAuto) {
     const Status geometry = EstimateGeometry(views);
     if (geometry.code() == Code::kDegenerate) {
@@ -281,6 +282,10 @@ Status Pipeline::ComputeDepth() {
     LB_RETURN_IF_ERROR(geometry);
   }
   LB_RETURN_IF_ERROR(depth_.Compute(views, disp_q8_));
+  // The map's own range: a signed one is lifted by the stage's bias (depth_stage.h).
+  const DepthConfig& d = depth_.config();
+  disp_min_q8_ = d.disp_min_q8 + DepthStage::MapBiasQ8(d);
+  disp_max_q8_ = d.disp_max_q8 + DepthStage::MapBiasQ8(d);
   depth_ready_ = true;
   return Status::Ok();
 }
@@ -297,10 +302,7 @@ Status Pipeline::EstimateGeometry(const ConstImageU8* views) {
   if (config_.focal_px > 0) k.fx = k.fy = config_.focal_px / scale_;
   LB_RETURN_IF_ERROR(motion_.Estimate(views, config_.reference, k, &motion_result_));
   LabelRange range;
-  LB_RETURN_IF_ERROR(SetDepthGeometry(motion_result_, false, &depth_, planes_, &range));
-  disp_min_q8_ = range.disp_min_q8;
-  disp_max_q8_ = range.disp_max_q8;
-  return Status::Ok();
+  return SetDepthGeometry(motion_result_, false, &depth_, planes_, &range);
 }
 
 Status Pipeline::BeginRender(const RenderParams& params) {

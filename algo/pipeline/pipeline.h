@@ -78,7 +78,8 @@ class Pipeline : public FrameSink {
   // flat, so the render keeps everything sharp, and depth_warning() says what to do.
   Status ComputeDepth();
   const Status& depth_warning() const { return depth_warning_; }
-  // The labels' disparity range of the last ComputeDepth (the configured one for kRectified).
+  // The disparity map's range of the last ComputeDepth (the labels', configured for
+  // kRectified), in the map's units: a signed range is lifted to start at 0 (depth_stage.h).
   int32_t disp_min_q8() const { return disp_min_q8_; }
   int32_t disp_max_q8() const { return disp_max_q8_; }
   const MotionResult& motion() const { return motion_result_; }

@@ -33,8 +33,9 @@ const char kUsage[] =
     "  --disparity-out D.pfm  disparity of the reference view, px per view step (PFM)\n"
     "  --preview P.png        colour-mapped preview (blue far .. red near)\n"
     "  --labels N             disparity labels, 2..256 (default 64)\n"
-    "  --disparity MIN,MAX    label range in px per view step (rectified default 0 and\n"
-    "                         (N-1)/4: quarter-pixel labels; auto: from the tracked points)\n"
+    "  --disparity MIN,MAX    label range in px per view step, signed for a converged rig\n"
+    "                         (rectified default 0 and (N-1)/4: quarter-pixel labels; auto:\n"
+    "                         from the tracked points)\n"
     "  --smoothness W         smoothness weight, 0..4096 (default %d)\n"
     "  --cycles N             expansion cycle cap, 0..32 (default %d)\n"
     "  --subpixel             write the sub-label refinement the renderer uses (default: the\n"
@@ -101,7 +102,7 @@ int DepthCommand(int argc, char** argv) {
   DepthConfig c;
   c.labels = 64;
   c.subpixel = false;
-  float disp_min = 0, disp_max = -1;
+  bool range_given = false;
   Geometry geometry = Geometry::kAuto;
   int32_t focal_35mm = 0;
   std::string error;
@@ -138,19 +139,8 @@ int DepthCommand(int argc, char** argv) {
     } else if (!strcmp(a, "--cycles")) {
       ok = need() && ParseInt(argv[++i], 0, 32, &c.max_cycles, &error);
     } else if (!strcmp(a, "--disparity")) {
-      ok = need();
-      if (ok) {
-        const char* text = argv[++i];
-        const char* comma = strchr(text, ',');
-        if (!comma) {
-          error = std::string("--disparity wants MIN,MAX, got \"") + text + "\"";
-          ok = false;
-        } else {
-          const std::string lo(text, comma);
-          ok = ParseFloat(lo.c_str(), 0, 255, &disp_min, &error) &&
-               ParseFloat(comma + 1, 0, 255, &disp_max, &error);
-        }
-      }
+      ok = need() && ParseDisparityRange(argv[++i], &c.disp_min_q8, &c.disp_max_q8, &error);
+      range_given = ok;
     } else {
       error = std::string("unknown option \"") + a + "\"";
       ok = false;
@@ -165,10 +155,7 @@ int DepthCommand(int argc, char** argv) {
   c.views = static_cast<int32_t>(files.size());
   c.reference = ref < 0 ? c.views / 2 : ref;
   if (c.reference >= c.views) return Usage("--ref is past the last view");
-  const bool range_given = disp_max >= 0;
-  if (!range_given) disp_max = static_cast<float>(c.labels - 1) / 4.0f;
-  c.disp_min_q8 = static_cast<int32_t>(disp_min * 256.0f + 0.5f);
-  c.disp_max_q8 = static_cast<int32_t>(disp_max * 256.0f + 0.5f);
+  if (!range_given) c.disp_max_q8 = (c.labels - 1) * 64;  // quarter-pixel labels from 0
 
   std::vector<std::vector<uint8_t>> pixels(files.size());
   for (size_t v = 0; v < files.size(); ++v) {
@@ -208,10 +195,11 @@ int DepthCommand(int argc, char** argv) {
   const ImageU16 out = MakeView(disp.data(), c.width, c.height);
   s = stage.Compute(views.data(), out);
   if (!s.ok()) return Fail(s.message());
-  s = WriteDisparityPfm(pfm, out);
+  const int32_t bias = DepthStage::MapBiasQ8(c);
+  s = WriteDisparityPfm(pfm, out, bias);
   if (!s.ok()) return Fail(s.message());
   if (preview) {
-    s = WriteDisparityPreview(preview, out, c.disp_min_q8, c.disp_max_q8);
+    s = WriteDisparityPreview(preview, out, c.disp_min_q8 + bias, c.disp_max_q8 + bias);
     if (!s.ok()) return Fail(s.message());
   }
   const DepthStats& st = stage.stats();

@@ -38,6 +38,20 @@ bool ParseInt(const char* text, int32_t lo, int32_t hi, int32_t* out, std::strin
   return true;
 }
 
+bool ParseDisparityRange(const char* text, int32_t* lo_q8, int32_t* hi_q8, std::string* error) {
+  float lo = 0, hi = 0;
+  char tail = 0;
+  if (sscanf(text, "%f,%f%c", &lo, &hi, &tail) != 2 || !(lo >= -255) || !(hi > lo) ||
+      !(hi <= 255) || hi - lo > 255) {
+    *error = std::string("disparity '") + text +
+             "' is not MIN,MAX with -255 <= MIN < MAX <= 255, at most 255 apart";
+    return false;
+  }
+  *lo_q8 = static_cast<int32_t>(__builtin_floor(lo * 256.0f + 0.5f));
+  *hi_q8 = static_cast<int32_t>(__builtin_floor(hi * 256.0f + 0.5f));
+  return true;
+}
+
 bool ParseFloat(const char* text, float lo, float hi, float* out, std::string* error) {
   char* end = nullptr;
   errno = 0;

@@ -15,6 +15,9 @@ namespace lb::cli {
 
 bool ParseInt(const char* text, int32_t lo, int32_t hi, int32_t* out, std::string* error);
 bool ParseFloat(const char* text, float lo, float hi, float* out, std::string* error);
+// "MIN,MAX" in px per view step, signed (a converged rig has both signs): -255 <= MIN < MAX
+// <= 255, at most 255 apart; Q8.8 out, rounded to nearest.
+bool ParseDisparityRange(const char* text, int32_t* lo_q8, int32_t* hi_q8, std::string* error);
 // "X,Y" (a point: a small square around it) or "X,Y,W,H" (a rectangle), full-resolution px.
 bool ParseFocus(const char* text, FocusRegion* out, std::string* error);
 // "disc" or "N-blade" / "polygon:N", e.g. "6-blade", "polygon:9".

@@ -64,18 +64,6 @@ int Usage(const std::string& error) {
   return 2;
 }
 
-bool ParseRange(const char* text, int32_t* lo_q8, int32_t* hi_q8, std::string* error) {
-  float lo = 0, hi = 0;
-  char tail = 0;
-  if (sscanf(text, "%f,%f%c", &lo, &hi, &tail) != 2 || !(lo >= 0) || !(hi > lo) || hi > 255) {
-    *error = std::string("disparity '") + text + "' is not MIN,MAX with 0 <= MIN < MAX <= 255";
-    return false;
-  }
-  *lo_q8 = static_cast<int32_t>(lo * 256.0f + 0.5f);
-  *hi_q8 = static_cast<int32_t>(hi * 256.0f + 0.5f);
-  return true;
-}
-
 }  // namespace
 
 int RunCommand(int argc, char** argv) {
@@ -144,7 +132,8 @@ int RunCommand(int argc, char** argv) {
         ok = ParseInt(optarg, 2, 256, &job.pipeline.labels, &error);
         break;
       case kDisparity:
-        ok = ParseRange(optarg, &job.pipeline.disp_min_q8, &job.pipeline.disp_max_q8, &error);
+        ok = ParseDisparityRange(optarg, &job.pipeline.disp_min_q8, &job.pipeline.disp_max_q8,
+                                 &error);
         range_given = true;
         break;
       case kWorking:

@@ -56,7 +56,7 @@ Status CheckMap(const char* path, ConstImageU16 disp_q8) {
 
 }  // namespace
 
-Status WriteDisparityPfm(const char* path, ConstImageU16 disp_q8) {
+Status WriteDisparityPfm(const char* path, ConstImageU16 disp_q8, int32_t bias_q8) {
   LB_RETURN_IF_ERROR(CheckMap(path, disp_q8));
   TempFile out(path);
   LB_RETURN_IF_ERROR(out.Open());
@@ -65,7 +65,7 @@ Status WriteDisparityPfm(const char* path, ConstImageU16 disp_q8) {
   for (int32_t y = disp_q8.height - 1; y >= 0; --y) {
     const uint16_t* src = disp_q8.Row(y);
     for (int32_t x = 0; x < disp_q8.width; ++x) {
-      const float v = static_cast<float>(src[x]) / 256.0f;
+      const float v = static_cast<float>(src[x] - bias_q8) / 256.0f;
       uint32_t bits;
       memcpy(&bits, &v, 4);
       for (int b = 0; b < 4; ++b) row[4 * x + b] = static_cast<uint8_t>(bits >> (8 * b));

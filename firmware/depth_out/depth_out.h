@@ -10,8 +10,9 @@
 
 namespace lb {
 
-// Single-channel PFM ("Pf"), little-endian (scale -1), rows bottom to top, values dispQ8 / 256.
-Status WriteDisparityPfm(const char* path, ConstImageU16 disp_q8);
+// Single-channel PFM ("Pf"), little-endian (scale -1), rows bottom to top, values
+// (map - bias_q8) / 256: signed disparities for a map lifted by DepthStage::MapBiasQ8.
+Status WriteDisparityPfm(const char* path, ConstImageU16 disp_q8, int32_t bias_q8 = 0);
 
 // RGB8 colour of a disparity on a blue (far) - cyan - green - yellow - red (near) ramp over
 // [min_q8, max_q8]; values outside are clamped.

@@ -60,7 +60,11 @@ Status PlaneDepth(const std::vector<ConstImageU8>& views, const MotionResult& m,
   MakeLabelPlanes(m, stage.config(), range->px_per_inv_depth, planes.data());
   LB_RETURN_IF_ERROR(stage.SetPlanes(planes.data()));
   disp->assign(static_cast<size_t>(c.width) * c.height, 0);
-  return stage.Compute(views.data(), MakeView(disp->data(), c.width, c.height));
+  LB_RETURN_IF_ERROR(stage.Compute(views.data(), MakeView(disp->data(), c.width, c.height)));
+  // Back to disparities: the ones beyond infinity (none in these scenes' truth) read as 0.
+  const int32_t bias = DepthStage::MapBiasQ8(stage.config());
+  for (uint16_t& d : *disp) d = static_cast<uint16_t>(d > bias ? d - bias : 0);
+  return Status::Ok();
 }
 
 Status Estimate(const std::vector<ConstImageU8>& views, int32_t reference,

@@ -69,18 +69,36 @@ TEST(LabelRange, AShallowSceneGetsTheFinestSpacingAroundItsPoints) {
   EXPECT_LE(r.disp_min_q8, (40 - 0.2) * 256);
   EXPECT_GE(r.disp_max_q8, (41 + 0.2) * 256);
   EXPECT_EQ(r.disp_min_q8 % (4 * 16), 0);
-  // Near infinity the window stops at 0.
+  // Near infinity the window goes on beyond it (signed inverse depth), still on the lattice
+  // through 0.
   ASSERT_TRUE(PlanLabelRange(Rig(5, 1, 400, 0.001, 0.003), Plan(64), &r).ok());
-  EXPECT_EQ(r.disp_min_q8, 0);
+  EXPECT_LT(r.disp_min_q8, 0);
+  EXPECT_LE(r.disp_min_q8, (0.4 - 0.16) * 256);
   EXPECT_GE(r.disp_max_q8, (1.2 + 0.16) * 256);
+  EXPECT_EQ(r.disp_min_q8 % (4 * Step(r, 64)), 0);
+}
+
+TEST(LabelRange, PointsOnBothSidesOfInfinityKeepTheirWindow) {
+  // A converged rig: the gauge's infinity inside the points' range (-3..+3 px per step).
+  LabelRange r;
+  ASSERT_TRUE(PlanLabelRange(Rig(5, 1, 400, -0.0075, 0.0075), Plan(64), &r).ok());
+  EXPECT_LE(r.disp_min_q8, (-3 - 1.2) * 256);
+  EXPECT_GE(r.disp_max_q8, (3 + 1.2) * 256);
+  EXPECT_EQ(r.disp_min_q8 % (4 * Step(r, 64)), 0);
+  EXPECT_EQ(r.disp_min_q8 + 63 * Step(r, 64), r.disp_max_q8);
 }
 
 TEST(LabelRange, StaysInsideTheDepthStagesLimits) {
   LabelRange r;
-  // Points at infinity and close: the far end stops at 0.
+  // Points at infinity and close: the margin goes beyond infinity, inside the stage's limits.
   ASSERT_TRUE(PlanLabelRange(Rig(5, 1, 400, 0.0, 0.05), Plan(16), &r).ok());
-  EXPECT_EQ(r.disp_min_q8, 0);
+  EXPECT_LT(r.disp_min_q8, 0);
   EXPECT_GT(r.disp_max_q8, r.disp_min_q8);
+  EXPECT_LE(r.disp_max_q8 - r.disp_min_q8, 65535);
+  // Points far beyond infinity: clamped to the stage's -65535.
+  ASSERT_TRUE(PlanLabelRange(Rig(5, 100, 4000, -2, -1), Plan(64), &r).ok());
+  EXPECT_GE(r.disp_min_q8, -65535);
+  EXPECT_EQ(r.disp_min_q8 + 63 * Step(r, 64), r.disp_max_q8);
   // All points at one depth: still a quantum per label.
   ASSERT_TRUE(PlanLabelRange(Rig(5, 1, 400, 0.02, 0.02), Plan(64), &r).ok());
   EXPECT_EQ(Step(r, 64), 16);
