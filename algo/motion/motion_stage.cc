@@ -143,6 +143,7 @@ Status MotionStage::Carve(Arena& arena) {
   pos_q16_ = arena.Allocate<int32_t>(2 * n);
   disp_q16_ = arena.Allocate<int32_t>(2 * vn);
   obs_ok_ = arena.Allocate<uint8_t>(vn);
+  near_ok_ = arena.Allocate<uint8_t>(vn);
   point_ok_ = arena.Allocate<uint8_t>(n);
   ref_xy_ = arena.Allocate<double>(2 * n);
   obs_xy_ = arena.Allocate<double>(2 * vn);
@@ -261,6 +262,36 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
   in.k1_prior = c.k1_prior;
   in.k1_reach_px = k.fx * corner * corner * corner;
   BundleReport report;
+  // Far frames start from the near ones: from the identity, a frame many steps out (18 px on
+  // barn1's ninth view) can send the first adjustment into a wrong minimum. The frames within
+  // kNearSteps of the reference are adjusted first; each farther frame then starts from the
+  // nearest adjusted one on its side, its translation scaled by the steps.
+  constexpr int32_t kNearSteps = 2;
+  int32_t far = 0;
+  for (int32_t v = 0; v < c.views; ++v) {
+    const int32_t d = v > reference ? v - reference : reference - v;
+    far = d > far ? d : far;
+  }
+  if (far > kNearSteps) {
+    for (int32_t v = 0; v < c.views; ++v) {
+      const int32_t d = v > reference ? v - reference : reference - v;
+      const size_t at = static_cast<size_t>(v) * n;
+      for (int32_t i = 0; i < n; ++i) near_ok_[at + i] = d <= kNearSteps ? obs_ok_[at + i] : 0;
+    }
+    in.obs_ok = near_ok_;
+    LB_RETURN_IF_ERROR(bundle_.Solve(in, c.bundle_iterations, c.huber_px, result->motion,
+                                     inv_depth_, nullptr, &report));
+    in.obs_ok = obs_ok_;
+    for (int32_t v = 0; v < c.views; ++v) {
+      const int32_t d = v > reference ? v - reference : reference - v;
+      if (d <= kNearSteps) continue;
+      const int32_t u = v > reference ? reference + kNearSteps : reference - kNearSteps;
+      result->motion[v] = result->motion[u];
+      for (int32_t k = 0; k < 3; ++k) {
+        result->motion[v].translation[k] *= static_cast<double>(d) / kNearSteps;
+      }
+    }
+  }
   for (int32_t round = 0; round < c.bundle_rounds; ++round) {
     // The distortion joins once the poses have settled without it: from the identity start a
     // free k1 can run off before the rotations have taken their share.

@@ -145,6 +145,7 @@ class MotionStage {
   int32_t* pos_q16_ = nullptr;   // corner x (max_points_), then y (max_points_)
   int32_t* disp_q16_ = nullptr;  // dx, dy per (view, point)
   uint8_t* obs_ok_ = nullptr;    // per (view, point)
+  uint8_t* near_ok_ = nullptr;   // obs_ok_ of the frames near the reference only
   uint8_t* point_ok_ = nullptr;  // per point
   double* ref_xy_ = nullptr;     // normalised, 2 per point
   double* obs_xy_ = nullptr;     // normalised, 2 per (view, point)

@@ -121,6 +121,9 @@ Status Scene::Configure(const SceneParams& params, int32_t width, int32_t height
     return Status(Code::kInvalidArgument,
                   "synthetic scene: handheld bounds %g deg / %g outside 0..10 deg / 0..0.1",
                   params.max_rotation_deg, params.max_translation);
+  if (!(params.converge_m >= 0 && params.converge_m <= 1000))
+    return Status(Code::kInvalidArgument, "synthetic scene: convergence at %g m outside 0..1000",
+                  params.converge_m);
 
   params_ = params;
   width_ = width;
@@ -291,6 +294,37 @@ void Scene::BuildFixedPoint() {
   }
 }
 
+// Turns `pose` so the reference point (0, 0, depth) lies on the view's optical axis: the
+// rotation taking its direction a to b = (0, 0, 1), I + [v]x + [v]x^2 / (1 + a.b) with
+// v = a x b (no trigonometry: the same bits everywhere).
+static void TurnToward(double depth, Pose* pose) {
+  double q[3];
+  for (int i = 0; i < 3; ++i) q[i] = pose->rotation[i][2] * depth + pose->translation[i];
+  const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+  const double a[3] = {q[0] / n, q[1] / n, q[2] / n};
+  const double v[3] = {a[1], -a[0], 0};  // a x (0, 0, 1)
+  const double c = a[2];
+  const double vx[3][3] = {{0, -v[2], v[1]}, {v[2], 0, -v[0]}, {-v[1], v[0], 0}};
+  double r[3][3];
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      double sq = 0;
+      for (int k = 0; k < 3; ++k) sq += vx[i][k] * vx[k][j];
+      r[i][j] = (i == j ? 1.0 : 0.0) + vx[i][j] + sq / (1 + c);
+    }
+  }
+  Pose out;
+  for (int i = 0; i < 3; ++i) {
+    out.translation[i] = 0;
+    for (int j = 0; j < 3; ++j) {
+      out.rotation[i][j] = 0;
+      for (int k = 0; k < 3; ++k) out.rotation[i][j] += r[i][k] * pose->rotation[k][j];
+      out.translation[i] += r[i][j] * pose->translation[j];
+    }
+  }
+  *pose = out;
+}
+
 Status Scene::BuildView(int32_t view) {
   Pose& pose = poses_[view];
   pose = Pose();
@@ -314,6 +348,7 @@ Status Scene::BuildView(int32_t view) {
     const double norm = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
     const double mag = rng.Range(0.5, 1) * params_.max_translation * scene_depth_ / norm;
     for (int i = 0; i < 3; ++i) pose.translation[i] = dir[i] * mag;
+    if (params_.converge_m > 0) TurnToward(params_.converge_m, &pose);
   }
 
   const Intrinsics& in = intrinsics_;

@@ -21,7 +21,8 @@
 //    row (the depth stage's convention).
 //  - kHandheld: the reference has the identity pose; every other view a seeded random rotation
 //    of 0.3..1 x max_rotation_deg about a random axis and a translation of 0.5..1 x
-//    max_translation * scene_depth() in a random, mostly sideways direction.
+//    max_translation * scene_depth() in a random, mostly sideways direction; with converge_m,
+//    then turned so the point converge_m down the reference's axis stays at the image centre.
 //
 // Ground truth: the reference view's per-step disparity (px per view step of the rectified rig;
 // in handheld mode the same number, proportional to inverse depth) and inverse depth (1/m), at
@@ -51,6 +52,9 @@ struct SceneParams {
   double disparity_scale = 1.0;   // scales the rectified baseline (and so every disparity)
   double max_rotation_deg = 1.0;  // handheld: rotation bound per frame
   double max_translation = 0.01;  // handheld: translation bound, a fraction of scene_depth()
+  // handheld: > 0 turns every view toward the point this many metres down the reference's
+  // axis, as a hand keeping its subject in frame does (the views converge on it).
+  double converge_m = 0;
   bool ground_plane = true;
   bool point_lights = true;
 };

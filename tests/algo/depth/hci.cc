@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "sim/files/image_file.h"
+#include "tests/algo/depth/fit_score.h"
 
 namespace lb::hci {
 namespace {
@@ -101,39 +102,7 @@ Status Load(const std::string& dir, Layout layout, Burst* b) {
 
 double FittedBadPixPercent(const Burst& b, const std::vector<float>& e, double threshold,
                            int32_t border, double* scale_out, double* offset_out) {
-  double a = 1, c = 0;
-  double band = -1;  // the first fit takes every pixel
-  for (int round = 0; round < 3; ++round) {
-    double n = 0, se = 0, st = 0, see = 0, set = 0;
-    for (int32_t y = border; y < b.height - border; ++y) {
-      for (int32_t x = border; x < b.width - border; ++x) {
-        const size_t i = static_cast<size_t>(y) * b.width + x;
-        if (!std::isfinite(e[i])) continue;
-        if (band > 0 && std::fabs(a * e[i] + c - b.truth[i]) > band) continue;
-        n += 1;
-        se += e[i];
-        st += b.truth[i];
-        see += double{e[i]} * e[i];
-        set += double{e[i]} * b.truth[i];
-      }
-    }
-    const double det = n * see - se * se;
-    if (!(n > 1) || !(std::fabs(det) > 0)) break;
-    a = (n * set - se * st) / det;
-    c = (st - a * se) / n;
-    band = 4 * threshold;
-  }
-  int64_t bad = 0, total = 0;
-  for (int32_t y = border; y < b.height - border; ++y) {
-    for (int32_t x = border; x < b.width - border; ++x) {
-      const size_t i = static_cast<size_t>(y) * b.width + x;
-      ++total;
-      bad += !std::isfinite(e[i]) || std::fabs(a * e[i] + c - b.truth[i]) > threshold;
-    }
-  }
-  if (scale_out) *scale_out = a;
-  if (offset_out) *offset_out = c;
-  return total ? 100.0 * static_cast<double>(bad) / static_cast<double>(total) : 100.0;
+  return FittedBadPercent(b.truth, e, b.width, b.height, threshold, border, scale_out, offset_out);
 }
 
 }  // namespace lb::hci

@@ -25,7 +25,8 @@ struct Set {
 
 // The data folder (from LB_SOURCE_DIR or the working directory), empty when absent.
 std::string DataDir();
-// name: tsukuba, venus or teddy.
+// name: tsukuba, venus, teddy, sawtooth or barn1 (the last two without an occlusion mask here:
+// every pixel of known disparity is evaluated).
 Status Load(const std::string& dir, const std::string& name, Set* set);
 // Percentage of bad pixels of disparities in px per view step, Q8.
 double BadPixelPercent(const Set& set, ConstImageU16 disp_q8);

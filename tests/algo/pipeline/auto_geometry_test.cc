@@ -21,6 +21,7 @@
 #include "algo/depth/planes.h"
 #include "algo/motion/motion_stage.h"
 #include "algo/pipeline/auto_geometry.h"
+#include "tests/algo/depth/fit_score.h"
 #include "tests/algo/depth/middlebury.h"
 #include "tests/algo/motion/burst.h"
 
@@ -36,9 +37,24 @@ struct Memory {
   }
 };
 
-// Depth of `views` in kPlanes mode for the poses of `m`; fills disp (Q8) and the range used.
+// Depth of `views` in kPlanes mode for the poses of `m`: signed disparities (px per view
+// step) and the range used.
+Status SignedPlaneDepth(const std::vector<ConstImageU8>& views, const MotionResult& m,
+                        int32_t labels, std::vector<float>* out, LabelRange* range);
+
+// The same as Q8 for the scenes whose truth has no point beyond infinity (those read as 0).
 Status PlaneDepth(const std::vector<ConstImageU8>& views, const MotionResult& m, int32_t labels,
                   std::vector<uint16_t>* disp, LabelRange* range) {
+  std::vector<float> d;
+  LB_RETURN_IF_ERROR(SignedPlaneDepth(views, m, labels, &d, range));
+  disp->resize(d.size());
+  for (size_t i = 0; i < d.size(); ++i)
+    (*disp)[i] = static_cast<uint16_t>(d[i] > 0 ? d[i] * 256 + 0.5f : 0);
+  return Status::Ok();
+}
+
+Status SignedPlaneDepth(const std::vector<ConstImageU8>& views, const MotionResult& m,
+                        int32_t labels, std::vector<float>* out, LabelRange* range) {
   LabelPlan plan;
   plan.labels = labels;
   LB_RETURN_IF_ERROR(PlanLabelRange(m, plan, range));
@@ -59,11 +75,11 @@ Status PlaneDepth(const std::vector<ConstImageU8>& views, const MotionResult& m,
   std::vector<PlaneHomography> planes(static_cast<size_t>(c.views) * labels);
   MakeLabelPlanes(m, stage.config(), range->px_per_inv_depth, planes.data());
   LB_RETURN_IF_ERROR(stage.SetPlanes(planes.data()));
-  disp->assign(static_cast<size_t>(c.width) * c.height, 0);
-  LB_RETURN_IF_ERROR(stage.Compute(views.data(), MakeView(disp->data(), c.width, c.height)));
-  // Back to disparities: the ones beyond infinity (none in these scenes' truth) read as 0.
+  std::vector<uint16_t> map(static_cast<size_t>(c.width) * c.height, 0);
+  LB_RETURN_IF_ERROR(stage.Compute(views.data(), MakeView(map.data(), c.width, c.height)));
   const int32_t bias = DepthStage::MapBiasQ8(stage.config());
-  for (uint16_t& d : *disp) d = static_cast<uint16_t>(d > bias ? d - bias : 0);
+  out->resize(map.size());
+  for (size_t i = 0; i < map.size(); ++i) (*out)[i] = static_cast<float>(map[i] - bias) / 256.0f;
   return Status::Ok();
 }
 
@@ -151,6 +167,90 @@ TEST(AutoGeometry, HandheldDepthWithEstimatedPosesIsCloseToTruePoses) {
   EXPECT_LE(Median(est_bad), 1.5 * Median(true_bad));
 }
 
+// Narrow fields of view, the camera turning toward its subject while it moves (the views
+// converge on it, so the inverse depth the frames can tell has an offset as well as a scale),
+// and the same with the focal length told 25 % long or short: after a scale + offset fit, bad
+// pixels within 1.5x of the true poses with the true focal length.
+struct NarrowCase {
+  double fov_deg;
+  double focal_error;  // the focal length told is the true one times this
+};
+
+class NarrowField : public ::testing::TestWithParam<NarrowCase> {};
+
+TEST_P(NarrowField, ConvergingBurstsKeepTheirDepthAfterScaleAndOffset) {
+  const NarrowCase& k = GetParam();
+  constexpr int32_t kW = 640, kH = 480, kLabels = 64, kBorder = 32;
+  const char* env = std::getenv("LB_AUTO_SEEDS");
+  const int32_t seeds = env ? std::atoi(env) : 3;
+  double est_sum = 0, true_sum = 0;
+  for (int32_t s = 0; s < seeds; ++s) {
+    const int32_t n = 5 + s % 3;
+    SceneParams params = motiontest::Handheld(300 + s);
+    params.fov_deg = k.fov_deg;
+    // The same hand: the parallax in px grows with the focal length, so the translation shrinks
+    // with the field of view's tangent (a ~64 degree lens takes 0.01 of the scene's depth).
+    params.max_translation = 0.01 * std::tan(k.fov_deg * M_PI / 360) / std::tan(32.5 * M_PI / 180);
+    params.converge_m = 1.5;
+    motiontest::Burst b;
+    ASSERT_TRUE(motiontest::MakeBurst(params, kW, kH, n, &b, PixelSamples()));
+    const int32_t ref = b.scene.reference();
+    MotionResult truth;
+    truth.views = n;
+    truth.reference = ref;
+    truth.intrinsics = b.intrinsics;
+    for (int32_t v = 0; v < n; ++v) {
+      const Pose& p = b.scene.pose(v);
+      for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) truth.motion[v].rotation[i][j] = p.rotation[i][j];
+        truth.motion[v].translation[i] = p.translation[i];
+      }
+    }
+    truth.inv_depth_min = b.scene.inverse_depth_min_q12() / 4096.0;
+    truth.inv_depth_max = b.scene.inverse_depth_max_q12() / 4096.0;
+    CameraIntrinsics told = b.intrinsics;
+    told.fx *= k.focal_error;
+    told.fy *= k.focal_error;
+    MotionResult est;
+    const Status st = Estimate(b.views, ref, told, &est);
+    ASSERT_TRUE(st.ok()) << "seed " << 300 + s << ": " << st.message();
+    std::vector<uint16_t> rho_q12(static_cast<size_t>(kW) * kH);
+    ASSERT_TRUE(b.scene.InverseDepthRows(b.truth_scale, 0, kH, rho_q12.data(), kW).ok());
+    std::vector<float> disp_true, disp_est;
+    LabelRange true_range, est_range;
+    ASSERT_TRUE(SignedPlaneDepth(b.views, truth, kLabels, &disp_true, &est_range).ok());
+    true_range = est_range;
+    ASSERT_TRUE(SignedPlaneDepth(b.views, est, kLabels, &disp_est, &est_range).ok());
+    std::vector<float> want(rho_q12.size());
+    for (size_t i = 0; i < want.size(); ++i) {
+      want[i] = static_cast<float>(rho_q12[i] / 4096.0 * true_range.px_per_inv_depth);
+    }
+    const double tolerance = 1.0 / (n - 1);
+    double ta = 0, tc = 0, ea = 0, ec = 0;
+    const double true_bad = FittedBadPercent(want, disp_true, kW, kH, tolerance, kBorder, &ta, &tc);
+    const double est_bad = FittedBadPercent(want, disp_est, kW, kH, tolerance, kBorder, &ea, &ec);
+    printf(
+        "fov %.0f, focal x%.2f, seed %d (%d frames): bad %.2f %% estimated (fit %.3f x + %.3f; "
+        "%d points, rail %d), %.2f %% true poses (fit %.3f x + %.3f)\n",
+        k.fov_deg, k.focal_error, 300 + s, n, est_bad, ea, ec, est.points, est.rail, true_bad, ta,
+        tc);
+    EXPECT_FALSE(est.rail) << "seed " << 300 + s;
+    // Per burst a looser 2x: at half a percent of bad pixels one seed's few hundred pixels
+    // swing the ratio (65 degrees, f told 0.8x, seed 302: 0.78 against 0.46 %).
+    EXPECT_LE(est_bad, 2.0 * true_bad) << "seed " << 300 + s;
+    est_sum += est_bad;
+    true_sum += true_bad;
+  }
+  printf("mean bad: %.2f %% estimated, %.2f %% true poses and focal length\n", est_sum / seeds,
+         true_sum / seeds);
+  EXPECT_LE(est_sum, 1.5 * true_sum);
+}
+
+INSTANTIATE_TEST_SUITE_P(Lenses, NarrowField,
+                         ::testing::Values(NarrowCase{20, 1.0}, NarrowCase{30, 1.0},
+                                           NarrowCase{65, 1.25}, NarrowCase{65, 0.8},
+                                           NarrowCase{25, 1.25}, NarrowCase{25, 0.8}));
+
 class MiddleburyAuto : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(MiddleburyAuto, GivesSaneDepthAfterTheGlobalScale) {
@@ -211,7 +311,8 @@ TEST_P(MiddleburyAuto, GivesSaneDepthAfterTheGlobalScale) {
   EXPECT_LE(median_bad, 1.5 * rectified_bad);
 }
 
-INSTANTIATE_TEST_SUITE_P(Sets, MiddleburyAuto, ::testing::Values("tsukuba", "venus", "teddy"));
+INSTANTIATE_TEST_SUITE_P(Sets, MiddleburyAuto,
+                         ::testing::Values("tsukuba", "venus", "teddy", "sawtooth", "barn1"));
 
 }  // namespace
 }  // namespace lb
