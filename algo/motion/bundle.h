@@ -13,7 +13,8 @@
 // Rotations are updated by a unit quaternion (1, d/2) normalised, so no sin/cos is needed and the
 // same bits come out on every target. Start: identity rotations, zero translations, w = 1; small
 // motion makes that close enough. Gauge: after every accepted step the inverse depths are scaled
-// to mean 1 (translations scaled inversely), so a unit is the harmonic mean depth of the points.
+// to mean |w| 1 with a mean >= 0 (translations scaled inversely). Inverse depths are signed: at a
+// narrow field of view the fit may put points beyond its infinity (motion_stage.h).
 //
 // Linear algebra: the point block is diagonal (one unknown per point), so each step solves the
 // reduced camera system (6 per view and k1, <= 91 unknowns) with an in-place Cholesky in arena

@@ -8,11 +8,13 @@
 // on a line at equal steps: adjusted again with the turn across the rail held and the lens's
 // radial distortion fitted), then the checks.
 //
-// Scale convention: inverse depths are scaled to mean 1 over the inlier points, so their unit is
-// 1 / (harmonic mean depth of the points), and translations are in units of that depth. Only
-// the product inv_depth * translation reaches pixels (plane_homography.h), and it does not
-// depend on the convention. A rectified rig of spacing b seen at mean inverse depth m has
-// |translation| = b m per view step.
+// Scale convention: inverse depths are signed and scaled to mean |w| 1 over the points, and
+// translations are in the inverse unit. Only the product inv_depth * translation reaches pixels
+// (plane_homography.h), and it does not depend on the convention. At a narrow field of view a
+// turn across the baseline looks like an offset of every inverse depth, so the fit's infinity
+// may lie among the points (a converged burst): only differences of inverse depth are
+// meaningful, which is all that depth labels and blur use (auto_geometry.h). A rectified rig of
+// spacing b seen at mean inverse depth m has |translation| = b m per view step.
 //
 // Memory: every buffer is carved at Configure; Estimate allocates nothing (Eigen runs on arena
 // memory and fixed-size temporaries; EIGEN_NO_MALLOC guards it).

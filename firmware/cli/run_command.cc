@@ -220,7 +220,7 @@ int RunCommand(int argc, char** argv) {
         "frame\n",
         p.motion().points, p.motion().rms_px,
         p.motion().rail ? ", on a rail (orientation held, lens k1 fitted)" : "",
-        p.disp_min_q8() / 256.0, p.disp_max_q8() / 256.0);
+        p.depth().config().disp_min_q8 / 256.0, p.depth().config().disp_max_q8 / 256.0);
   }
   return 0;
 }
