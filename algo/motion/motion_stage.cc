@@ -380,6 +380,16 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
   return Status::Ok();
 }
 
+void MotionStage::ReverseDepth(MotionResult* r) {
+  for (int32_t i = 0; i < r->points && r->inv_depth == out_w_; ++i) out_w_[i] = -out_w_[i];
+  for (int32_t v = 0; v < r->views; ++v) {
+    for (double& t : r->motion[v].translation) t = -t;
+  }
+  const double lo = r->inv_depth_min;
+  r->inv_depth_min = -r->inv_depth_max;
+  r->inv_depth_max = -lo;
+}
+
 Status MotionStage::Check(MotionResult* r) {
   const MotionConfig& c = config_;
   // Blur first: a blurred frame also loses points, and blur is what the user should hear about.

@@ -125,6 +125,11 @@ class MotionStage {
   Status Estimate(const ConstImageU8* views, int32_t reference, const CameraIntrinsics& intrinsics,
                   MotionResult* result);
 
+  // Turns `result` (of this stage's last Estimate) into its mirror w -> -w, t -> -t, which
+  // moves every pixel the same way: for a caller that has learnt which end is near
+  // (depth_order.h). Its points' inverse depths live in this stage's memory.
+  void ReverseDepth(MotionResult* result);
+
   const MotionConfig& config() const { return config_; }
   size_t arena_bytes() const { return arena_bytes_; }
 

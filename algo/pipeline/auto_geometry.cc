@@ -1,5 +1,6 @@
 #include "algo/pipeline/auto_geometry.h"
 
+#include "algo/depth/depth_order.h"
 #include "algo/depth/planes.h"
 
 namespace lb {
@@ -64,6 +65,32 @@ Status SetDepthGeometry(const MotionResult& motion, bool keep_range, DepthStage*
   }
   MakeLabelPlanes(motion, depth->config(), range->px_per_inv_depth, planes);
   return depth->SetPlanes(planes);
+}
+
+Status OrderDepth(const ConstImageU8* views, const PlaneHomography* planes, uint8_t* scratch,
+                  DepthStage* depth, MotionStage* stage, MotionResult* motion, ImageU16 map,
+                  bool* reversed) {
+  const DepthConfig c = depth->config();
+  if (reversed) *reversed = false;
+  if (map.width != c.width || map.height != c.height) {
+    return Status(Code::kInvalidArgument, "depth order: map %dx%d, depth %dx%d", map.width,
+                  map.height, c.width, c.height);
+  }
+  const DepthOrderVotes votes = VoteDepthOrder(views, c.views, c.reference, depth->labels(),
+                                               c.labels, planes, DepthOrderParams(), scratch);
+  if (votes.low_near <= 2 * votes.high_near) return Status::Ok();
+  const int32_t bias = DepthStage::MapBiasQ8(c);
+  LB_RETURN_IF_ERROR(depth->SetDisparityRange(-c.disp_max_q8, -c.disp_min_q8));
+  const int32_t new_bias = DepthStage::MapBiasQ8(depth->config());
+  for (int32_t y = 0; y < map.height; ++y) {
+    uint16_t* row = map.Row(y);
+    for (int32_t x = 0; x < map.width; ++x) {
+      row[x] = static_cast<uint16_t>(new_bias - (row[x] - bias));
+    }
+  }
+  if (stage && motion) stage->ReverseDepth(motion);
+  if (reversed) *reversed = true;
+  return Status::Ok();
 }
 
 }  // namespace lb

@@ -51,4 +51,14 @@ Status PlanLabelRange(const MotionResult& motion, const LabelPlan& plan, LabelRa
 Status SetDepthGeometry(const MotionResult& motion, bool keep_range, DepthStage* depth,
                         PlaneHomography* planes, LabelRange* range);
 
+// After a kPlanes Compute on the planes SetDepthGeometry built for `motion`: asks the views'
+// occlusions which end of the label range is near (depth_order.h) and, when a clear majority
+// (twice the other's votes) says the low end, reverses the depth: the map (d -> -d), the
+// stage's range and the motion (MotionStage::ReverseDepth; nullptr stage or motion: left as
+// they are). `scratch` holds
+// DepthOrderScratchBytes; `reversed`, when set, says whether it did.
+Status OrderDepth(const ConstImageU8* views, const PlaneHomography* planes, uint8_t* scratch,
+                  DepthStage* depth, MotionStage* stage, MotionResult* motion, ImageU16 map,
+                  bool* reversed);
+
 }  // namespace lb

@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "algo/core/color.h"
+#include "algo/depth/depth_order.h"
 #include "algo/pipeline/auto_geometry.h"
 
 namespace lb {
@@ -106,6 +107,7 @@ Status Pipeline::Carve(Arena& arena) {
   acc_ = arena.Allocate<uint32_t>(static_cast<size_t>(work_w_) * 3);
   if (UsesMotion(c, work_w_, work_h_)) {
     planes_ = arena.Allocate<PlaneHomography>(static_cast<size_t>(c.frames) * c.labels);
+    order_scratch_ = arena.Allocate<uint8_t>(DepthOrderScratchBytes(work_w_, work_h_));
   }
   if (arena.planning()) {
     (void)arena.AllocateBytes(DepthStage::RequiredBytes(MakeDepthConfig(c, work_w_, work_h_)));
@@ -264,6 +266,7 @@ Status Pipeline::ComputeDepth() {
   ConstImageU8 views[PipelineConfig::kMaxFrames];
   for (int32_t i = 0; i < config_.frames; ++i) views[i] = working_[i].AsConst();
   depth_warning_ = Status::Ok();
+  depth_reversed_ = false;
   const int32_t config_bias = config_.disp_min_q8 < 0 ? -config_.disp_min_q8 : 0;
   disp_min_q8_ = config_.disp_min_q8 + config_bias;
   disp_max_q8_ = config_.disp_max_q8 + config_bias;
@@ -282,6 +285,11 @@ Status Pipeline::ComputeDepth() {
     LB_RETURN_IF_ERROR(geometry);
   }
   LB_RETURN_IF_ERROR(depth_.Compute(views, disp_q8_));
+  if (config_.geometry == Geometry::kAuto) {
+    // SetDepthGeometry rebuilds the planes for every burst, so they are still this one's.
+    LB_RETURN_IF_ERROR(OrderDepth(views, planes_, order_scratch_, &depth_, &motion_,
+                                  &motion_result_, disp_q8_, &depth_reversed_));
+  }
   // The map's own range: a signed one is lifted by the stage's bias (depth_stage.h).
   const DepthConfig& d = depth_.config();
   disp_min_q8_ = d.disp_min_q8 + DepthStage::MapBiasQ8(d);

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "algo/core/color.h"
+#include "algo/depth/depth_order.h"
 #include "algo/depth/depth_stage.h"
 #include "algo/motion/motion_stage.h"
 #include "algo/pipeline/auto_geometry.h"
@@ -64,27 +65,34 @@ Status ReadRgb(const char* path, int32_t* width, int32_t* height, std::vector<ui
   return Status::Ok();
 }
 
+// Auto geometry's state for one run: the motion stage and its memory, its estimate and the
+// label planes the depth stage sweeps.
+struct AutoGeometry {
+  std::vector<uint8_t> memory;
+  MotionStage motion;
+  MotionResult result;
+  std::vector<PlaneHomography> planes;
+};
+
 // Auto geometry: the views' motion, then (unless the range was given) the label range from the
 // tracked points, and the planes' homographies. Updates `c` to the range used.
 Status EstimatePlanes(const std::vector<ConstImageU8>& views, double focal_px, bool range_given,
-                      DepthStage* stage, DepthConfig* c) {
+                      DepthStage* stage, DepthConfig* c, AutoGeometry* g) {
   MotionConfig mc;
   mc.width = c->width;
   mc.height = c->height;
   mc.views = c->views;
   LB_RETURN_IF_ERROR(MotionStage::Validate(mc));
-  std::vector<uint8_t> memory(MotionStage::RequiredBytes(mc) + Arena::kAlign);
-  void* const base = Arena::AlignUp(memory.data());
-  Arena arena(base, memory.size() - Arena::kAlign);
-  MotionStage motion;
-  LB_RETURN_IF_ERROR(motion.Configure(mc, arena));
+  g->memory.assign(MotionStage::RequiredBytes(mc) + Arena::kAlign, 0);
+  void* const base = Arena::AlignUp(g->memory.data());
+  Arena arena(base, g->memory.size() - Arena::kAlign);
+  LB_RETURN_IF_ERROR(g->motion.Configure(mc, arena));
   CameraIntrinsics k = DefaultIntrinsics(c->width, c->height);
   if (focal_px > 0) k.fx = k.fy = focal_px;
-  MotionResult m;
-  LB_RETURN_IF_ERROR(motion.Estimate(views.data(), c->reference, k, &m));
-  std::vector<PlaneHomography> planes(static_cast<size_t>(c->views) * c->labels);
+  LB_RETURN_IF_ERROR(g->motion.Estimate(views.data(), c->reference, k, &g->result));
+  g->planes.assign(static_cast<size_t>(c->views) * c->labels, PlaneHomography{});
   LabelRange range;
-  LB_RETURN_IF_ERROR(SetDepthGeometry(m, range_given, stage, planes.data(), &range));
+  LB_RETURN_IF_ERROR(SetDepthGeometry(g->result, range_given, stage, g->planes.data(), &range));
   if (!range_given) {
     c->disp_min_q8 = range.disp_min_q8;
     c->disp_max_q8 = range.disp_max_q8;
@@ -185,16 +193,25 @@ int DepthCommand(int argc, char** argv) {
   if (!s.ok()) return Fail(s.message());
   std::vector<ConstImageU8> views;
   for (const auto& p : pixels) views.push_back(MakeView(p.data(), c.width, c.height, 3));
+  AutoGeometry geometry_state;
   if (geometry == Geometry::kAuto) {
     const double focal = focal_35mm > 0 ? FocalPxFrom35mm(focal_35mm, c.width, c.height)
                                         : ExifFocalPx(files[0], c.width, c.height);
-    s = EstimatePlanes(views, focal, range_given, &stage, &c);
+    s = EstimatePlanes(views, focal, range_given, &stage, &c, &geometry_state);
     if (!s.ok()) return Fail(s.message());
   }
   std::vector<uint16_t> disp(static_cast<size_t>(c.width) * c.height);
   const ImageU16 out = MakeView(disp.data(), c.width, c.height);
   s = stage.Compute(views.data(), out);
   if (!s.ok()) return Fail(s.message());
+  if (geometry == Geometry::kAuto) {
+    std::vector<uint8_t> scratch(DepthOrderScratchBytes(c.width, c.height));
+    s = OrderDepth(views.data(), geometry_state.planes.data(), scratch.data(), &stage,
+                   &geometry_state.motion, &geometry_state.result, out, nullptr);
+    if (!s.ok()) return Fail(s.message());
+    c.disp_min_q8 = stage.config().disp_min_q8;
+    c.disp_max_q8 = stage.config().disp_max_q8;
+  }
   const int32_t bias = DepthStage::MapBiasQ8(c);
   s = WriteDisparityPfm(pfm, out, bias);
   if (!s.ok()) return Fail(s.message());
