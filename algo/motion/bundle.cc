@@ -93,6 +93,10 @@ double Bundle::ErrorPx(const BundleInput& in, const ViewMotion& m, double w, dou
                        int32_t view, int32_t point) {
   Vec3 rr;
   const Vec3 a = Ray(in, m, w, k1, point, &rr);
+  // A point behind the view's camera (or at its centre) is no fit of the observation, however
+  // its projection happens to fall: with signed inverse depths a step could otherwise flip
+  // points through the camera into a fit that wanders off.
+  if (!(a[2] > 1e-6 * rr.norm())) return kBehindPx;
   const Eigen::Vector2d o = Undistort(Obs(in, view, point), k1);
   const double ex = in.fx * (a[0] / a[2] - o[0]), ey = in.fy * (a[1] / a[2] - o[1]);
   return __builtin_sqrt(ex * ex + ey * ey);

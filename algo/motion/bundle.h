@@ -69,6 +69,8 @@ class Bundle {
   Status Solve(const BundleInput& in, int32_t max_iterations, double huber_px, ViewMotion* motion,
                double* inv_depth, double* k1, BundleReport* report);
 
+  // What ErrorPx says of a point behind the view's camera.
+  static constexpr double kBehindPx = 1e6;
   // Reprojection error in px of one observation under the given parameters.
   static double ErrorPx(const BundleInput& in, const ViewMotion& m, double w, double k1,
                         int32_t view, int32_t point);

@@ -209,15 +209,30 @@ Status MotionStage::Track(const ConstImageU8* views, int32_t reference, MotionRe
     pos_q16_[i] = corner_[i].x << 16;
     pos_q16_[max_points_ + i] = corner_[i].y << 16;
   }
-  for (int32_t v = 0; v < c.views; ++v) {
-    if (v == reference) continue;
-    LB_RETURN_IF_ERROR(view_.Build(views[v]));
-    result->sharpness_q4[v] = SharpnessQ4(view_.level(0));
-    int32_t* dx = disp_q16_ + 2 * static_cast<size_t>(v) * max_points_;
-    int32_t* dy = dx + max_points_;
-    for (int32_t i = 0; i < n; ++i) dx[i] = dy[i] = 0;
-    tracker_.Track(ref_, view_, pos_q16_, pos_q16_ + max_points_, n, dx, dy,
-                   obs_ok_ + static_cast<size_t>(v) * n);
+  // Outward from the reference, each frame starting from the one before it on its side, its
+  // motion scaled by the steps: a frame several steps out then starts within a step of its
+  // points, where a repetitive texture cannot lock onto the wrong period (the tracker also
+  // tries no motion, for a hand that went back).
+  for (int32_t d = 1; d < c.views; ++d) {
+    for (int32_t side = -1; side <= 1; side += 2) {
+      const int32_t v = reference + side * d;
+      if (v < 0 || v >= c.views) continue;
+      LB_RETURN_IF_ERROR(view_.Build(views[v]));
+      result->sharpness_q4[v] = SharpnessQ4(view_.level(0));
+      int32_t* dx = disp_q16_ + 2 * static_cast<size_t>(v) * max_points_;
+      int32_t* dy = dx + max_points_;
+      const int32_t u = v - side;  // the frame before, toward the reference
+      const int32_t* ux = disp_q16_ + 2 * static_cast<size_t>(u) * max_points_;
+      const int32_t* uy = ux + max_points_;
+      const uint8_t* u_ok = obs_ok_ + static_cast<size_t>(u) * n;
+      for (int32_t i = 0; i < n; ++i) {
+        const bool guess = u != reference && u_ok[i];
+        dx[i] = guess ? static_cast<int32_t>(int64_t{ux[i]} * d / (d - 1)) : 0;
+        dy[i] = guess ? static_cast<int32_t>(int64_t{uy[i]} * d / (d - 1)) : 0;
+      }
+      tracker_.Track(ref_, view_, pos_q16_, pos_q16_ + max_points_, n, dx, dy,
+                     obs_ok_ + static_cast<size_t>(v) * n);
+    }
   }
   return Status::Ok();
 }

@@ -47,17 +47,34 @@ void Tracker::Track(const GreyPyramid& ref, const GreyPyramid& view, const int32
                     const int32_t* y_q16, int32_t n, int32_t* dx_q16, int32_t* dy_q16,
                     uint8_t* ok) const {
   for (int32_t i = 0; i < n; ++i) {
-    ok[i] = TrackOne(ref, view, x_q16[i], y_q16[i], &dx_q16[i], &dy_q16[i]) ? 1 : 0;
+    const bool guessed = dx_q16[i] != 0 || dy_q16[i] != 0;
+    int32_t error = 0;
+    // From a guess only the two finest levels run: the coarse ones alias a fine repetitive
+    // texture and would drag the start off to a wrong period.
+    const int32_t top = guessed && ref.levels() > 2 ? 1 : ref.levels() - 1;
+    bool found = TrackOne(ref, view, x_q16[i], y_q16[i], top, &dx_q16[i], &dy_q16[i], &error);
+    if (guessed) {
+      int32_t dx0 = 0, dy0 = 0, error0 = 0;
+      // The guess wins unless no motion matches clearly better (half the error): on a
+      // repetitive texture both starts match about as well, and only the guess is right.
+      if (TrackOne(ref, view, x_q16[i], y_q16[i], ref.levels() - 1, &dx0, &dy0, &error0) &&
+          (!found || 2 * error0 < error)) {
+        found = true;
+        dx_q16[i] = dx0;
+        dy_q16[i] = dy0;
+      }
+    }
+    ok[i] = found ? 1 : 0;
   }
 }
 
 bool Tracker::TrackOne(const GreyPyramid& ref, const GreyPyramid& view, int32_t x_q16,
-                       int32_t y_q16, int32_t* dx_q16, int32_t* dy_q16) const {
+                       int32_t y_q16, int32_t top, int32_t* dx_q16, int32_t* dy_q16,
+                       int32_t* error_q4) const {
   const int32_t r = params_.radius;
   const int32_t tw = 2 * r + 3, ww = 2 * r + 1;
   constexpr int32_t kHalfQ16 = 1 << 15;
   int32_t dx = *dx_q16, dy = *dy_q16;
-  const int32_t top = ref.levels() - 1;
   dx >>= top;  // the guess, at the coarsest level
   dy >>= top;
   int32_t mean_error = 0;
@@ -140,6 +157,7 @@ bool Tracker::TrackOne(const GreyPyramid& ref, const GreyPyramid& view, int32_t 
   if (!Inside(view.level(0), x_q16 + dx, y_q16 + dy, r)) return false;
   *dx_q16 = dx;
   *dy_q16 = dy;
+  *error_q4 = mean_error;
   return mean_error <= params_.max_error_q4;
 }
 

@@ -31,12 +31,18 @@ class Tracker {
   // Tracks `n` points from `ref` into `view` (same sizes and levels). Start guesses are the
   // displacements in `dx_q16`/`dy_q16` (0 for none); on return they hold the tracked
   // displacement, and ok[i] is 1 where the point was followed to level 0 with a small error.
+  // A point with a guess is also tracked from no motion, which wins where the guess fails or
+  // matches twice as badly: a repetitive texture (bricks, tiles) locks onto a wrong period from
+  // a start too far off, and a wrong guess (a frame that went back) must not cost the point
+  // either.
   void Track(const GreyPyramid& ref, const GreyPyramid& view, const int32_t* x_q16,
              const int32_t* y_q16, int32_t n, int32_t* dx_q16, int32_t* dy_q16, uint8_t* ok) const;
 
  private:
+  // Coarse to fine from level `top`; `error_q4` receives the final mean |view - reference|
+  // over the window.
   bool TrackOne(const GreyPyramid& ref, const GreyPyramid& view, int32_t x_q16, int32_t y_q16,
-                int32_t* dx_q16, int32_t* dy_q16) const;
+                int32_t top, int32_t* dx_q16, int32_t* dy_q16, int32_t* error_q4) const;
 
   TrackerParams params_;
   int32_t* tmpl_ = nullptr;  // (2r+3)^2 reference samples, Q4

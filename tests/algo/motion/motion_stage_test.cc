@@ -251,6 +251,60 @@ TEST(MotionStageDegenerate, FramesWithNothingInCommonAreLostTracking) {
       << run.status.message();
 }
 
+// A wall of bricks of a 12 px period behind a board of smooth random blobs, a rail of 9
+// frames 5 px a step apart for the wall (10 px for the board): the outer frames, 10-20 px out
+// on the wall, must not lock onto a wrong period, so the steps come out equal. Each pixel
+// integrates 4 x 4 samples.
+double Bricks(double x, double y) {
+  const double fx = x / 12 - std::floor(x / 12), fy = y / 7.2 - std::floor(y / 7.2);
+  return ((fx < 0.15 || fy < 0.2) ? 60 : 190) + 20 * std::sin(x * 0.05) * std::cos(y * 0.043);
+}
+double Blobs(double x, double y) {
+  return 128 + 50 * std::sin(x * 0.31 + std::sin(y * 0.17) * 2) * std::cos(y * 0.23 - x * 0.07);
+}
+
+TEST(MotionStage, ARepetitiveTextureIsFollowedFramesOut) {
+  constexpr int32_t kW = 512, kH = 384, kN = 9, kRef = 4;
+  constexpr double kStep = 5.0;
+  std::vector<std::vector<uint8_t>> px(kN, std::vector<uint8_t>(kW * kH * 3));
+  for (int32_t v = 0; v < kN; ++v) {
+    for (int32_t y = 0; y < kH; ++y) {
+      for (int32_t x = 0; x < kW; ++x) {
+        double sum = 0;
+        for (int32_t s = 0; s < 16; ++s) {
+          const double sx = x + (s % 4 + 0.5) / 4, sy = y + (s / 4 + 0.5) / 4;
+          const double board = sx + (v - kRef) * 2 * kStep;  // the board's reference x
+          const bool on_board = board > 160 && board < 352 && sy > 100 && sy < 280;
+          sum += on_board ? Blobs(board, sy) : Bricks(sx + (v - kRef) * kStep, sy);
+        }
+        for (int32_t k = 0; k < 3; ++k)
+          px[v][(y * kW + x) * 3 + k] = static_cast<uint8_t>(sum / 16);
+      }
+    }
+  }
+  std::vector<ConstImageU8> views;
+  for (const auto& p : px) views.push_back(MakeView(p.data(), kW, kH, 3));
+  MotionConfig c;
+  c.width = kW;
+  c.height = kH;
+  c.views = kN;
+  std::vector<uint8_t> memory(MotionStage::RequiredBytes(c));
+  Arena arena(memory.data(), memory.size());
+  MotionStage stage;
+  ASSERT_TRUE(stage.Configure(c, arena).ok());
+  MotionResult r;
+  const Status st = stage.Estimate(views.data(), kRef, DefaultIntrinsics(kW, kH), &r);
+  ASSERT_TRUE(st.ok()) << st.message();
+  const double step = r.motion[kRef + 1].translation[0];
+  printf("repetitive: %d points, rms %.3f px, step %.4f\n", r.points, r.rms_px, step);
+  EXPECT_LT(r.rms_px, 0.15);
+  for (int32_t v = 0; v < kN; ++v) {
+    if (v == kRef) continue;
+    EXPECT_NEAR(r.motion[v].translation[0] / (v - kRef), step, 0.05 * std::fabs(step))
+        << "frame " << v;
+  }
+}
+
 TEST(MotionStage, RejectsViewsThatDoNotMatchTheConfiguration) {
   Burst b;
   ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(1), 320, 240, 3, &b));
