@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -163,6 +164,54 @@ TEST_F(Cli, DepthOfAHandheldBurstFindsItsOwnGeometry) {
   EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   EXPECT_NE(r.err.find("sideways"), std::string::npos) << r.err;
   EXPECT_EQ(Slurp(dir_ + "/still.pfm"), "");
+}
+
+// A converged rig: the wall behind the focus plane at -2 px per view step, a square in front at
+// +2. Rectified geometry takes the signed range and the PFM says so.
+TEST_F(Cli, RectifiedDepthTakesASignedRange) {
+  constexpr int kW = 128, kH = 96;
+  auto texture = [](int x, int y, int layer) {
+    uint32_t h = static_cast<uint32_t>(x) * 73856093u ^ static_cast<uint32_t>(y) * 19349663u ^
+                 static_cast<uint32_t>(layer + 1) * 83492791u;
+    h ^= h >> 13;
+    h *= 0x5bd1e995u;
+    return static_cast<uint16_t>(h >> 24);
+  };
+  auto in_square = [](int x, int y) { return x >= 44 && x < 84 && y >= 28 && y < 68; };
+  std::vector<std::string> args = {"depth",         "--geometry", "rectified", "--disparity",
+                                   "-3.5,3",        "--labels",   "27",        "--disparity-out",
+                                   dir_ + "/d.pfm", "--views"};
+  for (int v = 0; v < 5; ++v) {
+    const int k = v - 2;
+    std::vector<uint16_t> samples(static_cast<size_t>(kW) * kH * 3);
+    for (int y = 0; y < kH; ++y) {
+      for (int x = 0; x < kW; ++x) {
+        // View k shows the reference point that sits at x + k d.
+        const bool front = in_square(x + 2 * k, y);
+        const int rx = front ? x + 2 * k : x - 2 * k;
+        for (int c = 0; c < 3; ++c) samples[(y * kW + x) * 3 + c] = texture(rx, y * 3 + c, front);
+      }
+    }
+    args.push_back(dir_ + "/c" + std::to_string(v) + ".ppm");
+    ASSERT_TRUE(test::WriteFile(args.back(), test::EncodePnm("P6", kW, kH, 255, samples)));
+  }
+  const Result r = Run(args);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string pfm = Slurp(dir_ + "/d.pfm");
+  const size_t header = pfm.find('\n', pfm.find('\n', 3) + 1) + 1;
+  ASSERT_EQ(pfm.size(), header + static_cast<size_t>(kW) * kH * 4);
+  auto at = [&](int x, int y) {  // rows bottom to top
+    float f = 0;
+    memcpy(&f, pfm.data() + header + (static_cast<size_t>(kH - 1 - y) * kW + x) * 4, 4);
+    return f;
+  };
+  EXPECT_NEAR(at(64, 48), 2.0f, 0.3f);   // the square
+  EXPECT_NEAR(at(20, 48), -2.0f, 0.3f);  // the wall, beyond the focus plane
+  EXPECT_NEAR(at(100, 80), -2.0f, 0.3f);
+
+  // A range the wrong way round is a usage error.
+  args[4] = "3,-1";
+  EXPECT_EQ(Run(args).exit_code, 2);
 }
 
 TEST_F(Cli, TruncatedPpm) {
