@@ -8,6 +8,7 @@
 #include "firmware/app/refocusable.h"
 #include "firmware/jpeg/jpeg_writer.h"
 #include "firmware/storage/atomic_file.h"
+#include "firmware/storage/output_target.h"
 
 namespace lb {
 namespace {
@@ -64,10 +65,10 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
   Pipeline& p = *pipeline_;
   p.ResetBurst();
 
-  // Opened first so an unwritable destination fails before the capture; any later failure
-  // removes the temporary, so nothing is left on storage.
-  AtomicFile file;
-  LB_RETURN_IF_ERROR(file.Open(out_path));
+  // The destination is checked before the capture, so a device, a link or a missing or
+  // read-only folder fails at once; the temporary is created only when the photo is ready to be
+  // written, and any later failure removes it, so nothing is left on storage.
+  LB_RETURN_IF_ERROR(CheckOutputTarget(out_path, nullptr, 0));
   double t0 = Now();
   LB_RETURN_IF_ERROR(sensor_->CaptureBurst(p));
   double t1 = Now();
@@ -101,6 +102,8 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
                                  FocusOf(p.render(), options_.render, mode_.width, mode_.height),
                                  mode_.width, &meta.extra_segments));
   }
+  AtomicFile file;
+  LB_RETURN_IF_ERROR(file.Open(out_path));
   JpegWriter writer;
   LB_RETURN_IF_ERROR(writer.Begin(&file, mode_.width, mode_.height, options_.quality, meta));
   for (;;) {

@@ -2,6 +2,8 @@
 // PFM, and optionally a colour-mapped PNG preview. With --geometry auto (the default) the camera
 // motion is estimated from the views; with rectified they are taken as equally spaced, left to
 // right.
+#include <sys/stat.h>
+
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -15,6 +17,8 @@
 #include "firmware/cli/commands.h"
 #include "firmware/cli/options.h"
 #include "firmware/depth_out/depth_out.h"
+#include "firmware/storage/atomic_file.h"
+#include "firmware/storage/output_target.h"
 #include "sim/files/exif_focal.h"
 #include "sim/files/image_file.h"
 
@@ -160,11 +164,24 @@ int DepthCommand(int argc, char** argv) {
     return Usage("--views takes at most 16 files");
   }
   if (!pfm) return Usage("--disparity-out is required");
+  if (preview && !strcmp(preview, pfm)) return Usage("--preview and --disparity-out name one file");
   c.views = static_cast<int32_t>(files.size());
   c.reference = ref < 0 ? c.views / 2 : ref;
   if (c.reference >= c.views) return Usage("--ref is past the last view");
   if (!range_given) c.disp_max_q8 = (c.labels - 1) * 64;  // quarter-pixel labels from 0
 
+  // Both outputs are checked before any work: devices, links, a missing folder, an input.
+  for (const char* target : {pfm, preview}) {
+    if (!target) continue;
+    const Status check =
+        CheckOutputTarget(target, files.data(), static_cast<int32_t>(files.size()));
+    if (!check.ok()) return Fail(check.message());
+  }
+  struct stat a, b;
+  if (preview && stat(pfm, &a) == 0 && stat(preview, &b) == 0 && a.st_dev == b.st_dev &&
+      a.st_ino == b.st_ino) {
+    return Usage("--preview and --disparity-out name one file");
+  }
   std::vector<std::vector<uint8_t>> pixels(files.size());
   for (size_t v = 0; v < files.size(); ++v) {
     int32_t w = 0, h = 0;
@@ -212,13 +229,19 @@ int DepthCommand(int argc, char** argv) {
     c.disp_min_q8 = stage.config().disp_min_q8;
     c.disp_max_q8 = stage.config().disp_max_q8;
   }
+  // Both outputs are written in full before either is renamed into place: a failed preview
+  // leaves no PFM behind.
   const int32_t bias = DepthStage::MapBiasQ8(c);
-  s = WriteDisparityPfm(pfm, out, bias);
-  if (!s.ok()) return Fail(s.message());
-  if (preview) {
-    s = WriteDisparityPreview(preview, out, c.disp_min_q8 + bias, c.disp_max_q8 + bias);
-    if (!s.ok()) return Fail(s.message());
+  AtomicFile pfm_file, preview_file;
+  s = pfm_file.Open(pfm);
+  if (s.ok()) s = EncodeDisparityPfm(&pfm_file, out, bias);
+  if (s.ok() && preview) s = preview_file.Open(preview);
+  if (s.ok() && preview) {
+    s = EncodeDisparityPreview(&preview_file, out, c.disp_min_q8 + bias, c.disp_max_q8 + bias);
   }
+  if (s.ok() && preview) s = preview_file.Commit();
+  if (s.ok()) s = pfm_file.Commit();
+  if (!s.ok()) return Fail(s.message());
   const DepthStats& st = stage.stats();
   printf(
       "%s: %dx%d, %d views (reference %d), %d labels %.2f..%.2f px/step, %d cycles, %zu arena "

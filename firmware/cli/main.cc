@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "firmware/cli/commands.h"
+#include "firmware/storage/temp_registry.h"
 
 namespace {
 
@@ -33,6 +34,8 @@ int main(int argc, char** argv) {
     printf("refocus %s\n", LB_VERSION);
     return 0;
   }
+  // An interrupted run leaves no hidden temporary behind (temp_registry.h).
+  lb::RemoveTemporariesOnSignals();
   const char* cmd = argv[1];
   if (!strcmp(cmd, "run")) return lb::cli::RunCommand(argc - 1, argv + 1);
 #ifdef LB_HAVE_DEPTH_COMMAND

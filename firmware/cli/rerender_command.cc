@@ -7,6 +7,7 @@
 #include "firmware/app/rerender.h"
 #include "firmware/cli/commands.h"
 #include "firmware/cli/options.h"
+#include "firmware/storage/output_target.h"
 
 namespace lb::cli {
 namespace {
@@ -57,8 +58,11 @@ int RerenderCommand(int argc, char** argv) {
   o.quality = lens.quality;
   if (optind != argc - 1) return Usage("give exactly one input file");
   if (out_path.empty()) return Usage("--out OUT.jpg is required");
+  const char* input = argv[optind];
+  Status s = CheckOutputTarget(out_path.c_str(), &input, 1);
+  if (!s.ok()) return Fail(s.message());
   Rerenderer r;
-  Status s = r.Load(argv[optind]);
+  s = r.Load(input);
   if (s.ok()) s = r.Render(o, out_path.c_str());
   if (!s.ok()) return Fail(s.message());
   printf("wrote %s: %dx%d re-rendered at f/%.1f\n", out_path.c_str(), r.width(), r.height(),

@@ -10,6 +10,7 @@
 #include "firmware/app/job.h"
 #include "firmware/cli/commands.h"
 #include "firmware/cli/options.h"
+#include "firmware/storage/output_target.h"
 #include "sim/files/file_sensor.h"
 #include "sim/synthetic/synthetic_sensor.h"
 
@@ -163,11 +164,13 @@ int RunCommand(int argc, char** argv) {
   }
 
   std::unique_ptr<Sensor> sensor;
+  const FileSensor* file_sensor = nullptr;
   if (!input_dir.empty() || !files.empty()) {
     std::unique_ptr<FileSensor> fs;
     Status s = input_dir.empty() ? FileSensor::FromFiles(files, &fs)
                                  : FileSensor::FromDirectory(input_dir.c_str(), &fs);
     if (!s.ok()) return Fail(s.message());
+    file_sensor = fs.get();
     sensor = std::move(fs);
     job.sensor.width = job.sensor.height = 0;  // the files decide
     job.model = "Image files";
@@ -199,6 +202,13 @@ int RunCommand(int argc, char** argv) {
 
   Job runner;
   Status s = runner.Configure(sensor.get(), job);
+  if (!s.ok()) return Fail(s.message());
+  // The inputs are known once the files were probed: the output may be none of them.
+  std::vector<const char*> inputs;
+  if (file_sensor) {
+    for (const std::string& path : file_sensor->paths()) inputs.push_back(path.c_str());
+  }
+  s = CheckOutputTarget(out_path.c_str(), inputs.data(), static_cast<int32_t>(inputs.size()));
   if (!s.ok()) return Fail(s.message());
   JobReport report;
   s = runner.Run(out_path.c_str(), &report);

@@ -11,42 +11,6 @@
 namespace lb {
 namespace {
 
-// Writes through a temporary file and renames it over `path` only when everything succeeded.
-class TempFile {
- public:
-  explicit TempFile(const char* path) : path_(path), temp_(std::string(path) + ".tmp") {}
-  ~TempFile() {
-    if (file_) fclose(file_);
-    if (!committed_) remove(temp_.c_str());
-  }
-  Status Open() {
-    file_ = fopen(temp_.c_str(), "wb");
-    if (!file_)
-      return Status(Code::kIoError, "%s: cannot create: %s", temp_.c_str(), strerror(errno));
-    return Status::Ok();
-  }
-  FILE* file() { return file_; }
-  Status Commit() {
-    const bool write_error = ferror(file_) != 0;
-    const int closed = fclose(file_);
-    file_ = nullptr;
-    if (write_error || closed != 0) {
-      return Status(Code::kIoError, "%s: write failed: %s", path_.c_str(), strerror(errno));
-    }
-    if (rename(temp_.c_str(), path_.c_str()) != 0) {
-      return Status(Code::kIoError, "%s: cannot rename into place: %s", path_.c_str(),
-                    strerror(errno));
-    }
-    committed_ = true;
-    return Status::Ok();
-  }
-
- private:
-  std::string path_, temp_;
-  FILE* file_ = nullptr;
-  bool committed_ = false;
-};
-
 Status CheckMap(const char* path, ConstImageU16 disp_q8) {
   if (disp_q8.empty() || disp_q8.channels != 1) {
     return Status(Code::kInvalidArgument, "%s: no single-channel disparity map to write", path);
@@ -56,11 +20,12 @@ Status CheckMap(const char* path, ConstImageU16 disp_q8) {
 
 }  // namespace
 
-Status WriteDisparityPfm(const char* path, ConstImageU16 disp_q8, int32_t bias_q8) {
-  LB_RETURN_IF_ERROR(CheckMap(path, disp_q8));
-  TempFile out(path);
-  LB_RETURN_IF_ERROR(out.Open());
-  fprintf(out.file(), "Pf\n%d %d\n-1.0\n", disp_q8.width, disp_q8.height);
+Status EncodeDisparityPfm(AtomicFile* out, ConstImageU16 disp_q8, int32_t bias_q8) {
+  LB_RETURN_IF_ERROR(CheckMap(out->path(), disp_q8));
+  char header[64];
+  const int n =
+      snprintf(header, sizeof(header), "Pf\n%d %d\n-1.0\n", disp_q8.width, disp_q8.height);
+  LB_RETURN_IF_ERROR(out->Write(header, static_cast<size_t>(n)));
   std::vector<uint8_t> row(static_cast<size_t>(disp_q8.width) * 4);
   for (int32_t y = disp_q8.height - 1; y >= 0; --y) {
     const uint16_t* src = disp_q8.Row(y);
@@ -70,8 +35,16 @@ Status WriteDisparityPfm(const char* path, ConstImageU16 disp_q8, int32_t bias_q
       memcpy(&bits, &v, 4);
       for (int b = 0; b < 4; ++b) row[4 * x + b] = static_cast<uint8_t>(bits >> (8 * b));
     }
-    fwrite(row.data(), 1, row.size(), out.file());
+    LB_RETURN_IF_ERROR(out->Write(row.data(), row.size()));
   }
+  return Status::Ok();
+}
+
+Status WriteDisparityPfm(const char* path, ConstImageU16 disp_q8, int32_t bias_q8) {
+  LB_RETURN_IF_ERROR(CheckMap(path, disp_q8));
+  AtomicFile out;
+  LB_RETURN_IF_ERROR(out.Open(path));
+  LB_RETURN_IF_ERROR(EncodeDisparityPfm(&out, disp_q8, bias_q8));
   return out.Commit();
 }
 
@@ -89,11 +62,9 @@ void DisparityColour(int32_t disp_q8, int32_t min_q8, int32_t max_q8, uint8_t rg
   }
 }
 
-Status WriteDisparityPreview(const char* path, ConstImageU16 disp_q8, int32_t min_q8,
-                             int32_t max_q8) {
-  LB_RETURN_IF_ERROR(CheckMap(path, disp_q8));
-  TempFile out(path);
-  LB_RETURN_IF_ERROR(out.Open());
+Status EncodeDisparityPreview(AtomicFile* out, ConstImageU16 disp_q8, int32_t min_q8,
+                              int32_t max_q8) {
+  LB_RETURN_IF_ERROR(CheckMap(out->path(), disp_q8));
   std::vector<uint8_t> pixels(static_cast<size_t>(disp_q8.width) * disp_q8.height * 3);
   for (int32_t y = 0; y < disp_q8.height; ++y) {
     for (int32_t x = 0; x < disp_q8.width; ++x) {
@@ -108,9 +79,23 @@ Status WriteDisparityPreview(const char* path, ConstImageU16 disp_q8, int32_t mi
   image.width = static_cast<png_uint_32>(disp_q8.width);
   image.height = static_cast<png_uint_32>(disp_q8.height);
   image.format = PNG_FORMAT_RGB;
-  if (!png_image_write_to_stdio(&image, out.file(), 0, pixels.data(), 0, nullptr)) {
-    return Status(Code::kIoError, "%s: PNG encoder: %s", path, image.message);
+  png_alloc_size_t size = 0;
+  if (!png_image_write_to_memory(&image, nullptr, &size, 0, pixels.data(), 0, nullptr)) {
+    return Status(Code::kIoError, "%s: PNG encoder: %s", out->path(), image.message);
   }
+  std::vector<uint8_t> png(size);
+  if (!png_image_write_to_memory(&image, png.data(), &size, 0, pixels.data(), 0, nullptr)) {
+    return Status(Code::kIoError, "%s: PNG encoder: %s", out->path(), image.message);
+  }
+  return out->Write(png.data(), size);
+}
+
+Status WriteDisparityPreview(const char* path, ConstImageU16 disp_q8, int32_t min_q8,
+                             int32_t max_q8) {
+  LB_RETURN_IF_ERROR(CheckMap(path, disp_q8));
+  AtomicFile out;
+  LB_RETURN_IF_ERROR(out.Open(path));
+  LB_RETURN_IF_ERROR(EncodeDisparityPreview(&out, disp_q8, min_q8, max_q8));
   return out.Commit();
 }
 

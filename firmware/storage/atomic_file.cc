@@ -9,17 +9,11 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "firmware/storage/errno_text.h"
+#include "firmware/storage/output_target.h"
+#include "firmware/storage/temp_registry.h"
+
 namespace lb {
-namespace {
-
-// strerror with a lower-case first letter, so it reads as the tail of "path: ...".
-void ErrnoText(int err, char* out, size_t size) {
-  snprintf(out, size, "%s", strerror(err));
-  if (out[0] >= 'A' && out[0] <= 'Z' && !(out[1] >= 'A' && out[1] <= 'Z')) out[0] += 'a' - 'A';
-}
-
-}  // namespace
-
 AtomicFile::~AtomicFile() { Abort(); }
 
 Status AtomicFile::Fail(int err, const char* what) {
@@ -67,6 +61,7 @@ Status AtomicFile::Open(const char* final_path) {
   }
   fd_ = fd;
   error_ = 0;
+  registered_ = temp_registry::Add(temp_path_);
   // mkostemp creates 0600; pictures are for everyone to read.
   if (fchmod(fd_, 0644) != 0) {
     const int err = errno;
@@ -115,16 +110,22 @@ Status AtomicFile::Commit() {
   fd_ = -1;
   if (close(fd) != 0) {
     const int err = errno;
-    unlink(temp_path_);
-    temp_path_[0] = '\0';
+    Forget();
     return Fail(err, nullptr);
+  }
+  // The target may have become a device, a FIFO or a link since the run began: a rename would
+  // replace it.
+  const Status kind = CheckTargetKind(final_path_);
+  if (!kind.ok()) {
+    Forget();
+    return kind;
   }
   if (rename(temp_path_, final_path_) != 0) {
     const int err = errno;
-    unlink(temp_path_);
-    temp_path_[0] = '\0';
+    Forget();
     return Fail(err, "rename");
   }
+  Unregister();
   temp_path_[0] = '\0';
   // The rename itself is durable only once the directory is synced.
   const int dir_fd = open(dir_path_, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
@@ -142,11 +143,20 @@ void AtomicFile::Abort() {
     close(fd_);
     fd_ = -1;
   }
-  if (temp_path_[0] != '\0') {
-    unlink(temp_path_);
-    temp_path_[0] = '\0';
-  }
+  if (temp_path_[0] != '\0') Forget();
   error_ = 0;
+}
+
+void AtomicFile::Forget() {
+  // Unlinked before it leaves the registry, so a signal in between finds nothing left.
+  unlink(temp_path_);
+  Unregister();
+  temp_path_[0] = '\0';
+}
+
+void AtomicFile::Unregister() {
+  if (registered_) temp_registry::Remove(temp_path_);
+  registered_ = false;
 }
 
 }  // namespace lb

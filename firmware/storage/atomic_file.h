@@ -1,7 +1,9 @@
 // AtomicFile: writes a file under a hidden temporary name in the destination directory and
 // renames it over the final name only once every byte is on the medium. A failure at any step
 // (missing directory, full card, I/O error, the caller giving up) leaves neither the final name
-// nor the temporary behind.
+// nor the temporary behind, and nor does a signal where the program installed
+// RemoveTemporariesOnSignals (temp_registry.h). The rename never replaces anything but a
+// regular file (output_target.h).
 #pragma once
 
 #include <cstddef>
@@ -38,9 +40,12 @@ class AtomicFile {
 
  private:
   Status Fail(int err, const char* what);
+  void Forget();      // unlinks the temporary and forgets it
+  void Unregister();  // drops it from the signal handler's list (temp_registry.h)
 
   int fd_ = -1;
   int error_ = 0;  // errno of the first failed write, sticky until Abort
+  bool registered_ = false;
   char final_path_[kMaxPath] = {};
   char temp_path_[kMaxPath] = {};
   char dir_path_[kMaxPath] = {};

@@ -294,6 +294,78 @@ TEST_F(Cli, UnwritableOutputDirectory) {
   EXPECT_EQ(Slurp(not_dir).size(), 3u);
 }
 
+// Issue 13, defect 1: a device, a FIFO, a link or an input frame is never written over.
+TEST_F(Cli, OutputOntoSomethingNotARegularFileIsRefusedBeforeWork) {
+  const std::vector<std::string> frames = PpmBurst(3, 64, 48);
+  ASSERT_EQ(mkfifo((out_dir_ + "/fifo.jpg").c_str(), 0644), 0);
+  ASSERT_TRUE(test::WriteFile(dir_ + "/old.jpg", Bytes{9, 9, 9}));
+  ASSERT_EQ(symlink((dir_ + "/old.jpg").c_str(), (out_dir_ + "/link.jpg").c_str()), 0);
+  const std::string frame0 = Slurp(frames[0]);
+  struct Case {
+    std::string out, says;
+  };
+  for (const Case& c :
+       {Case{"/dev/null", "not a regular file"}, Case{out_dir_ + "/fifo.jpg", "not a regular file"},
+        Case{out_dir_ + "/link.jpg", "symbolic link"},
+        Case{frames[0], "is an input of this run"}}) {
+    std::vector<std::string> args = {"run", "--geometry", "rectified", "--out", c.out};
+    args.insert(args.end(), frames.begin(), frames.end());
+    const Result r = Run(args);
+    EXPECT_EQ(r.exit_code, 1) << c.out << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << r.err;
+  }
+  struct stat st;
+  ASSERT_EQ(stat("/dev/null", &st), 0);
+  EXPECT_TRUE(S_ISCHR(st.st_mode)) << "/dev/null is still the device";
+  ASSERT_EQ(lstat((out_dir_ + "/fifo.jpg").c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+  ASSERT_EQ(lstat((out_dir_ + "/link.jpg").c_str(), &st), 0);
+  EXPECT_TRUE(S_ISLNK(st.st_mode));
+  EXPECT_EQ(Slurp(dir_ + "/old.jpg"), std::string(3, 9));
+  EXPECT_EQ(Slurp(frames[0]), frame0) << "the input frame is untouched";
+}
+
+// Issue 13, defect 4: `refocus depth` writes the way every output is written.
+TEST_F(Cli, DepthOutputsFollowTheFileRule) {
+  const std::vector<std::string> frames = PpmBurst(3, 64, 48);
+  std::vector<std::string> args = {
+      "depth",           "--geometry",        "rectified", "--labels",          "8",
+      "--disparity-out", out_dir_ + "/d.pfm", "--preview", out_dir_ + "/d.pfm", "--views"};
+  args.insert(args.end(), frames.begin(), frames.end());
+  // One file for both outputs: a usage error, nothing written.
+  EXPECT_EQ(Run(args).exit_code, 2);
+  EXPECT_TRUE(OutDirEmpty());
+  // A user's file named like the old fixed temporary survives, and no temporary is left.
+  ASSERT_TRUE(test::WriteFile(out_dir_ + "/d.pfm.tmp", Bytes{1, 2}));
+  args[8] = out_dir_ + "/p.png";
+  Result r = Run(args);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(Slurp(out_dir_ + "/d.pfm.tmp").size(), 2u);
+  EXPECT_EQ(Slurp(out_dir_ + "/d.pfm").rfind("Pf\n64 48\n", 0), 0u);
+  EXPECT_EQ(Slurp(out_dir_ + "/p.png").substr(1, 3), "PNG");
+  // A preview that cannot be written: exit 1 before any work, and no PFM either.
+  ASSERT_EQ(mkfifo((out_dir_ + "/fifo.png").c_str(), 0644), 0);
+  args[6] = out_dir_ + "/e.pfm";
+  args[8] = out_dir_ + "/fifo.png";
+  r = Run(args);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_EQ(Slurp(out_dir_ + "/e.pfm"), "");
+  // An output folder that does not exist is found before the computation.
+  args[6] = dir_ + "/nowhere/d.pfm";
+  args[8] = out_dir_ + "/q.png";
+  r = Run(args);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find(dir_ + "/nowhere"), std::string::npos) << r.err;
+  EXPECT_EQ(Slurp(out_dir_ + "/q.png"), "");
+  DIR* d = opendir(out_dir_.c_str());
+  while (dirent* e = readdir(d)) {
+    const std::string n = e->d_name;
+    EXPECT_TRUE(n == "." || n == ".." || n[0] != '.') << "temporary left: " << n;
+  }
+  closedir(d);
+}
+
 TEST_F(Cli, UsageErrorsExitWithTwo) {
   EXPECT_EQ(Run({"run", "--synthetic"}).exit_code, 2);  // no --out
   EXPECT_EQ(Run({"run", "--f-number", "fast", "--out", Out()}).exit_code, 2);

@@ -111,8 +111,9 @@ TEST(RefocusdProcessTest, KilledAtRandomMomentsLeavesWholePhotosOrNothing) {
   ASSERT_EQ(d.Wait(kPhotoMs), 0) << d.log();
 
   std::mt19937 rng(20261123);
-  // Half the kills anywhere in the photo, half in its last third (rendering into the file).
-  std::uniform_real_distribution<double> anywhere(0.0, 1.2), late(0.66, 1.05);
+  // Half the kills anywhere in the photo, half while it is written into its temporary (created
+  // only once the depth is done, so late in the photo).
+  std::uniform_real_distribution<double> anywhere(0.0, 1.2), late(0.8, 1.02);
   constexpr int kTrials = 50;
   int leftovers_seen = 0, removed_reported = 0;
   for (int trial = 0; trial < kTrials; ++trial) {
@@ -130,8 +131,19 @@ TEST(RefocusdProcessTest, KilledAtRandomMomentsLeavesWholePhotosOrNothing) {
           d.Count("output: removed " + std::to_string(temps.size()) + " unfinished");
     }
     d.Press();
-    const double f = trial % 2 ? late(rng) : anywhere(rng);
-    usleep(static_cast<useconds_t>(f * photo_us));
+    double f = anywhere(rng);
+    if (trial % 2 == 0) {
+      usleep(static_cast<useconds_t>(f * photo_us));
+    } else {
+      // The other half while the photo is being written: as soon as its temporary shows, or
+      // after a random moment of its last fifth if it never showed in time.
+      f = late(rng);
+      std::vector<std::string> seen_photos, seen_temps;
+      for (int waited = 0; waited < f * photo_us && seen_temps.empty(); waited += 100) {
+        usleep(100);
+        ListPhotos(d.out_dir(), &seen_photos, &seen_temps);
+      }
+    }
     d.Signal(SIGKILL);
     ASSERT_EQ(d.Wait(kPhotoMs), 128 + SIGKILL);
     ListPhotos(d.out_dir(), &photos, &temps);
