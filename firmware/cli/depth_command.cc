@@ -46,6 +46,11 @@ const char kUsage[] =
     "  --subpixel             write the sub-label refinement the renderer uses (default: the\n"
     "                         labels' disparities, which score best against whole-pixel truth)\n";
 
+// refocus depth works at the views' full size: views x pixels x (3 bytes of view, about 40 of
+// the stage's arena). 2 megapixels keeps 16 views within about 1.5 GB and a typical 5-view
+// burst of them within 0.5 GB.
+constexpr int64_t kMaxDepthPixels = int64_t{2} << 20;
+
 int Usage(const char* problem) {
   if (problem) fprintf(stderr, "refocus depth: %s\n", problem);
   const DepthConfig defaults;
@@ -182,24 +187,45 @@ int DepthCommand(int argc, char** argv) {
       a.st_ino == b.st_ino) {
     return Usage("--preview and --disparity-out name one file");
   }
+  // Every header first: sizes are checked before a single pixel buffer exists, so a small
+  // file that claims a huge image costs nothing.
+  for (size_t v = 0; v < files.size(); ++v) {
+    ImageFileInfo info;
+    const Status probe = ProbeImageFile(files[v], &info);
+    if (!probe.ok()) return Fail(probe.message());
+    if (v == 0) {
+      c.width = info.width;
+      c.height = info.height;
+    } else if (info.width != c.width || info.height != c.height) {
+      char msg[512];
+      snprintf(msg, sizeof(msg), "%s is %dx%d, but %s is %dx%d: the views must match", files[v],
+               info.width, info.height, files[0], c.width, c.height);
+      return Fail(msg);
+    }
+  }
+  if (int64_t{c.width} * c.height > kMaxDepthPixels) {
+    char msg[512];
+    snprintf(msg, sizeof(msg),
+             "%s: %dx%d views are more than refocus depth works on (%lld pixels, it works at "
+             "full size): scale them down, or use refocus run, which works on a smaller copy",
+             files[0], c.width, c.height, static_cast<long long>(kMaxDepthPixels));
+    return Fail(msg);
+  }
+  if (geometry == Geometry::kAuto) c.geometry = DepthGeometry::kPlanes;
+  const Status valid = DepthStage::Validate(c);
+  if (!valid.ok()) return Fail(valid.message());
   std::vector<std::vector<uint8_t>> pixels(files.size());
   for (size_t v = 0; v < files.size(); ++v) {
     int32_t w = 0, h = 0;
     const Status read = ReadRgb(files[v], &w, &h, &pixels[v]);
     if (!read.ok()) return Fail(read.message());
-    if (v == 0) {
-      c.width = w;
-      c.height = h;
-    } else if (w != c.width || h != c.height) {
+    if (w != c.width || h != c.height) {
       char msg[512];
-      snprintf(msg, sizeof(msg), "%s is %dx%d, but %s is %dx%d: the views must match", files[v], w,
-               h, files[0], c.width, c.height);
+      snprintf(msg, sizeof(msg), "%s: the header said %dx%d, the pixels are %dx%d", files[v],
+               c.width, c.height, w, h);
       return Fail(msg);
     }
   }
-  if (geometry == Geometry::kAuto) c.geometry = DepthGeometry::kPlanes;
-  const Status valid = DepthStage::Validate(c);
-  if (!valid.ok()) return Fail(valid.message());
 
   const size_t bytes = DepthStage::RequiredBytes(c);
   std::vector<uint8_t> memory(bytes + Arena::kAlign);

@@ -1,9 +1,11 @@
 // `refocus run` as a user meets it: every bad input gives one line on stderr that names the file
 // and the problem, a non-zero exit, and nothing under the output name (nor a stray temporary).
 #include <dirent.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <zlib.h>
 
 #include <gtest/gtest.h>
 
@@ -364,6 +366,75 @@ TEST_F(Cli, DepthOutputsFollowTheFileRule) {
     EXPECT_TRUE(n == "." || n == ".." || n[0] != '.') << "temporary left: " << n;
   }
   closedir(d);
+}
+
+// A valid PNG of width x height all-zero RGB pixels, streamed through zlib: 16384 x 16384 is
+// about 0.8 MB of file for 0.8 GB of pixels.
+Bytes ZeroPng(uint32_t width, uint32_t height) {
+  Bytes out = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  auto chunk = [&out](const char* type, const Bytes& data) {
+    for (int s = 24; s >= 0; s -= 8) out.push_back(static_cast<uint8_t>(data.size() >> s));
+    const size_t at = out.size();
+    out.insert(out.end(), type, type + 4);
+    out.insert(out.end(), data.begin(), data.end());
+    const uLong crc = crc32(0, out.data() + at, static_cast<uInt>(out.size() - at));
+    for (int s = 24; s >= 0; s -= 8) out.push_back(static_cast<uint8_t>(crc >> s));
+  };
+  Bytes ihdr;
+  for (uint32_t v : {width, height})
+    for (int s = 24; s >= 0; s -= 8) ihdr.push_back(static_cast<uint8_t>(v >> s));
+  ihdr.insert(ihdr.end(), {8, 2, 0, 0, 0});
+  chunk("IHDR", ihdr);
+  z_stream z = {};
+  deflateInit(&z, 9);
+  const Bytes row(1 + static_cast<size_t>(width) * 3, 0);
+  Bytes idat, buf(1 << 16);
+  for (uint32_t y = 0; y < height; ++y) {
+    z.next_in = const_cast<Bytef*>(row.data());
+    z.avail_in = static_cast<uInt>(row.size());
+    const int flush = y + 1 == height ? Z_FINISH : Z_NO_FLUSH;
+    do {
+      z.next_out = buf.data();
+      z.avail_out = static_cast<uInt>(buf.size());
+      deflate(&z, flush);
+      idat.insert(idat.end(), buf.data(), buf.data() + (buf.size() - z.avail_out));
+    } while (z.avail_out == 0);
+  }
+  deflateEnd(&z);
+  chunk("IDAT", idat);
+  chunk("IEND", {});
+  return out;
+}
+
+// Issue 13, defect 3: a small file that claims a huge image is refused from its header, the
+// file named, in little memory.
+TEST_F(Cli, HugeViewsAreRefusedFromTheirHeaders) {
+  const std::string big = dir_ + "/zero.png";
+  ASSERT_TRUE(test::WriteFile(big, ZeroPng(16384, 16384)));
+  std::vector<std::string> args = {"depth", "--disparity-out", out_dir_ + "/d.pfm", "--views"};
+  for (int v = 0; v < 16; ++v) args.push_back(big);
+  const pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    if (!freopen((dir_ + "/stderr").c_str(), "w", stderr)) _exit(126);
+    std::vector<char*> argv = {const_cast<char*>(REFOCUS_BIN)};
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv(REFOCUS_BIN, argv.data());
+    _exit(127);
+  }
+  int status = 0;
+  rusage usage = {};
+  ASSERT_EQ(wait4(pid, &status, 0, &usage), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  const std::string err = Slurp(dir_ + "/stderr");
+  EXPECT_NE(err.find(big), std::string::npos) << err;
+  EXPECT_NE(err.find("16384x16384"), std::string::npos) << err;
+  EXPECT_LT(usage.ru_maxrss, 64 * 1024) << "peak RSS in KiB";
+  printf("16 views of a %zu-byte 16384x16384 PNG: refused at %ld KiB peak RSS\n", Slurp(big).size(),
+         usage.ru_maxrss);
+  EXPECT_TRUE(OutDirEmpty());
 }
 
 TEST_F(Cli, UsageErrorsExitWithTwo) {
