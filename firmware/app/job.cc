@@ -45,7 +45,12 @@ Status Job::Configure(Sensor* sensor, const JobOptions& options) {
     mode_.focal_px = FocalPxFrom35mm(options.focal_35mm, mode_.width, mode_.height);
   }
   if (pc.focal_px == 0) pc.focal_px = mode_.focal_px;
-  if (pc.reference < 0 || pc.reference >= pc.frames) pc.reference = pc.frames / 2;
+  if (pc.reference >= pc.frames) {
+    return Status(Code::kInvalidArgument,
+                  "reference frame %d is past the burst's %d frames (0..%d)", pc.reference,
+                  pc.frames, pc.frames - 1);
+  }
+  if (pc.reference < 0) pc.reference = pc.frames / 2;
   size_t bytes = 0;
   LB_RETURN_IF_ERROR(Pipeline::RequiredBytes(pc, &bytes));
   if (bytes != arena_bytes_) {

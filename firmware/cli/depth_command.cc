@@ -52,10 +52,14 @@ const char kUsage[] =
 constexpr int64_t kMaxDepthPixels = int64_t{2} << 20;
 
 int Usage(const char* problem) {
-  if (problem) fprintf(stderr, "refocus depth: %s\n", problem);
-  const DepthConfig defaults;
-  fprintf(stderr, kUsage, defaults.smooth_weight, defaults.max_cycles);
+  fprintf(stderr, "refocus depth: %s ('refocus depth --help' lists the options)\n", problem);
   return 2;
+}
+
+int Help() {
+  const DepthConfig defaults;
+  printf(kUsage, defaults.smooth_weight, defaults.max_cycles);
+  return 0;
 }
 
 // Reads an image file of any supported format as tightly packed RGB8.
@@ -138,7 +142,7 @@ int DepthCommand(int argc, char** argv) {
       c.subpixel = true;
       continue;
     } else if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-      return Usage(nullptr);
+      return Help();
     } else if (!strcmp(a, "--disparity-out")) {
       ok = need() && (pfm = argv[++i]);
     } else if (!strcmp(a, "--preview")) {

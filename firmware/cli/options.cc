@@ -7,6 +7,8 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "firmware/app/size_text.h"
+
 namespace lb::cli {
 namespace {
 
@@ -133,14 +135,10 @@ bool ParseGeometry(const char* text, Geometry* out, std::string* error) {
 }
 
 bool ParseSize(const char* text, int32_t* width, int32_t* height, std::string* error) {
-  int w = 0, h = 0;
-  char tail = 0;
-  if (sscanf(text, "%dx%d%c", &w, &h, &tail) != 2 || w < 16 || h < 16 || w > 8192 || h > 8192) {
+  if (!ParseSizeText(text, 16, 8192, width, height)) {
     *error = Printf("size '%s' is not WxH between 16x16 and 8192x8192", text);
     return false;
   }
-  *width = w;
-  *height = h;
   return true;
 }
 

@@ -22,7 +22,8 @@ const char kUsage[] =
 enum Opt { kOut = 256, kHelp };
 
 int Usage(const std::string& error) {
-  fprintf(stderr, "refocus rerender: %s\n\n%s%s", error.c_str(), kUsage, kLensUsage);
+  fprintf(stderr, "refocus rerender: %s ('refocus rerender --help' lists the options)\n",
+          error.c_str());
   return 2;
 }
 
@@ -36,7 +37,8 @@ int RerenderCommand(int argc, char** argv) {
   LensOptions lens;
   std::string out_path, error;
   optind = 1;
-  for (int c; (c = getopt_long(argc, argv, "", options.data(), nullptr)) != -1;) {
+  opterr = 0;  // the messages below say it in one line
+  for (int c; (c = getopt_long(argc, argv, ":", options.data(), nullptr)) != -1;) {
     bool ok = true;
     switch (c) {
       case kOut:
@@ -45,8 +47,10 @@ int RerenderCommand(int argc, char** argv) {
       case kHelp:
         printf("%s%s", kUsage, kLensUsage);
         return 0;
+      case ':':
+        return Usage(std::string(argv[optind - 1]) + " needs a value");
       case '?':
-        return Usage("unknown option");
+        return Usage(std::string("unknown option '") + argv[optind - 1] + "'");
       default:
         ok = ParseLensOption(c, optarg, &lens, &error);
     }

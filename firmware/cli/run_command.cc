@@ -61,7 +61,7 @@ enum Opt {
 };
 
 int Usage(const std::string& error) {
-  fprintf(stderr, "refocus run: %s\n\n%s%s", error.c_str(), kUsage, kLensUsage);
+  fprintf(stderr, "refocus run: %s ('refocus run --help' lists the options)\n", error.c_str());
   return 2;
 }
 
@@ -74,6 +74,7 @@ int RunCommand(int argc, char** argv) {
   job.pipeline.reference = -1;  // the middle frame
   std::string input_dir, out_path, error;
   bool synthetic = false, range_given = false;
+  const char* synthetic_only = nullptr;  // the last option that only the synthetic scene takes
   const char* motion = nullptr;
   job.pipeline.geometry = Geometry::kAuto;
   SceneParams scene;
@@ -97,20 +98,25 @@ int RunCommand(int argc, char** argv) {
   });
   LensOptions lens;
   optind = 1;
-  for (int c; (c = getopt_long(argc, argv, "", options.data(), nullptr)) != -1;) {
+  opterr = 0;  // the messages below say it in one line
+  for (int c; (c = getopt_long(argc, argv, ":", options.data(), nullptr)) != -1;) {
     bool ok = true;
     switch (c) {
       case kSynthetic:
         synthetic = true;
         break;
       case kInput:
+        ok = input_dir.empty();
+        if (!ok) error = "--input given twice";
         input_dir = optarg;
         break;
       case kSize:
         ok = ParseSize(optarg, &job.sensor.width, &job.sensor.height, &error);
+        synthetic_only = "--size";
         break;
       case kFrames:
         ok = ParseInt(optarg, 1, 16, &job.sensor.frames, &error);
+        synthetic_only = "--frames";
         break;
       case kSeed:
         ok = ParseInt(optarg, 0, INT32_MAX, &seed, &error);
@@ -142,13 +148,17 @@ int RunCommand(int argc, char** argv) {
                        &error);
         break;
       case kOut:
+        ok = out_path.empty();
+        if (!ok) error = "--out given twice";
         out_path = optarg;
         break;
       case kHelp:
         printf("%s%s", kUsage, kLensUsage);
         return 0;
+      case ':':
+        return Usage(std::string(argv[optind - 1]) + " needs a value");
       case '?':
-        return Usage("unknown option");
+        return Usage(std::string("unknown option '") + argv[optind - 1] + "'");
       default:
         ok = ParseLensOption(c, optarg, &lens, &error);
     }
@@ -161,6 +171,10 @@ int RunCommand(int argc, char** argv) {
   if (out_path.empty()) return Usage("--out OUT.jpg is required");
   if (synthetic + !input_dir.empty() + !files.empty() > 1) {
     return Usage("give one input: --synthetic, --input DIR or FILE...");
+  }
+  if (synthetic_only && (!input_dir.empty() || !files.empty())) {
+    return Usage(std::string(synthetic_only) +
+                 " is for the synthetic scene: files bring their own size and count");
   }
 
   std::unique_ptr<Sensor> sensor;

@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "firmware/app/size_text.h"
+
 namespace lb {
 namespace {
 
@@ -57,13 +59,9 @@ bool Float(const char* v, float lo, float hi, float* out, Why* why) {
 }
 
 bool Size(const char* v, int32_t* w, int32_t* h, Why* why) {
-  int a = 0, b = 0;
-  char tail = 0;
-  if (sscanf(v, "%dx%d%c", &a, &b, &tail) != 2 || a < 16 || b < 16 || a > 8192 || b > 8192) {
+  if (!ParseSizeText(v, 16, 8192, w, h)) {
     return Fail(why, "'%s' is not WxH between 16x16 and 8192x8192", v);
   }
-  *w = a;
-  *h = b;
   return true;
 }
 

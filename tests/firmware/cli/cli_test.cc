@@ -437,6 +437,43 @@ TEST_F(Cli, HugeViewsAreRefusedFromTheirHeaders) {
   EXPECT_TRUE(OutDirEmpty());
 }
 
+// Issue 13, defects 6 and 7: no value is changed or ignored without a word, and a usage error
+// is one line that says what was wrong.
+TEST_F(Cli, NothingIsSilentlyChangedOrIgnored) {
+  const std::vector<std::string> frames = PpmBurst(5, 64, 48);
+  auto run = [&](std::vector<std::string> args, bool with_frames) {
+    if (with_frames) args.insert(args.end(), frames.begin(), frames.end());
+    return Run(args);
+  };
+  struct Case {
+    std::vector<std::string> args;
+    bool with_frames;
+    int exit_code;
+    std::string says;
+  };
+  const std::string out = Out();
+  for (const Case& c : std::vector<Case>{
+           {{"run", "--ref", "7", "--out", out}, true, 1, "reference frame 7 is past"},
+           {{"run", "--size", "4294967616x240", "--out", out}, false, 2, "4294967616x240"},
+           {{"run", "--size", "320x240", "--out", out}, true, 2, "--size is for the synthetic"},
+           {{"run", "--frames", "3", "--out", out}, true, 2, "--frames is for the synthetic"},
+           {{"run", "--out", out, "--out", out + "2"}, false, 2, "--out given twice"},
+           {{"run", "--synthetic", "--out"}, false, 2, "--out needs a value"},
+           {{"run", "--bogus", "--out", out}, false, 2, "unknown option '--bogus'"},
+       }) {
+    const Result r = run(c.args, c.with_frames);
+    EXPECT_EQ(r.exit_code, c.exit_code) << c.args[1] << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << r.err;
+  }
+  EXPECT_TRUE(OutDirEmpty());
+  // Help is asked for: on stdout, exit 0.
+  const Result help = Run({"depth", "--help"});
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.out.find("usage: refocus depth"), std::string::npos);
+  EXPECT_EQ(help.err, "");
+}
+
 TEST_F(Cli, UsageErrorsExitWithTwo) {
   EXPECT_EQ(Run({"run", "--synthetic"}).exit_code, 2);  // no --out
   EXPECT_EQ(Run({"run", "--f-number", "fast", "--out", Out()}).exit_code, 2);
