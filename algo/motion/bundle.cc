@@ -11,15 +11,16 @@ using Mat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
 
 Mat3 Rot(const ViewMotion& m) { return Eigen::Map<const Mat3>(&m.rotation[0][0]); }
 
-// Undistorted normalised coordinates of a distorted observation p: p (1 + k1 |p|^2).
-Eigen::Vector2d Undistort(const double* p, double k1) {
-  return Eigen::Vector2d(p[0], p[1]) * UndistortScale(k1, p[0], p[1]);
+// Undistorted normalised coordinates of a distorted observation p: p (1 + k0 + k1 |p|^2).
+Eigen::Vector2d Undistort(const double* p, double k1, double k0) {
+  return Eigen::Vector2d(p[0], p[1]) * UndistortScale(k1, p[0], p[1], k0);
 }
 
 // Point on the reference ray of `point` at inverse depth w, in view coordinates (up to scale);
 // rr receives R r.
-Vec3 Ray(const BundleInput& in, const ViewMotion& m, double w, double k1, int32_t point, Vec3* rr) {
-  const Eigen::Vector2d u = Undistort(in.ref_xy + 2 * point, k1);
+Vec3 Ray(const BundleInput& in, const ViewMotion& m, double w, double k1, double k0, int32_t point,
+         Vec3* rr) {
+  const Eigen::Vector2d u = Undistort(in.ref_xy + 2 * point, k1, k0);
   *rr = Rot(m) * Vec3(u[0], u[1], 1.0);
   return *rr + w * Eigen::Map<const Vec3>(m.translation);
 }
@@ -54,9 +55,9 @@ Vec3 AngleVector(const ViewMotion& m) {
   return Vec3(0.5 * (r[2][1] - r[1][2]), 0.5 * (r[0][2] - r[2][0]), 0.5 * (r[1][0] - r[0][1]));
 }
 
-double PriorCost(const BundleInput& in, const ViewMotion* motion, double k1) {
-  const double reach = k1 * in.k1_reach_px;
-  double cost = 0.5 * in.k1_prior * reach * reach;
+double PriorCost(const BundleInput& in, const ViewMotion* motion, double k1, double k0) {
+  const double reach = k1 * in.k1_reach_px, scale = k0 * in.k0_reach_px;
+  double cost = 0.5 * in.k1_prior * reach * reach + 0.5 * in.k0_prior * scale * scale;
   if (in.rotation_prior > 0) {
     for (int32_t v = 0; v < in.views; ++v) {
       if (v == in.reference) continue;
@@ -76,9 +77,9 @@ Status Bundle::Carve(int32_t max_views, int32_t max_points, Arena& arena) {
   }
   max_views_ = max_views;
   max_points_ = max_points;
-  const size_t nc = 6 * static_cast<size_t>(max_views - 1), nr = nc + 1;
+  const size_t nc = 6 * static_cast<size_t>(max_views - 1), nr = nc + 2;
   hcc_ = arena.Allocate<double>(nc * 6);
-  hck_ = arena.Allocate<double>(nr);
+  hck_ = arena.Allocate<double>(2 * nr);
   g_ = arena.Allocate<double>(nr);
   s_ = arena.Allocate<double>(nr * nr);
   g2_ = arena.Allocate<double>(nr);
@@ -90,27 +91,28 @@ Status Bundle::Carve(int32_t max_views, int32_t max_points, Arena& arena) {
 }
 
 double Bundle::ErrorPx(const BundleInput& in, const ViewMotion& m, double w, double k1,
-                       int32_t view, int32_t point) {
+                       int32_t view, int32_t point, double k0) {
   Vec3 rr;
-  const Vec3 a = Ray(in, m, w, k1, point, &rr);
+  const Vec3 a = Ray(in, m, w, k1, k0, point, &rr);
   // A point behind the view's camera (or at its centre) is no fit of the observation, however
   // its projection happens to fall: with signed inverse depths a step could otherwise flip
   // points through the camera into a fit that wanders off.
   if (!(a[2] > 1e-6 * rr.norm())) return kBehindPx;
-  const Eigen::Vector2d o = Undistort(Obs(in, view, point), k1);
+  const Eigen::Vector2d o = Undistort(Obs(in, view, point), k1, k0);
   const double ex = in.fx * (a[0] / a[2] - o[0]), ey = in.fy * (a[1] / a[2] - o[1]);
-  return __builtin_sqrt(ex * ex + ey * ey);
+  // In px of the focal length the fit holds, fx / (1 + k0): the frames' own pixels.
+  return __builtin_sqrt(ex * ex + ey * ey) / (1 + k0);
 }
 
 double Bundle::Cost(const BundleInput& in, const ViewMotion* motion, const double* w, double k1,
-                    double huber, int32_t* count) const {
+                    double k0, double huber, int32_t* count) const {
   double cost = 0;
   int32_t n = 0;
   for (int32_t j = 0; j < in.points; ++j) {
     if (!in.point_ok[j]) continue;
     for (int32_t v = 0; v < in.views; ++v) {
       if (v == in.reference || !ObsOk(in, v, j)) continue;
-      const double e = ErrorPx(in, motion[v], w[j], k1, v, j);
+      const double e = ErrorPx(in, motion[v], w[j], k1, v, j, k0);
       cost += Huber(e * e, huber);
       ++n;
     }
@@ -120,32 +122,33 @@ double Bundle::Cost(const BundleInput& in, const ViewMotion* motion, const doubl
 }
 
 Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber,
-                     ViewMotion* motion, double* w, double* k1, BundleReport* report) {
+                     ViewMotion* motion, double* w, double* k1, double* k0, BundleReport* report) {
   if (in.views < 2 || in.views > max_views_ || in.points > max_points_ || in.reference < 0 ||
       in.reference >= in.views) {
     return Status(Code::kInvalidArgument, "bundle: %d views, %d points beyond the configuration",
                   in.views, in.points);
   }
   const int32_t nc = 6 * (in.views - 1);
-  // The reduced system: the camera blocks, then k1 when it is estimated.
-  double kd = k1 ? *k1 : 0;
-  const int32_t nr = nc + (k1 ? 1 : 0);
+  // The reduced system: the camera blocks, then k1 and k0 when they are estimated (at i1, i0).
+  double kd = k1 ? *k1 : 0, kz = k0 ? *k0 : 0;
+  const int32_t i1 = nc, i0 = nc + (k1 ? 1 : 0);
+  const int32_t nr = i0 + (k0 ? 1 : 0);
   // Hcc is block diagonal (an observation involves one camera): kept as nc x 6 undamped blocks;
-  // the k1 row of the camera part is hck (nr: its last entry is Hkk).
+  // the lens rows are hck: row 0 for k1, row 1 for k0, each over all nr unknowns.
   Eigen::Map<Eigen::MatrixXd> hcc(hcc_, nc, 6);
-  Eigen::Map<Eigen::VectorXd> hck(hck_, nr);
+  Eigen::Map<Eigen::Matrix<double, 2, Eigen::Dynamic>> hck(hck_, 2, nr);
   Eigen::Map<Eigen::VectorXd> g(g_, nr);
   Eigen::Map<Eigen::MatrixXd> s(s_, nr, nr);
   Eigen::Map<Eigen::VectorXd> g2(g2_, nr);
   // Camera block index of a view (the reference has none).
   auto block = [&](int32_t v) { return 6 * (v < in.reference ? v : v - 1); };
   int32_t count = 0;
-  double cost = Cost(in, motion, w, kd, huber, &count);
+  double cost = Cost(in, motion, w, kd, kz, huber, &count);
   *report = BundleReport{};
   report->observations = count;
   report->initial_rms_px = count ? __builtin_sqrt(2 * cost / count) : 0;
   if (count == 0) return Status(Code::kDegenerate, "bundle: no observations");
-  cost += PriorCost(in, motion, kd);
+  cost += PriorCost(in, motion, kd, kz);
   double lambda = 1e-3;
   const double eps = 1e-12 * in.fx * in.fx;
   ViewMotion trial[kMaxViews];
@@ -166,15 +169,19 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
       for (int32_t v = 0; v < in.views; ++v) {
         if (v == in.reference || !ObsOk(in, v, j)) continue;
         Vec3 rr;
-        const Vec3 a = Ray(in, motion[v], w[j], kd, j, &rr);
+        const Vec3 a = Ray(in, motion[v], w[j], kd, kz, j, &rr);
         const double* od = Obs(in, v, j);
-        const Eigen::Vector2d o = Undistort(od, kd);
+        const Eigen::Vector2d o = Undistort(od, kd, kz);
         const double iz = 1.0 / a[2];
-        const Eigen::Vector2d e(in.fx * (a[0] * iz - o[0]), in.fy * (a[1] * iz - o[1]));
+        // Residuals in px of the focal length the fit holds (ErrorPx): scaled by c, so a focal
+        // length that shrinks every normalised error is no gain in itself.
+        const double c = 1 / (1 + kz);
+        const Eigen::Vector2d e(c * in.fx * (a[0] * iz - o[0]), c * in.fy * (a[1] * iz - o[1]));
         const double en = e.norm();
         const double rw = en <= huber ? 1.0 : huber / en;
         Eigen::Matrix<double, 2, 3> ja;
         ja << in.fx * iz, 0, -in.fx * a[0] * iz * iz, 0, in.fy * iz, -in.fy * a[1] * iz * iz;
+        ja *= c;
         Mat3 skew;  // d(R r)/dd = -[R r]x
         skew << 0, rr[2], -rr[1], -rr[2], 0, rr[0], rr[1], -rr[0], 0;
         Eigen::Matrix<double, 2, 6> jc;
@@ -187,15 +194,28 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
         hcw.segment<6>(b) += rw * jc.transpose() * jw;
         hww_[j] += rw * jw.squaredNorm();
         gw_[j] -= rw * jw.dot(e);
-        if (k1) {
-          // k1 moves the reference ray (R (rd |rd|^2, 0)) and the observation (od |od|^2).
+        if (k1 || k0) {
+          // k1 moves the reference ray (R (rd |rd|^2, 0)) and the observation (od |od|^2), k0
+          // the same without the |.|^2: a focal length a fraction off.
           const double od2 = od[0] * od[0] + od[1] * od[1];
-          const Eigen::Vector2d jk = ja * (Rot(motion[v]) * Vec3(rd[0] * rd2, rd[1] * rd2, 0)) -
-                                     Eigen::Vector2d(in.fx * od[0] * od2, in.fy * od[1] * od2);
-          hck.segment<6>(b) += rw * jc.transpose() * jk;
-          hck[nc] += rw * jk.squaredNorm();
-          g[nc] -= rw * jk.dot(e);
-          hcw[nc] += rw * jk.dot(jw);
+          const Mat3 r = Rot(motion[v]);
+          Eigen::Vector2d jk[2];
+          jk[0] = ja * (r * Vec3(rd[0] * rd2, rd[1] * rd2, 0)) -
+                  c * Eigen::Vector2d(in.fx * od[0] * od2, in.fy * od[1] * od2);
+          // k0 also moves the residual's scale c: d(c E)/dk0 = c dE/dk0 - c e.
+          jk[1] = ja * (r * Vec3(rd[0], rd[1], 0)) -
+                  c * Eigen::Vector2d(in.fx * od[0], in.fy * od[1]) - c * e;
+          const bool on[2] = {k1 != nullptr, k0 != nullptr};
+          const int32_t at[2] = {i1, i0};
+          for (int32_t e1 = 0; e1 < 2; ++e1) {
+            if (!on[e1]) continue;
+            hck.row(e1).segment<6>(b) += rw * (jc.transpose() * jk[e1]).transpose();
+            for (int32_t e2 = 0; e2 < 2; ++e2) {
+              if (on[e2]) hck(e1, at[e2]) += rw * jk[e1].dot(jk[e2]);
+            }
+            g[at[e1]] -= rw * jk[e1].dot(e);
+            hcw[at[e1]] += rw * jk[e1].dot(jw);
+          }
         }
       }
     }
@@ -212,8 +232,13 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
     }
     if (k1 && in.k1_prior > 0) {
       const double pk = in.k1_prior * in.k1_reach_px * in.k1_reach_px;
-      hck[nc] += pk;
-      g[nc] -= pk * kd;
+      hck(0, i1) += pk;
+      g[i1] -= pk * kd;
+    }
+    if (k0 && in.k0_prior > 0) {
+      const double pk = in.k0_prior * in.k0_reach_px * in.k0_reach_px;
+      hck(1, i0) += pk;
+      g[i0] -= pk * kz;
     }
     bool accepted = false;
     for (int32_t tries = 0; tries < 10 && !accepted; ++tries) {
@@ -221,8 +246,12 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
       s.setZero();
       for (int32_t b = 0; b < nc; b += 6) s.block<6, 6>(b, b) = hcc.block<6, 6>(b, 0);
       if (k1) {
-        s.col(nc) = hck;
-        s.row(nc) = hck.transpose();
+        s.col(i1) = hck.row(0).transpose();
+        s.row(i1) = hck.row(0);
+      }
+      if (k0) {
+        s.col(i0) = hck.row(1).transpose();
+        s.row(i0) = hck.row(1);
       }
       for (int32_t k = 0; k < nr; ++k) s(k, k) = s(k, k) * (1 + lambda) + eps;
       g2 = g;
@@ -247,7 +276,8 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
         RotateBy(d, &trial[v]);
         for (int32_t k = 0; k < 3; ++k) trial[v].translation[k] += g2[b + 3 + k];
       }
-      const double k_try = k1 ? kd + g2[nc] : kd;
+      const double k_try = k1 ? kd + g2[i1] : kd;
+      const double z_try = k0 ? kz + g2[i0] : kz;
       double sum = 0, sum_abs = 0;
       int32_t used = 0;
       for (int32_t j = 0; j < in.points; ++j) {
@@ -260,13 +290,14 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
         sum_abs += w_try_[j] < 0 ? -w_try_[j] : w_try_[j];
         ++used;
       }
-      const double new_cost =
-          Cost(in, trial, w_try_, k_try, huber, nullptr) + PriorCost(in, trial, k_try);
+      const double new_cost = Cost(in, trial, w_try_, k_try, z_try, huber, nullptr) +
+                              PriorCost(in, trial, k_try, z_try);
       if (new_cost < cost) {
         accepted = true;
         const double rel = (cost - new_cost) / cost;
         cost = new_cost;
         kd = k_try;
+        kz = z_try;
         lambda = lambda / 3 > 1e-9 ? lambda / 3 : 1e-9;
         // Gauge: mean |inverse depth| 1, and a mean >= 0 (w -> -w, t -> -t leaves every w t, so
         // every pixel, unchanged). Signed: at a narrow field of view a turn across the baseline
@@ -287,8 +318,9 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
     if (!accepted) break;
   }
   if (k1) *k1 = kd;
+  if (k0) *k0 = kz;
   report->iterations = it;
-  report->rms_px = __builtin_sqrt(2 * Cost(in, motion, w, kd, huber, nullptr) / count);
+  report->rms_px = __builtin_sqrt(2 * Cost(in, motion, w, kd, kz, huber, nullptr) / count);
   return Status::Ok();
 }
 

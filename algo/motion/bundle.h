@@ -48,6 +48,10 @@ struct BundleInput {
   // narrow field of view k1 barely moves a pixel and would otherwise run off along the turn.
   double k1_prior = 0;
   double k1_reach_px = 0;
+  // The same for k0, the focal length's error (the normalised points scaled by 1 + k0: the true
+  // focal length is fx / (1 + k0)): 0.5 w (k0 k0_reach_px)^2, k0_reach_px = fx |corner|.
+  double k0_prior = 0;
+  double k0_reach_px = 0;
 };
 
 struct BundleReport {
@@ -64,30 +68,30 @@ class Bundle {
   Status Carve(int32_t max_views, int32_t max_points, Arena& arena);
 
   // Refines `motion` (one per view; the reference's is left the identity), `inv_depth` (one
-  // per point) and the radial distortion `k1` (nullptr: none, held at 0) from their current
-  // values.
+  // per point), the radial distortion `k1` and the focal length's error `k0` (each nullptr:
+  // held at 0) from their current values.
   Status Solve(const BundleInput& in, int32_t max_iterations, double huber_px, ViewMotion* motion,
-               double* inv_depth, double* k1, BundleReport* report);
+               double* inv_depth, double* k1, double* k0, BundleReport* report);
 
   // What ErrorPx says of a point behind the view's camera.
   static constexpr double kBehindPx = 1e6;
   // Reprojection error in px of one observation under the given parameters.
   static double ErrorPx(const BundleInput& in, const ViewMotion& m, double w, double k1,
-                        int32_t view, int32_t point);
+                        int32_t view, int32_t point, double k0 = 0);
 
  private:
   double Cost(const BundleInput& in, const ViewMotion* motion, const double* w, double k1,
-              double huber, int32_t* count) const;
+              double k0, double huber, int32_t* count) const;
 
   int32_t max_views_ = 0, max_points_ = 0;
   double* hcc_ = nullptr;    // camera blocks, 6(V-1) x 6
-  double* hck_ = nullptr;    // k1 row of the camera matrix, 6(V-1) + 1 (the last is Hkk)
-  double* g_ = nullptr;      // camera (and k1) gradient, 6(V-1) + 1
-  double* s_ = nullptr;      // damped reduced camera matrix, (6(V-1) + 1) squared
+  double* hck_ = nullptr;    // the k1 and k0 rows of the reduced matrix, 2 x (6(V-1) + 2)
+  double* g_ = nullptr;      // camera (and k1, k0) gradient, 6(V-1) + 2
+  double* s_ = nullptr;      // damped reduced camera matrix, (6(V-1) + 2) squared
   double* g2_ = nullptr;     // its right-hand side, then the camera step
   double* hww_ = nullptr;    // per point
   double* gw_ = nullptr;     // per point
-  double* hcw_ = nullptr;    // per point: 6(V-1) + 1
+  double* hcw_ = nullptr;    // per point: 6(V-1) + 2
   double* w_try_ = nullptr;  // per point
 };
 

@@ -40,9 +40,11 @@ inline double Focal35mmFromPx(double focal_px, int32_t width, int32_t height) {
   return focal_px / FocalPxFrom35mm(1.0, width, height);
 }
 
-// The lens's radial distortion, one term (bundle.h): a distorted normalised point (x, y) is the
-// pinhole's (x, y) times this.
-inline double UndistortScale(double k1, double x, double y) { return 1 + k1 * (x * x + y * y); }
+// The lens's radial distortion, one term, and the focal length's error k0 (bundle.h): a
+// distorted normalised point (x, y) is the pinhole's (x, y) times this.
+inline double UndistortScale(double k1, double x, double y, double k0 = 0) {
+  return 1 + k0 + k1 * (x * x + y * y);
+}
 
 struct ViewMotion {
   double rotation[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};

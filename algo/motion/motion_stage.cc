@@ -100,9 +100,9 @@ Status MotionStage::Validate(const MotionConfig& c) {
                   "thresholds and blur_percent 0..100 expected");
   }
   if (!(c.rail_off_axis >= 0 && c.rail_off_axis < 1) || !(c.rail_spacing >= 0) ||
-      !(c.rail_rotation_prior >= 0)) {
+      !(c.rail_rotation_prior >= 0) || !(c.k1_prior >= 0) || !(c.focal_prior >= 0)) {
     return Status(Code::kInvalidArgument,
-                  "motion: rail_off_axis 0..1, rail_spacing and rail_rotation_prior >= 0 expected");
+                  "motion: rail_off_axis 0..1, rail_spacing and the priors >= 0 expected");
   }
   return Status::Ok();
 }
@@ -276,6 +276,8 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
   const double corner = __builtin_sqrt(cx * cx + cy * cy);
   in.k1_prior = c.k1_prior;
   in.k1_reach_px = k.fx * corner * corner * corner;
+  in.k0_prior = c.focal_prior;
+  in.k0_reach_px = k.fx * corner;
   BundleReport report;
   // Far frames start from the near ones: from the identity, a frame many steps out (18 px on
   // barn1's ninth view) can send the first adjustment into a wrong minimum. The frames within
@@ -295,7 +297,7 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
     }
     in.obs_ok = near_ok_;
     LB_RETURN_IF_ERROR(bundle_.Solve(in, c.bundle_iterations, c.huber_px, result->motion,
-                                     inv_depth_, nullptr, &report));
+                                     inv_depth_, nullptr, nullptr, &report));
     in.obs_ok = obs_ok_;
     for (int32_t v = 0; v < c.views; ++v) {
       const int32_t d = v > reference ? v - reference : reference - v;
@@ -312,8 +314,9 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
     // free k1 can run off before the rotations have taken their share.
     const bool settled = round > 0 || c.bundle_rounds == 1;
     double* k1 = c.estimate_distortion && settled ? &result->k1 : nullptr;
+    double* k0 = c.estimate_focal && settled ? &result->k0 : nullptr;
     LB_RETURN_IF_ERROR(bundle_.Solve(in, c.bundle_iterations, c.huber_px, result->motion,
-                                     inv_depth_, k1, &report));
+                                     inv_depth_, k1, k0, &report));
     if (round + 1 == c.bundle_rounds) break;
     // Drop the observations the fit cannot explain (mismatched corners, moving things), and
     // points left with none.
@@ -323,7 +326,7 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
       for (int32_t v = 0; v < c.views; ++v) {
         uint8_t& ok = obs_ok_[static_cast<size_t>(v) * n + i];
         if (!ok) continue;
-        if (Bundle::ErrorPx(in, result->motion[v], inv_depth_[i], result->k1, v, i) >
+        if (Bundle::ErrorPx(in, result->motion[v], inv_depth_[i], result->k1, v, i, result->k0) >
             c.outlier_px) {
           ok = 0;
         }
@@ -342,9 +345,14 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
   if (result->rail && c.rail_rotation_prior > 0) {
     in.rotation_prior = c.rail_rotation_prior;
     LB_RETURN_IF_ERROR(bundle_.Solve(in, c.bundle_iterations, c.huber_px, result->motion,
-                                     inv_depth_, &result->k1, &report));
+                                     inv_depth_, &result->k1,
+                                     c.estimate_focal ? &result->k0 : nullptr, &report));
   }
   result->rms_px = report.rms_px;
+  // The poses and inverse depths now live in the normalised coordinates of the focal length the
+  // frames told: fx / (1 + k0).
+  result->intrinsics.fx = k.fx / (1 + result->k0);
+  result->intrinsics.fy = k.fy / (1 + result->k0);
   int32_t m = 0;
   for (int32_t i = 0; i < n; ++i) {
     if (!point_ok_[i]) continue;
@@ -374,7 +382,7 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
       double p[2][3];
       double r[3] = {(out_xy_[2 * j] + 0.5 - k.cx) / k.fx, (out_xy_[2 * j + 1] + 0.5 - k.cy) / k.fy,
                      1.0};
-      const double u = UndistortScale(result->k1, r[0], r[1]);
+      const double u = UndistortScale(result->k1, r[0], r[1], result->k0);
       r[0] *= u;
       r[1] *= u;
       const ViewMotion& mo = result->motion[v];
@@ -385,8 +393,8 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
                     ws[s] * mo.translation[i];
         }
       }
-      const double dx = k.fx * (p[0][0] / p[0][2] - p[1][0] / p[1][2]);
-      const double dy = k.fy * (p[0][1] / p[0][2] - p[1][1] / p[1][2]);
+      const double dx = result->intrinsics.fx * (p[0][0] / p[0][2] - p[1][0] / p[1][2]);
+      const double dy = result->intrinsics.fy * (p[0][1] / p[0][2] - p[1][1] / p[1][2]);
       sorted_[j] = __builtin_sqrt(dx * dx + dy * dy);
     }
     std::sort(sorted_, sorted_ + m);

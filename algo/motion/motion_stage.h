@@ -65,6 +65,12 @@ struct MotionConfig {
   // Weight of the prior that holds k1 near 0 (bundle.h): what k1 does at the frame's corner
   // counts as this many observations.
   double k1_prior = 0.01;
+  // The focal length as an unknown too (k0 in bundle.h), for frames whose lens nobody told
+  // (no EXIF, no configuration: DefaultIntrinsics' guess), held near the guess by this prior
+  // weight (what k0 does at the frame's corner counts as this many observations). At a narrow
+  // field of view the frames cannot tell and the guess stays.
+  bool estimate_focal = false;
+  double focal_prior = 0.001;
   double outlier_px = 0.8;
   double min_parallax_px = 1.0;  // depth-dependent motion the best view must show
   int32_t blur_percent = 55;     // a frame whose sharpness is below this % of the median: blurred
@@ -104,6 +110,9 @@ struct MotionResult {
   // The depth stage's plane homographies leave it out: it moves points by a fraction of a pixel
   // over a burst's baseline.
   double k1 = 0;
+  // The focal length's error the frames showed (estimate_focal): `intrinsics` already holds the
+  // corrected fx / (1 + k0), the one every pose and inverse depth here is in.
+  double k0 = 0;
   bool rail = false;  // the frames lie on a line at equal steps: the rotations were held
   int32_t corners = 0;
 

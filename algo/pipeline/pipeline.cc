@@ -43,6 +43,7 @@ static MotionConfig MakeMotionConfig(const PipelineConfig& c, int32_t w, int32_t
   m.width = w;
   m.height = h;
   m.views = c.frames;
+  m.estimate_focal = !(c.focal_px > 0);  // nobody told the lens: the frames may
   return m;
 }
 

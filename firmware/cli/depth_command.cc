@@ -95,6 +95,7 @@ Status EstimatePlanes(const std::vector<ConstImageU8>& views, double focal_px, b
   mc.width = c->width;
   mc.height = c->height;
   mc.views = c->views;
+  mc.estimate_focal = !(focal_px > 0);  // nobody told the lens: the frames may
   LB_RETURN_IF_ERROR(MotionStage::Validate(mc));
   g->memory.assign(MotionStage::RequiredBytes(mc) + Arena::kAlign, 0);
   void* const base = Arena::AlignUp(g->memory.data());

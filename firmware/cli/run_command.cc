@@ -240,10 +240,12 @@ int RunCommand(int argc, char** argv) {
   const Pipeline& p = runner.pipeline();
   if (job.pipeline.geometry == Geometry::kAuto && report.warning.ok()) {
     printf(
-        "motion: %d points followed (reprojection %.2f px)%s, depth labels %.2f..%.2f px per "
-        "frame\n",
+        "motion: %d points followed (reprojection %.2f px)%s, focal length %.0f px%s, depth "
+        "labels %.2f..%.2f px per frame\n",
         p.motion().points, p.motion().rms_px,
         p.motion().rail ? ", on a rail (orientation held, lens k1 fitted)" : "",
+        p.motion().intrinsics.fx * p.working_scale(),
+        job.pipeline.focal_px > 0 || runner.mode().focal_px > 0 ? "" : " (found from the frames)",
         p.depth().config().disp_min_q8 / 256.0, p.depth().config().disp_max_q8 / 256.0);
   }
   return 0;

@@ -123,6 +123,7 @@ Status AutoDepth(const hci::Burst& b, double focal_35mm, std::vector<float>* out
   mc.width = b.width;
   mc.height = b.height;
   mc.views = static_cast<int32_t>(views.size());
+  mc.estimate_focal = !(focal_35mm > 0);  // as the product does when nothing told the lens
   Memory motion_memory;
   Arena motion_arena = motion_memory.Make(MotionStage::RequiredBytes(mc));
   MotionStage motion;
@@ -180,10 +181,10 @@ TEST_P(Antinous, AutoGeometryIsWithinOneAndAHalfOfTheKnownGeometry) {
   const double auto_bad = hci::FittedBadPixPercent(b, est, kThreshold, kBorder, &ea, &ec);
   printf(
       "antinous %s, %s: auto BadPix0.3 %.2f %% (fit %.3f x + %.3f; %d points, rms %.3f px, rail "
-      "%d, k1 %.3f%s), known geometry %.2f %% (fit %.3f x + %.3f)\n",
+      "%d, k1 %.3f, f %.0f px%s), known geometry %.2f %% (fit %.3f x + %.3f)\n",
       hci::LayoutName(k.layout), k.focal_35mm > 0 ? "--focal-35mm 103" : "default lens", auto_bad,
-      ea, ec, m.points, m.rms_px, m.rail, m.k1, reversed ? ", turned round by the occlusions" : "",
-      known_bad, a, c);
+      ea, ec, m.points, m.rms_px, m.rail, m.k1, m.intrinsics.fx,
+      reversed ? ", turned round by the occlusions" : "", known_bad, a, c);
   EXPECT_LE(auto_bad, 1.5 * known_bad);
   // Near is near: the fit needs no mirror (depth_order.h).
   EXPECT_GT(ea, 0);
