@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <vector>
@@ -85,6 +86,41 @@ TEST(MotionAccuracy, PointSampledBurstsOverSeeds) {
   EXPECT_LT(Percentile(f.rot, 1.0), 0.05);
   EXPECT_LT(Percentile(f.dir, 0.5), 2.0);
   EXPECT_LT(Percentile(f.dir, 0.9), 3.0);
+}
+
+// A lens nobody told: the frames of a wide handheld burst show the focal length; where they show
+// less (a narrow view) the estimate must not wander further off than the guess.
+TEST(MotionAccuracy, TheFramesTellTheFocalLengthWhereTheyCan) {
+  for (const double fov : {65.0, 25.0}) {
+    SceneParams params = motiontest::Handheld(11);
+    params.fov_deg = fov;
+    params.max_translation = 0.01 * std::tan(fov * M_PI / 360) / std::tan(32.5 * M_PI / 180);
+    motiontest::Burst b;
+    ASSERT_TRUE(motiontest::MakeBurst(params, 640, 480, 7, &b, 4));
+    const double truth = b.intrinsics.fx;
+    for (const double told : {1.25, 0.8}) {
+      b.intrinsics.fx = b.intrinsics.fy = truth * told;
+      MotionConfig config;
+      config.width = b.width;
+      config.height = b.height;
+      config.views = b.scene.views();
+      config.estimate_focal = true;
+      std::vector<uint8_t> memory(MotionStage::RequiredBytes(config));
+      Arena arena(memory.data(), memory.size());
+      MotionStage stage;
+      ASSERT_TRUE(stage.Configure(config, arena).ok());
+      MotionResult r;
+      const Status st = stage.Estimate(b.views.data(), b.scene.reference(), b.intrinsics, &r);
+      ASSERT_TRUE(st.ok()) << st.message();
+      const double found = r.intrinsics.fx / truth;
+      printf("%.0f degrees, told %.2fx: found %.3fx the true focal length\n", fov, told, found);
+      // Never further from the truth than the guess, and close to it where the view is wide.
+      EXPECT_LE(std::fabs(found - 1), std::fabs(told - 1) + 0.02) << fov << " told " << told;
+      if (fov > 40) {
+        EXPECT_NEAR(found, 1.0, 0.1) << "told " << told;
+      }
+    }
+  }
 }
 
 }  // namespace
