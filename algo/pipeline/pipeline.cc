@@ -65,10 +65,13 @@ Status Pipeline::RequiredBytes(const PipelineConfig& c, size_t* bytes) {
     return Status(Code::kInvalidArgument, "frame size %dx%d outside 16x16 .. %dx%d", c.width,
                   c.height, PipelineConfig::kMaxWidth, PipelineConfig::kMaxHeight);
   }
-  if (c.frames < 2 || c.frames > PipelineConfig::kMaxFrames) {
-    return Status(Code::kInvalidArgument,
-                  "a burst of %d frame%s: depth needs at least 2 views (at most %d)", c.frames,
-                  c.frames == 1 ? "" : "s", PipelineConfig::kMaxFrames);
+  if (c.frames < 2) {
+    return Status(Code::kInvalidArgument, "a burst of %d frame%s: depth needs at least 2", c.frames,
+                  c.frames == 1 ? "" : "s");
+  }
+  if (c.frames > PipelineConfig::kMaxFrames) {
+    return Status(Code::kInvalidArgument, "a burst of %d frames: at most %d are used", c.frames,
+                  PipelineConfig::kMaxFrames);
   }
   if (c.max_working_width < 8 || c.max_working_height < 8) {
     return Status(Code::kInvalidArgument, "working size bound %dx%d is below 8x8",

@@ -15,7 +15,7 @@ const char kUsage[] =
     "Commands:\n"
     "  run        burst (files, a folder or the synthetic scene) -> refocused JPEG\n"
 #ifdef LB_HAVE_DEPTH_COMMAND
-    "  depth      rectified views -> disparity map (PFM) and a preview\n"
+    "  depth      views (auto or rectified geometry) -> disparity map (PFM) and a preview\n"
 #endif
 #ifdef LB_HAVE_RERENDER_COMMAND
     "  rerender   refocusable JPEG -> the same photo with a new focus\n"

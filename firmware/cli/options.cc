@@ -159,7 +159,7 @@ enum LensId {
 const char kLensUsage[] =
     "Lens:\n"
     "  --focus X,Y[,W,H]      point or rectangle to keep sharp (default: the centre)\n"
-    "  --f-number N           aperture as on a lens, 1.4 .. 16 (default 2.8)\n"
+    "  --f-number N           aperture as on a lens, 1 .. 22 (default 2.8)\n"
     "  --aperture SHAPE       disc (default), or N-blade for a polygonal iris (3..12)\n"
     "  --rotation DEG         rotation of the polygonal iris\n"
     "  --curvature C          blade curvature, 0 (straight) .. 1 (round)\n"

@@ -24,7 +24,7 @@ const char kUsage[] =
     "  --synthetic            the built-in synthetic scene (a clone carries no photos)\n"
     "  --input DIR            every .ppm .pgm .png .jpg in DIR, sorted by name, as the burst\n"
     "  FILE...                these files, left to right, as the burst\n"
-    "  --size WxH             synthetic frame size (default 1280x960, up to 4056x3040)\n"
+    "  --size WxH             synthetic frame size (default 1280x960, 16x16 .. 8192x8192)\n"
     "  --frames N             synthetic burst length (default 5)\n"
     "  --seed S               synthetic scene seed (default 1)\n"
     "  --motion M             synthetic camera motion: handheld or rectified (default: handheld\n"

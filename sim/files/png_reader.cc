@@ -66,7 +66,9 @@ Status PngReader::Run() {
       return Status(Code::kCorruptData, "%s: truncated: PNG data ends after %" PRIu64 " bytes",
                     name, src_.consumed());
     }
-    return Status(Code::kCorruptData, "%s: PNG %s", name, message_);
+    // libpng's own messages often start with "PNG" already.
+    const bool named = strncmp(message_, "PNG ", 4) == 0;
+    return Status(Code::kCorruptData, "%s: %s%s", name, named ? "" : "PNG ", message_);
   }
   // Decode() may longjmp back here: it keeps only trivially destructible locals.
   return Decode();

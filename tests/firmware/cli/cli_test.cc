@@ -474,6 +474,40 @@ TEST_F(Cli, NothingIsSilentlyChangedOrIgnored) {
   EXPECT_EQ(help.err, "");
 }
 
+// Issue 13, defects 7 and 8: the help and the code agree on the ranges, and libpng's own
+// "PNG ..." messages are not prefixed twice.
+TEST_F(Cli, HelpAndBehaviourAgree) {
+  const Result help = Run({"run", "--help"});
+  ASSERT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.out.find("1 .. 22"), std::string::npos) << help.out;
+  EXPECT_NE(help.out.find("16x16 .. 8192x8192"), std::string::npos) << help.out;
+  for (const char* f : {"1", "22"}) {
+    const Result r = Run({"run", "--size", "64x48", "--f-number", f, "--out", Out()});
+    EXPECT_EQ(r.exit_code, 0) << f << ": " << r.err;
+  }
+  EXPECT_EQ(Run({"run", "--f-number", "23", "--out", Out()}).exit_code, 2);
+  EXPECT_EQ(Run({"run", "--f-number", "0.9", "--out", Out()}).exit_code, 2);
+  const Result top = Run({"--help"});
+  EXPECT_EQ(top.out.find("rectified views"), std::string::npos) << top.out;
+
+  auto paths = PpmBurst(2, 64, 48);
+  test::PngSpec spec;
+  spec.width = 64;
+  spec.height = 48;
+  spec.rows.resize(64 * 48 * 3, 90);
+  Bytes png;
+  ASSERT_TRUE(test::EncodePng(spec, &png));
+  png[16] = 0x80;  // IHDR width 2^31 + 64: libpng says "PNG unsigned integer out of range"
+  const uLong crc = crc32(0, png.data() + 12, 17);  // IHDR's type and data, CRC after them
+  for (int k = 0; k < 4; ++k) png[29 + k] = static_cast<uint8_t>(crc >> (24 - 8 * k));
+  const std::string bad = dir_ + "/wide.png";
+  ASSERT_TRUE(test::WriteFile(bad, png));
+  const Result r = Run({"run", paths[0], bad, paths[1], "--out", Out()});
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("wide.png"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("PNG PNG"), std::string::npos) << r.err;
+}
+
 TEST_F(Cli, UsageErrorsExitWithTwo) {
   EXPECT_EQ(Run({"run", "--synthetic"}).exit_code, 2);  // no --out
   EXPECT_EQ(Run({"run", "--f-number", "fast", "--out", Out()}).exit_code, 2);
