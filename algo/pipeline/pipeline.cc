@@ -304,6 +304,15 @@ Status Pipeline::ComputeDepth() {
 
 // Poses, then the burst's label range and the planes' homographies for the depth stage.
 Status Pipeline::EstimateGeometry(const ConstImageU8* views) {
+  if (!UsesMotion(config_, work_w_, work_h_) &&
+      (config_.max_working_width < MotionConfig::kMinSize ||
+       config_.max_working_height < MotionConfig::kMinSize)) {
+    return Status(Code::kDegenerate,
+                  "the working size bound %dx%d is below the %dx%d the camera's motion needs: "
+                  "raise it",
+                  config_.max_working_width, config_.max_working_height, MotionConfig::kMinSize,
+                  MotionConfig::kMinSize);
+  }
   if (!UsesMotion(config_, work_w_, work_h_)) {
     return Status(Code::kDegenerate,
                   "frames of %dx%d are too small to follow the camera's motion (at least %dx%d "

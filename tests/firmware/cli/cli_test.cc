@@ -467,6 +467,11 @@ TEST_F(Cli, NothingIsSilentlyChangedOrIgnored) {
     EXPECT_NE(r.err.find(c.says), std::string::npos) << r.err;
   }
   EXPECT_TRUE(OutDirEmpty());
+  // A working size too small for the motion stage is named as such, not "shoot larger".
+  const Result small = Run({"run", "--size", "320x240", "--working-size", "16x16", "--out", out});
+  EXPECT_EQ(small.exit_code, 0) << small.err;
+  EXPECT_NE(small.err.find("working size bound 16x16"), std::string::npos) << small.err;
+  EXPECT_EQ(small.err.find("higher resolution"), std::string::npos) << small.err;
   // Help is asked for: on stdout, exit 0.
   const Result help = Run({"depth", "--help"});
   EXPECT_EQ(help.exit_code, 0);
