@@ -24,6 +24,18 @@ double Percentile(std::vector<double> v, double p) {
   return v[static_cast<size_t>(p * (v.size() - 1) + 0.5)];
 }
 
+// The motion stage with `config` (its size and views set from the burst) on `b`.
+Status EstimateBurst(const motiontest::Burst& b, MotionConfig config, MotionResult* r) {
+  config.width = b.width;
+  config.height = b.height;
+  config.views = b.scene.views();
+  std::vector<uint8_t> memory(MotionStage::RequiredBytes(config));
+  Arena arena(memory.data(), memory.size());
+  MotionStage stage;
+  LB_RETURN_IF_ERROR(stage.Configure(config, arena));
+  return stage.Estimate(b.views.data(), b.scene.reference(), b.intrinsics, r);
+}
+
 struct Figures {
   std::vector<double> rot, dir, rms;
 };
@@ -36,16 +48,8 @@ void RunSeeds(int32_t pixel_samples, Figures* f) {
     motiontest::Burst b;
     ASSERT_TRUE(
         motiontest::MakeBurst(motiontest::Handheld(100 + s), 640, 480, views, &b, pixel_samples));
-    MotionConfig config;
-    config.width = 640;
-    config.height = 480;
-    config.views = views;
-    std::vector<uint8_t> memory(MotionStage::RequiredBytes(config));
-    Arena arena(memory.data(), memory.size());
-    MotionStage stage;
-    ASSERT_TRUE(stage.Configure(config, arena).ok());
     MotionResult r;
-    const Status st = stage.Estimate(b.views.data(), b.scene.reference(), b.intrinsics, &r);
+    const Status st = EstimateBurst(b, MotionConfig(), &r);
     ASSERT_TRUE(st.ok()) << "seed " << 100 + s << ": " << st.message();
     EXPECT_FALSE(r.rail) << "seed " << 100 + s << ": a hand does not move on a line at equal steps";
     double worst_rot = 0, worst_dir = 0;
@@ -101,16 +105,9 @@ TEST(MotionAccuracy, TheFramesTellTheFocalLengthWhereTheyCan) {
     for (const double told : {1.25, 0.8}) {
       b.intrinsics.fx = b.intrinsics.fy = truth * told;
       MotionConfig config;
-      config.width = b.width;
-      config.height = b.height;
-      config.views = b.scene.views();
       config.estimate_focal = true;
-      std::vector<uint8_t> memory(MotionStage::RequiredBytes(config));
-      Arena arena(memory.data(), memory.size());
-      MotionStage stage;
-      ASSERT_TRUE(stage.Configure(config, arena).ok());
       MotionResult r;
-      const Status st = stage.Estimate(b.views.data(), b.scene.reference(), b.intrinsics, &r);
+      const Status st = EstimateBurst(b, config, &r);
       ASSERT_TRUE(st.ok()) << st.message();
       const double found = r.intrinsics.fx / truth;
       printf("%.0f degrees, told %.2fx: found %.3fx the true focal length\n", fov, told, found);

@@ -103,6 +103,24 @@ Status Estimate(const std::vector<ConstImageU8>& views, int32_t reference,
   return stage.Estimate(views.data(), reference, k, m);
 }
 
+// The scene's own poses and inverse-depth range as a motion result.
+MotionResult TruePoses(const motiontest::Burst& b) {
+  MotionResult truth;
+  truth.views = b.scene.views();
+  truth.reference = b.scene.reference();
+  truth.intrinsics = b.intrinsics;
+  for (int32_t v = 0; v < truth.views; ++v) {
+    const Pose& p = b.scene.pose(v);
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) truth.motion[v].rotation[i][j] = p.rotation[i][j];
+      truth.motion[v].translation[i] = p.translation[i];
+    }
+  }
+  truth.inv_depth_min = b.scene.inverse_depth_min_q12() / 4096.0;
+  truth.inv_depth_max = b.scene.inverse_depth_max_q12() / 4096.0;
+  return truth;
+}
+
 double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v[v.size() / 2];
@@ -124,19 +142,7 @@ TEST(AutoGeometry, HandheldDepthWithEstimatedPosesIsCloseToTruePoses) {
     ASSERT_TRUE(
         motiontest::MakeBurst(motiontest::Handheld(200 + s), kW, kH, n, &b, PixelSamples()));
     const int32_t ref = b.scene.reference();
-    MotionResult truth;
-    truth.views = n;
-    truth.reference = ref;
-    truth.intrinsics = b.intrinsics;
-    for (int32_t v = 0; v < n; ++v) {
-      const Pose& p = b.scene.pose(v);
-      for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j) truth.motion[v].rotation[i][j] = p.rotation[i][j];
-        truth.motion[v].translation[i] = p.translation[i];
-      }
-    }
-    truth.inv_depth_min = b.scene.inverse_depth_min_q12() / 4096.0;
-    truth.inv_depth_max = b.scene.inverse_depth_max_q12() / 4096.0;
+    const MotionResult truth = TruePoses(b);
     MotionResult est;
     const Status st = Estimate(b.views, ref, b.intrinsics, &est);
     ASSERT_TRUE(st.ok()) << "seed " << 200 + s << ": " << st.message();
@@ -203,19 +209,7 @@ TEST_P(NarrowField, ConvergingBurstsKeepTheirDepthAfterScaleAndOffset) {
     motiontest::Burst b;
     ASSERT_TRUE(motiontest::MakeBurst(params, kW, kH, n, &b, PixelSamples()));
     const int32_t ref = b.scene.reference();
-    MotionResult truth;
-    truth.views = n;
-    truth.reference = ref;
-    truth.intrinsics = b.intrinsics;
-    for (int32_t v = 0; v < n; ++v) {
-      const Pose& p = b.scene.pose(v);
-      for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j) truth.motion[v].rotation[i][j] = p.rotation[i][j];
-        truth.motion[v].translation[i] = p.translation[i];
-      }
-    }
-    truth.inv_depth_min = b.scene.inverse_depth_min_q12() / 4096.0;
-    truth.inv_depth_max = b.scene.inverse_depth_max_q12() / 4096.0;
+    const MotionResult truth = TruePoses(b);
     CameraIntrinsics told = b.intrinsics;
     told.fx *= k.focal_error;
     told.fy *= k.focal_error;

@@ -37,6 +37,16 @@ std::string Slurp(const std::string& path) {
   return s;
 }
 
+// A valid 64x48 RGB PNG of one grey, for tests that break one of its chunks.
+Bytes GreyPng() {
+  test::PngSpec spec;
+  spec.width = 64;
+  spec.height = 48;
+  spec.rows.resize(64 * 48 * 3, 90);
+  Bytes png;
+  return test::EncodePng(spec, &png) ? png : Bytes{};
+}
+
 class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -225,12 +235,8 @@ TEST_F(Cli, TruncatedPpm) {
 
 TEST_F(Cli, PngWithBrokenCrc) {
   auto paths = PpmBurst(2, 64, 48);
-  test::PngSpec spec;
-  spec.width = 64;
-  spec.height = 48;
-  spec.rows.resize(64 * 48 * 3, 90);
-  Bytes png;
-  ASSERT_TRUE(test::EncodePng(spec, &png));
+  Bytes png = GreyPng();
+  ASSERT_FALSE(png.empty());
   const long idat = test::FindPngChunk(png, "IDAT");
   ASSERT_GT(idat, 0);
   const size_t at = static_cast<size_t>(idat);
@@ -496,12 +502,8 @@ TEST_F(Cli, HelpAndBehaviourAgree) {
   EXPECT_EQ(top.out.find("rectified views"), std::string::npos) << top.out;
 
   auto paths = PpmBurst(2, 64, 48);
-  test::PngSpec spec;
-  spec.width = 64;
-  spec.height = 48;
-  spec.rows.resize(64 * 48 * 3, 90);
-  Bytes png;
-  ASSERT_TRUE(test::EncodePng(spec, &png));
+  Bytes png = GreyPng();
+  ASSERT_FALSE(png.empty());
   png[16] = 0x80;  // IHDR width 2^31 + 64: libpng says "PNG unsigned integer out of range"
   const uLong crc = crc32(0, png.data() + 12, 17);  // IHDR's type and data, CRC after them
   for (int k = 0; k < 4; ++k) png[29 + k] = static_cast<uint8_t>(crc >> (24 - 8 * k));
