@@ -26,6 +26,8 @@ struct SensorMode {
   // Focal length in full-resolution px, 0 when the sensor does not know it (the pipeline then
   // assumes a typical compact camera's field of view). Motion estimation needs it.
   double focal_px = 0;
+  // EXIF Orientation (1..8) the frames were stored with, 0 when unknown: the photo carries it.
+  int32_t orientation = 0;
 };
 
 class Sensor {

@@ -94,6 +94,8 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
   FormatExifTime(when, sizeof(when));
   meta.datetime_original = when;
   meta.f_number = options_.render.f_number;
+  // The frames' orientation goes with the pixels (and the depth map, stored the same way).
+  meta.orientation = mode_.orientation;
   if (mode_.focal_px > 0) {
     meta.focal_35mm =
         static_cast<int32_t>(Focal35mmFromPx(mode_.focal_px, mode_.width, mode_.height) + 0.5);

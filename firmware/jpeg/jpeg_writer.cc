@@ -147,7 +147,7 @@ bool AddLong(ExifData* data, ExifMem* mem, ExifIfd ifd, ExifTag tag, uint32_t va
 
 bool JpegMetadata::has_exif() const {
   return !make.empty() || !model.empty() || !software.empty() || !datetime_original.empty() ||
-         f_number > 0.0f || focal_35mm > 0;
+         f_number > 0.0f || focal_35mm > 0 || orientation > 0;
 }
 
 Status BuildExif(const JpegMetadata& meta, int32_t width, int32_t height,
@@ -194,6 +194,10 @@ Status BuildExif(const JpegMetadata& meta, int32_t width, int32_t height,
     // Hundredths are finer than any lens marking (f/1.4, f/2.8, f/5.6).
     const ExifRational f = {static_cast<ExifLong>(meta.f_number * 100.0f + 0.5f), 100};
     ok = AddRational(data, mem, EXIF_IFD_EXIF, EXIF_TAG_FNUMBER, f);
+  }
+  if (ok && meta.orientation >= 1 && meta.orientation <= 8) {
+    ok = AddShort(data, mem, EXIF_IFD_0, EXIF_TAG_ORIENTATION,
+                  static_cast<uint16_t>(meta.orientation));
   }
   if (ok && meta.focal_35mm > 0) {
     ok = AddShort(data, mem, EXIF_IFD_EXIF, EXIF_TAG_FOCAL_LENGTH_IN_35MM_FILM,

@@ -31,6 +31,7 @@ struct JpegMetadata {
   std::string datetime_original;            // "YYYY:MM:DD HH:MM:SS"
   float f_number = 0.0f;                    // 0 = not recorded
   int32_t focal_35mm = 0;                   // 35 mm equivalent focal length, mm; 0 = not recorded
+  int32_t orientation = 0;                  // EXIF Orientation 1..8; 0 = not recorded
   std::vector<JpegSegment> extra_segments;  // written after the EXIF segment, in order
 
   // EXIF is written when any field above is set; otherwise a JFIF header is.

@@ -21,4 +21,17 @@ double ExifFocalPx(const char* path, int32_t width, int32_t height) {
   return focal;
 }
 
+int32_t ExifOrientation(const char* path) {
+  ExifData* data = exif_data_new_from_file(path);
+  if (data == nullptr) return 0;
+  int32_t orientation = 0;
+  ExifEntry* e = exif_content_get_entry(data->ifd[EXIF_IFD_0], EXIF_TAG_ORIENTATION);
+  if (e != nullptr && e->format == EXIF_FORMAT_SHORT && e->components == 1) {
+    const int32_t v = exif_get_short(e->data, exif_data_get_byte_order(data));
+    if (v >= 1 && v <= 8) orientation = v;
+  }
+  exif_data_unref(data);
+  return orientation;
+}
+
 }  // namespace lb

@@ -132,6 +132,7 @@ Status FileSensor::Configure(const SensorConfig& config, SensorMode* mode) {
   mode_.format = first.format;
   mode_.frames = static_cast<int32_t>(paths_.size());
   mode_.focal_px = ExifFocalPx(paths_[0].c_str(), first.width, first.height);
+  mode_.orientation = ExifOrientation(paths_[0].c_str());
   *mode = mode_;
   configured_ = true;
   return Status::Ok();

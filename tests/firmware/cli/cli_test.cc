@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "firmware/jpeg/jpeg_writer.h"
+#include "sim/files/exif_focal.h"
 #include "tests/algo/motion/burst.h"
 #include "tests/sim/files/test_images.h"
 
@@ -513,6 +515,34 @@ TEST_F(Cli, HelpAndBehaviourAgree) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("wide.png"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("PNG PNG"), std::string::npos) << r.err;
+}
+
+// Issue 13, defect 6: the frames' EXIF Orientation goes into the photo, so it shows upright.
+TEST_F(Cli, TheFramesOrientationGoesIntoThePhoto) {
+  JpegMetadata meta;
+  meta.orientation = 6;  // stored turned: the viewer rotates 90 degrees clockwise
+  std::vector<uint8_t> exif;
+  ASSERT_TRUE(BuildExif(meta, 64, 48, &exif).ok());
+  std::vector<std::string> args = {"run", "--geometry", "rectified", "--out", Out()};
+  for (int i = 0; i < 3; ++i) {
+    std::vector<uint8_t> rgb(64 * 48 * 3);
+    for (int y = 0; y < 48; ++y)
+      for (int x = 0; x < 64; ++x)
+        for (int c = 0; c < 3; ++c) rgb[(y * 64 + x) * 3 + c] = test::Smooth(x + 2 * i, y, c);
+    Bytes jpg;
+    ASSERT_TRUE(test::EncodeJpeg(64, 48, 3, rgb.data(), 95, false, &jpg));
+    // APP1 right after SOI: marker, big-endian length (itself included), the payload.
+    const size_t n = exif.size() + 2;
+    Bytes app1 = {0xff, 0xe1, static_cast<uint8_t>(n >> 8), static_cast<uint8_t>(n)};
+    app1.insert(app1.end(), exif.begin(), exif.end());
+    jpg.insert(jpg.begin() + 2, app1.begin(), app1.end());
+    args.push_back(dir_ + "/f" + std::to_string(i) + ".jpg");
+    ASSERT_TRUE(test::WriteFile(args.back(), jpg));
+  }
+  ASSERT_EQ(ExifOrientation(args[5].c_str()), 6) << "the test's own frames";
+  const Result r = Run(args);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(ExifOrientation(Out().c_str()), 6);
 }
 
 TEST_F(Cli, UsageErrorsExitWithTwo) {
