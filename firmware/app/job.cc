@@ -5,6 +5,7 @@
 #include <ctime>
 
 #include "algo/motion/camera.h"
+#include "firmware/app/focus.h"
 #include "firmware/app/refocusable.h"
 #include "firmware/jpeg/jpeg_writer.h"
 #include "firmware/storage/atomic_file.h"
@@ -51,6 +52,7 @@ Status Job::Configure(Sensor* sensor, const JobOptions& options) {
                   pc.frames, pc.frames - 1);
   }
   if (pc.reference < 0) pc.reference = pc.frames / 2;
+  LB_RETURN_IF_ERROR(CheckFocusRegion(options_.render.focus, mode_.width, mode_.height));
   size_t bytes = 0;
   LB_RETURN_IF_ERROR(Pipeline::RequiredBytes(pc, &bytes));
   if (bytes != arena_bytes_) {

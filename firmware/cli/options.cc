@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "firmware/app/focus.h"
 #include "firmware/app/size_text.h"
 
 namespace lb::cli {
@@ -21,10 +22,6 @@ std::string Printf(const char* format, ...) {
   va_end(args);
   return buf;
 }
-
-// Half the side of the square a focus *point* stands for, as a fraction of the image: small
-// enough to pick one object, large enough that the median of its depths is stable.
-constexpr int32_t kPointHalfSide = 8;
 
 }  // namespace
 
@@ -92,7 +89,7 @@ bool ParseFocus(const char* text, FocusRegion* out, std::string* error) {
     return false;
   }
   if (n == 2) {
-    *out = {v[0] - kPointHalfSide, v[1] - kPointHalfSide, 2 * kPointHalfSide, 2 * kPointHalfSide};
+    *out = FocusAtPoint(v[0], v[1]);
     if (out->x < 0) out->x = 0;
     if (out->y < 0) out->y = 0;
   } else {

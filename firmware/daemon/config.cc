@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "firmware/app/focus.h"
 #include "firmware/app/size_text.h"
 
 namespace lb {
@@ -78,7 +79,7 @@ bool Focus(const char* v, FocusRegion* out, Why* why) {
   if (strcmp(v, "center") == 0) {
     *out = FocusRegion();
   } else if (sscanf(v, "point %d,%d%c", &x, &y, &tail) == 2 && x >= 0 && y >= 0) {
-    *out = {x, y, 1, 1};  // the render stage grows a tapped point to a small square
+    *out = FocusAtPoint(x, y);  // the same square as refocus --focus X,Y
   } else if (sscanf(v, "region %d,%d,%d,%d%c", &x, &y, &w, &h, &tail) == 4 && x >= 0 && y >= 0 &&
              w > 0 && h > 0) {
     *out = {x, y, w, h};

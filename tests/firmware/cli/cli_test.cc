@@ -468,6 +468,10 @@ TEST_F(Cli, NothingIsSilentlyChangedOrIgnored) {
            {{"run", "--out", out, "--out", out + "2"}, false, 2, "--out given twice"},
            {{"run", "--synthetic", "--out"}, false, 2, "--out needs a value"},
            {{"run", "--bogus", "--out", out}, false, 2, "unknown option '--bogus'"},
+           {{"run", "--size", "320x240", "--focus", "5000,5000", "--out", out},
+            false,
+            1,
+            "lies outside the 320x240 photo"},
        }) {
     const Result r = run(c.args, c.with_frames);
     EXPECT_EQ(r.exit_code, c.exit_code) << c.args[1] << ": " << r.err;

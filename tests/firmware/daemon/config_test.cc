@@ -1,5 +1,6 @@
 // refocusd's configuration file: what an installer or a user editing /etc/refocusd.conf sees.
 #include "firmware/daemon/config.h"
+#include "firmware/app/focus.h"
 
 #include <gtest/gtest.h>
 
@@ -122,8 +123,13 @@ TEST(ConfigTest, NativeResolutionAutoDeviceAndPointFocus) {
   EXPECT_EQ(c.width, 0);
   EXPECT_EQ(c.height, 0);
   EXPECT_EQ(c.device, "");
-  EXPECT_EQ(c.render.focus.x, 5);
-  EXPECT_EQ(c.render.focus.width, 1);
+  // Issue 13, defect 6: a point means what it means on the command line (firmware/app/focus.h).
+  const FocusRegion cli = FocusAtPoint(5, 6);
+  EXPECT_EQ(c.render.focus.x, cli.x);
+  EXPECT_EQ(c.render.focus.y, cli.y);
+  EXPECT_EQ(c.render.focus.width, cli.width);
+  EXPECT_EQ(c.render.focus.height, cli.height);
+  EXPECT_EQ(cli.width, 2 * kFocusPointHalfSide);
 }
 
 TEST(ConfigTest, ErrorsNameTheFileTheLineAndTheProblem) {
