@@ -1,12 +1,12 @@
 // refocusd's configuration file: what an installer or a user editing /etc/refocusd.conf sees.
 #include "firmware/daemon/config.h"
-#include "firmware/app/focus.h"
 
 #include <gtest/gtest.h>
 
 #include <cstdlib>
 #include <string>
 
+#include "firmware/app/focus.h"
 #include "tests/firmware/jpeg/jpeg_test_util.h"
 
 namespace lb {
