@@ -134,6 +134,9 @@ TEST(ConfigTest, NativeResolutionAutoDeviceAndPointFocus) {
 
 TEST(ConfigTest, ErrorsNameTheFileTheLineAndTheProblem) {
   EXPECT_EQ(Error("frames = 5\n\nburst = 3\n"), "test.conf:3: unknown key 'burst'");
+  // Issue 13, defect 6: no integer overflow turns a size into another one.
+  EXPECT_EQ(Error("resolution = 4294967616x240\n"),
+            "test.conf:1: resolution: '4294967616x240' is not WxH between 16x16 and 8192x8192");
   EXPECT_EQ(Error("frames 5\n"), "test.conf:1: 'frames 5' is not 'key = value'");
   EXPECT_EQ(Error("frames = 5\nframes = 6\n"), "test.conf:2: frames is already set on line 1");
   EXPECT_EQ(Error("quality =\n"), "test.conf:1: quality has no value");
