@@ -126,9 +126,8 @@ class DepthStage {
   static int32_t LabelDispQ8(const DepthConfig& config, int32_t label);
   // What the output map adds to every disparity so that it fits 16 unsigned bits: 0 for a range
   // that starts at 0 or above, -disp_min_q8 for a signed one.
-  static int32_t MapBiasQ8(const DepthConfig& config) {
-    return config.disp_min_q8 < 0 ? -config.disp_min_q8 : 0;
-  }
+  static int32_t MapBiasQ8(int32_t disp_min_q8) { return disp_min_q8 < 0 ? -disp_min_q8 : 0; }
+  static int32_t MapBiasQ8(const DepthConfig& config) { return MapBiasQ8(config.disp_min_q8); }
 
  private:
   // The rectangles of a move: one for the whole grid, or, for a restricted move, one per run

@@ -10,6 +10,11 @@ int32_t Cell(const MotionConfig& c) {
   return c.width / 80 > 8 ? c.width / 80 : 8;
 }
 
+// View steps between frame v and the reference.
+int32_t StepsFrom(int32_t reference, int32_t v) {
+  return v > reference ? v - reference : reference - v;
+}
+
 // Chord |R - I|_F = 2 sqrt(2) sin(angle / 2): monotone in the angle, no acos needed.
 double RotationChord(const ViewMotion& m) {
   double s = 0;
@@ -286,12 +291,12 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
   constexpr int32_t kNearSteps = 2;
   int32_t far = 0;
   for (int32_t v = 0; v < c.views; ++v) {
-    const int32_t d = v > reference ? v - reference : reference - v;
+    const int32_t d = StepsFrom(reference, v);
     far = d > far ? d : far;
   }
   if (far > kNearSteps) {
     for (int32_t v = 0; v < c.views; ++v) {
-      const int32_t d = v > reference ? v - reference : reference - v;
+      const int32_t d = StepsFrom(reference, v);
       const size_t at = static_cast<size_t>(v) * n;
       for (int32_t i = 0; i < n; ++i) near_ok_[at + i] = d <= kNearSteps ? obs_ok_[at + i] : 0;
     }
@@ -300,7 +305,7 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
                                      inv_depth_, nullptr, nullptr, &report));
     in.obs_ok = obs_ok_;
     for (int32_t v = 0; v < c.views; ++v) {
-      const int32_t d = v > reference ? v - reference : reference - v;
+      const int32_t d = StepsFrom(reference, v);
       if (d <= kNearSteps) continue;
       const int32_t u = v > reference ? reference + kNearSteps : reference - kNearSteps;
       result->motion[v] = result->motion[u];
@@ -404,7 +409,9 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
 }
 
 void MotionStage::ReverseDepth(MotionResult* r) {
-  for (int32_t i = 0; i < r->points && r->inv_depth == out_w_; ++i) out_w_[i] = -out_w_[i];
+  if (r->inv_depth == out_w_) {  // this stage's points
+    for (int32_t i = 0; i < r->points; ++i) out_w_[i] = -out_w_[i];
+  }
   for (int32_t v = 0; v < r->views; ++v) {
     for (double& t : r->motion[v].translation) t = -t;
   }

@@ -43,8 +43,10 @@ Status PlanLabelRange(const MotionResult& m, const LabelPlan& plan, LabelRange* 
   // the lattice (floor, also below 0), inside -65535..65535.
   const int64_t cell = step * (plan.lattice > 0 ? plan.lattice : 1);
   const double first = lo - 0.5 * (static_cast<double>(width - step * plan.lattice) - (hi - lo));
-  int64_t label0 = static_cast<int64_t>(__builtin_floor(first / static_cast<double>(cell))) * cell;
-  if (plan.lattice == 0) label0 = static_cast<int64_t>(__builtin_floor(first));
+  int64_t label0 =
+      plan.lattice > 0
+          ? static_cast<int64_t>(__builtin_floor(first / static_cast<double>(cell))) * cell
+          : static_cast<int64_t>(__builtin_floor(first));
   while (label0 + width > 65535) label0 -= cell;
   while (label0 < -65535) label0 += cell;
   out->disp_min_q8 = static_cast<int32_t>(label0);

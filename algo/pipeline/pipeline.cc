@@ -270,8 +270,7 @@ Status Pipeline::ComputeDepth() {
   ConstImageU8 views[PipelineConfig::kMaxFrames];
   for (int32_t i = 0; i < config_.frames; ++i) views[i] = working_[i].AsConst();
   depth_warning_ = Status::Ok();
-  depth_reversed_ = false;
-  const int32_t config_bias = config_.disp_min_q8 < 0 ? -config_.disp_min_q8 : 0;
+  const int32_t config_bias = DepthStage::MapBiasQ8(config_.disp_min_q8);
   disp_min_q8_ = config_.disp_min_q8 + config_bias;
   disp_max_q8_ = config_.disp_max_q8 + config_bias;
   if (config_.geometry == Geometry::kAuto) {
@@ -292,7 +291,7 @@ Status Pipeline::ComputeDepth() {
   if (config_.geometry == Geometry::kAuto) {
     // SetDepthGeometry rebuilds the planes for every burst, so they are still this one's.
     LB_RETURN_IF_ERROR(OrderDepth(views, planes_, order_scratch_, &depth_, &motion_,
-                                  &motion_result_, disp_q8_, &depth_reversed_));
+                                  &motion_result_, disp_q8_, nullptr));
   }
   // The map's own range: a signed one is lifted by the stage's bias (depth_stage.h).
   const DepthConfig& d = depth_.config();
@@ -304,16 +303,15 @@ Status Pipeline::ComputeDepth() {
 
 // Poses, then the burst's label range and the planes' homographies for the depth stage.
 Status Pipeline::EstimateGeometry(const ConstImageU8* views) {
-  if (!UsesMotion(config_, work_w_, work_h_) &&
-      (config_.max_working_width < MotionConfig::kMinSize ||
-       config_.max_working_height < MotionConfig::kMinSize)) {
-    return Status(Code::kDegenerate,
-                  "the working size bound %dx%d is below the %dx%d the camera's motion needs: "
-                  "raise it",
-                  config_.max_working_width, config_.max_working_height, MotionConfig::kMinSize,
-                  MotionConfig::kMinSize);
-  }
   if (!UsesMotion(config_, work_w_, work_h_)) {
+    if (config_.max_working_width < MotionConfig::kMinSize ||
+        config_.max_working_height < MotionConfig::kMinSize) {
+      return Status(Code::kDegenerate,
+                    "the working size bound %dx%d is below the %dx%d the camera's motion needs: "
+                    "raise it",
+                    config_.max_working_width, config_.max_working_height, MotionConfig::kMinSize,
+                    MotionConfig::kMinSize);
+    }
     return Status(Code::kDegenerate,
                   "frames of %dx%d are too small to follow the camera's motion (at least %dx%d "
                   "at the working resolution): take the burst at a higher resolution",

@@ -83,9 +83,6 @@ class Pipeline : public FrameSink {
   int32_t disp_min_q8() const { return disp_min_q8_; }
   int32_t disp_max_q8() const { return disp_max_q8_; }
   const MotionResult& motion() const { return motion_result_; }
-  // kAuto: the views' occlusions said the motion's near end was the far one, and the depth was
-  // turned round (OrderDepth in auto_geometry.h).
-  bool depth_reversed() const { return depth_reversed_; }
   Status BeginRender(const RenderParams& params);
   Status NextStrip(ConstPlanarU8* strip, int32_t* y0, int32_t* rows);
 
@@ -123,7 +120,6 @@ class Pipeline : public FrameSink {
   MotionResult motion_result_;
   PlaneHomography* planes_ = nullptr;  // kAuto: frames x labels, view-major
   uint8_t* order_scratch_ = nullptr;   // kAuto: DepthOrderScratchBytes (auto_geometry.h)
-  bool depth_reversed_ = false;
   int32_t disp_min_q8_ = 0, disp_max_q8_ = 0;
   Status depth_warning_;
 

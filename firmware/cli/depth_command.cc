@@ -174,7 +174,6 @@ int DepthCommand(int argc, char** argv) {
     return Usage("--views takes at most 16 files");
   }
   if (!pfm) return Usage("--disparity-out is required");
-  if (preview && !strcmp(preview, pfm)) return Usage("--preview and --disparity-out name one file");
   c.views = static_cast<int32_t>(files.size());
   c.reference = ref < 0 ? c.views / 2 : ref;
   if (c.reference >= c.views) return Usage("--ref is past the last view");
@@ -188,8 +187,8 @@ int DepthCommand(int argc, char** argv) {
     if (!check.ok()) return Fail(check.message());
   }
   struct stat a, b;
-  if (preview && stat(pfm, &a) == 0 && stat(preview, &b) == 0 && a.st_dev == b.st_dev &&
-      a.st_ino == b.st_ino) {
+  if (preview && (!strcmp(preview, pfm) || (stat(pfm, &a) == 0 && stat(preview, &b) == 0 &&
+                                            a.st_dev == b.st_dev && a.st_ino == b.st_ino))) {
     return Usage("--preview and --disparity-out name one file");
   }
   // Every header first: sizes are checked before a single pixel buffer exists, so a small
