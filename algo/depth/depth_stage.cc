@@ -14,9 +14,10 @@ int32_t DepthStage::LabelDispQ8(const DepthConfig& c, int32_t label) {
 }
 
 Status DepthStage::Validate(const DepthConfig& c) {
-  if (c.width < 8 || c.height < 8 || int64_t{c.width} * c.height > (int64_t{1} << 24)) {
-    return Status(Code::kInvalidArgument, "depth: working size %dx%d outside 8x8 .. 16M pixels",
-                  c.width, c.height);
+  if (c.width < DepthConfig::kMinSize || c.height < DepthConfig::kMinSize ||
+      int64_t{c.width} * c.height > (int64_t{1} << 24)) {
+    return Status(Code::kInvalidArgument, "depth: working size %dx%d outside %dx%d .. 16M pixels",
+                  c.width, c.height, DepthConfig::kMinSize, DepthConfig::kMinSize);
   }
   if (c.views < 2 || c.views > DepthConfig::kMaxViews) {
     return Status(Code::kInvalidArgument, "depth: %d views (needs 2 to %d)", c.views,

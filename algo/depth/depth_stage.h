@@ -29,6 +29,7 @@ enum class DepthGeometry : uint8_t { kRectified, kPlanes };
 struct DepthConfig {
   static constexpr int32_t kMaxViews = 16;
   static constexpr int32_t kMaxLabels = 256;
+  static constexpr int32_t kMinSize = 8;  // working width and height
 
   int32_t width = 0;  // working resolution
   int32_t height = 0;

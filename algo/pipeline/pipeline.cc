@@ -11,7 +11,16 @@ namespace lb {
 Pipeline::Layout Pipeline::Plan(const PipelineConfig& c) {
   int32_t s = 1;
   while (c.width / s > c.max_working_width || c.height / s > c.max_working_height) ++s;
+  // A frame far thinner than the bound (16x8192 into 640x480) would shrink below one pixel: it
+  // gets no depth (ComputeDepth says so) and a scale that keeps a pixel for its flat map.
+  const int32_t thin = c.width < c.height ? c.width : c.height;
+  if (s > thin) s = thin;
   return {s, c.width / s, c.height / s};
+}
+
+// Working images smaller than the depth stage takes give a flat map and a warning.
+static bool HasDepth(int32_t work_w, int32_t work_h) {
+  return work_w >= DepthConfig::kMinSize && work_h >= DepthConfig::kMinSize;
 }
 
 static DepthConfig MakeDepthConfig(const PipelineConfig& c, int32_t w, int32_t h) {
@@ -78,7 +87,9 @@ Status Pipeline::RequiredBytes(const PipelineConfig& c, size_t* bytes) {
                   c.max_working_width, c.max_working_height);
   }
   const Layout l = Plan(c);
-  LB_RETURN_IF_ERROR(DepthStage::Validate(MakeDepthConfig(c, l.work_w, l.work_h)));
+  if (HasDepth(l.work_w, l.work_h)) {
+    LB_RETURN_IF_ERROR(DepthStage::Validate(MakeDepthConfig(c, l.work_w, l.work_h)));
+  }
   LB_RETURN_IF_ERROR(RenderStage::Validate(MakeRenderConfig(c, l.scale, l.work_w, l.work_h)));
   if (UsesMotion(c, l.work_w, l.work_h)) {
     LB_RETURN_IF_ERROR(MotionStage::Validate(MakeMotionConfig(c, l.work_w, l.work_h)));
@@ -113,8 +124,11 @@ Status Pipeline::Carve(Arena& arena) {
     planes_ = arena.Allocate<PlaneHomography>(static_cast<size_t>(c.frames) * c.labels);
     order_scratch_ = arena.Allocate<uint8_t>(DepthOrderScratchBytes(work_w_, work_h_));
   }
+  const bool depth = HasDepth(work_w_, work_h_);
   if (arena.planning()) {
-    (void)arena.AllocateBytes(DepthStage::RequiredBytes(MakeDepthConfig(c, work_w_, work_h_)));
+    if (depth) {
+      (void)arena.AllocateBytes(DepthStage::RequiredBytes(MakeDepthConfig(c, work_w_, work_h_)));
+    }
     (void)arena.AllocateBytes(
         RenderStage::RequiredBytes(MakeRenderConfig(c, scale_, work_w_, work_h_)));
     if (UsesMotion(c, work_w_, work_h_)) {
@@ -122,7 +136,7 @@ Status Pipeline::Carve(Arena& arena) {
     }
     return Status::Ok();
   }
-  LB_RETURN_IF_ERROR(depth_.Configure(MakeDepthConfig(c, work_w_, work_h_), arena));
+  if (depth) LB_RETURN_IF_ERROR(depth_.Configure(MakeDepthConfig(c, work_w_, work_h_), arena));
   LB_RETURN_IF_ERROR(render_.Configure(MakeRenderConfig(c, scale_, work_w_, work_h_), arena));
   if (UsesMotion(c, work_w_, work_h_)) {
     LB_RETURN_IF_ERROR(motion_.Configure(MakeMotionConfig(c, work_w_, work_h_), arena));
@@ -273,20 +287,27 @@ Status Pipeline::ComputeDepth() {
   const int32_t config_bias = DepthStage::MapBiasQ8(config_.disp_min_q8);
   disp_min_q8_ = config_.disp_min_q8 + config_bias;
   disp_max_q8_ = config_.disp_max_q8 + config_bias;
-  if (config_.geometry == Geometry::kAuto) {
-    const Status geometry = EstimateGeometry(views);
-    if (geometry.code() == Code::kDegenerate) {
-      // Everything at one depth: the render keeps the whole picture sharp.
-      depth_warning_ = geometry;
-      for (int32_t y = 0; y < work_h_; ++y) {
-        uint16_t* row = disp_q8_.Row(y);
-        for (int32_t x = 0; x < work_w_; ++x) row[x] = static_cast<uint16_t>(disp_min_q8_);
-      }
-      depth_ready_ = true;
-      return Status::Ok();
-    }
-    LB_RETURN_IF_ERROR(geometry);
+  Status geometry = Status::Ok();
+  if (!HasDepth(work_w_, work_h_)) {
+    geometry = Status(Code::kDegenerate,
+                      "frames of %dx%d are too thin for depth: within the working size bound "
+                      "%dx%d they shrink below %dx%d (take frames of a less extreme shape)",
+                      config_.width, config_.height, config_.max_working_width,
+                      config_.max_working_height, DepthConfig::kMinSize, DepthConfig::kMinSize);
+  } else if (config_.geometry == Geometry::kAuto) {
+    geometry = EstimateGeometry(views);
   }
+  if (geometry.code() == Code::kDegenerate) {
+    // Everything at one depth: the render keeps the whole picture sharp.
+    depth_warning_ = geometry;
+    for (int32_t y = 0; y < work_h_; ++y) {
+      uint16_t* row = disp_q8_.Row(y);
+      for (int32_t x = 0; x < work_w_; ++x) row[x] = static_cast<uint16_t>(disp_min_q8_);
+    }
+    depth_ready_ = true;
+    return Status::Ok();
+  }
+  LB_RETURN_IF_ERROR(geometry);
   LB_RETURN_IF_ERROR(depth_.Compute(views, disp_q8_));
   if (config_.geometry == Geometry::kAuto) {
     // SetDepthGeometry rebuilds the planes for every burst, so they are still this one's.

@@ -8,6 +8,7 @@
 #include "firmware/jpeg/jpeg_writer.h"
 #include "firmware/jpeg/refocusable_reader.h"
 #include "firmware/storage/atomic_file.h"
+#include "sim/files/exif_focal.h"
 #include "sim/files/image_file.h"
 
 namespace lb {
@@ -19,12 +20,23 @@ Status Rerenderer::Load(const char* path) {
     return Status(Code::kUnsupported, "%s: no all-in-focus original (GImage) to re-render from",
                   path);
   }
-  LB_RETURN_IF_ERROR(DisparityFromDepth(file, &disp_q8_, &range_));
-  ImageFileInfo info;
-  std::vector<uint8_t> pixels;
-  Status s = ReadImageMemory(file.xmp.image.data(), file.xmp.image.size(), "GImage", &info, &pixels,
-                             ImageFileType::kJpeg);
+  Status s = DisparityFromDepth(file, &disp_q8_, &range_);
   if (!s.ok()) return s.Prefix("%s: ", path);
+  // The original's header first: a few bytes may claim gigabytes of pixels.
+  ImageFileInfo info;
+  s = ProbeImageMemory(file.xmp.image.data(), file.xmp.image.size(), "GImage", &info,
+                       ImageFileType::kJpeg);
+  if (!s.ok()) return s.Prefix("%s: ", path);
+  if (info.width > PipelineConfig::kMaxWidth || info.height > PipelineConfig::kMaxHeight) {
+    return Status(Code::kUnsupported,
+                  "%s: GImage: a %dx%d original, larger than the %dx%d refocus renders", path,
+                  info.width, info.height, PipelineConfig::kMaxWidth, PipelineConfig::kMaxHeight);
+  }
+  std::vector<uint8_t> pixels;
+  s = ReadImageMemory(file.xmp.image.data(), file.xmp.image.size(), "GImage", &info, &pixels,
+                      ImageFileType::kJpeg);
+  if (!s.ok()) return s.Prefix("%s: ", path);
+  orientation_ = ExifOrientation(path);
   depth_w_ = file.depth.width;
   depth_h_ = file.depth.height;
   width_ = info.width;
@@ -99,6 +111,7 @@ Status Rerenderer::Render(const RerenderOptions& options, const char* out_path,
   meta.model = "Re-rendered";
   meta.software = "refocus rerender";
   meta.f_number = options.render.f_number;
+  meta.orientation = orientation_;
   LB_RETURN_IF_ERROR(BuildRefocusableSegments(disparity_q8(), range_, original_jpeg_,
                                               FocusOf(render, options.render, width_, height_),
                                               width_, &meta.extra_segments));

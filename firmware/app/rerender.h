@@ -36,6 +36,7 @@ class Rerenderer {
 
  private:
   int32_t width_ = 0, height_ = 0, scale_ = 1, depth_w_ = 0, depth_h_ = 0;
+  int32_t orientation_ = 0;           // the file's EXIF Orientation, carried into the re-render
   std::vector<uint8_t> y_, cb_, cr_;  // the original as JFIF YCbCr 4:2:0
   std::vector<uint16_t> disp_q8_;
   DisparityRange range_;

@@ -215,9 +215,22 @@ int DepthCommand(int argc, char** argv) {
              files[0], c.width, c.height, static_cast<long long>(kMaxDepthPixels));
     return Fail(msg);
   }
+  char msg[512];
+  if (geometry == Geometry::kAuto &&
+      (c.width < MotionConfig::kMinSize || c.height < MotionConfig::kMinSize)) {
+    snprintf(msg, sizeof(msg),
+             "%s: %dx%d views are too small to follow the camera's motion (at least %dx%d); "
+             "--geometry rectified takes aligned views from %dx%d",
+             files[0], c.width, c.height, MotionConfig::kMinSize, MotionConfig::kMinSize,
+             DepthConfig::kMinSize, DepthConfig::kMinSize);
+    return Fail(msg);
+  }
   if (geometry == Geometry::kAuto) c.geometry = DepthGeometry::kPlanes;
   const Status valid = DepthStage::Validate(c);
-  if (!valid.ok()) return Fail(valid.message());
+  if (!valid.ok()) {
+    snprintf(msg, sizeof(msg), "%s: %s", files[0], valid.message());
+    return Fail(msg);
+  }
   std::vector<std::vector<uint8_t>> pixels(files.size());
   for (size_t v = 0; v < files.size(); ++v) {
     int32_t w = 0, h = 0;

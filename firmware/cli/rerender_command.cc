@@ -42,6 +42,8 @@ int RerenderCommand(int argc, char** argv) {
     bool ok = true;
     switch (c) {
       case kOut:
+        ok = out_path.empty();
+        if (!ok) error = "--out given twice";
         out_path = optarg;
         break;
       case kHelp:

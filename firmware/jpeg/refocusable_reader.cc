@@ -1,5 +1,7 @@
 #include "firmware/jpeg/refocusable_reader.h"
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -14,6 +16,8 @@ namespace lb {
 namespace {
 
 constexpr int32_t kMaxDepthSide = 8192;
+// Two 8192x8192 JPEGs (the photo and its original) at the highest quality, and the depth map.
+constexpr size_t kMaxFileBytes = size_t{512} << 20;
 constexpr size_t kExtendedHeader = sizeof(kExtendedXmpSignature) + 32 + 4 + 4;
 
 struct Chunk {
@@ -197,11 +201,18 @@ Status ReadDepth(const char* name, const Fields& f, RefocusableImage* out) {
     }
     d.width = static_cast<int32_t>(w);
     d.height = static_cast<int32_t>(h);
+    if (out->width > 0 && (d.width > out->width || d.height > out->height)) {
+      return Status(Code::kCorruptData, "%s: GDepth: a %dx%d depth map in a %dx%d photo", name,
+                    d.width, d.height, out->width, out->height);
+    }
   }
   char what[300];
   snprintf(what, sizeof(what), "%s: GDepth:Data", name);
-  // The size is checked against the header before any pixel is decoded.
-  return DecodeGrayPng(d.data.data(), d.data.size(), what, kMaxDepthSide, d.width, d.height,
+  // The size is checked against the PNG's header before any pixel is decoded; a depth map is
+  // never larger than the photo it belongs to.
+  const int32_t photo_side = std::max(out->width, out->height);
+  const int32_t max_side = photo_side > 0 ? std::min(photo_side, kMaxDepthSide) : kMaxDepthSide;
+  return DecodeGrayPng(d.data.data(), d.data.size(), what, max_side, d.width, d.height,
                        &out->depth);
 }
 
@@ -353,12 +364,20 @@ Status ReadRefocusable(const uint8_t* data, size_t size, const char* name, Refoc
 }
 
 Status ReadRefocusableFile(const char* path, RefocusableImage* out) {
-  FILE* f = fopen(path, "rb");
+  FILE* f = fopen(path, "rbe");
   if (f == nullptr) {
     return Status(errno == ENOENT ? Code::kNotFound : Code::kIoError, "%s: %s", path,
                   strerror(errno));
   }
+  struct stat st;
+  if (fstat(fileno(f), &st) != 0 || !S_ISREG(st.st_mode) ||
+      static_cast<uint64_t>(st.st_size) > kMaxFileBytes) {
+    fclose(f);
+    return Status(Code::kInvalidArgument, "%s: not a regular file of at most %zu MiB", path,
+                  kMaxFileBytes >> 20);
+  }
   std::vector<uint8_t> bytes;
+  bytes.reserve(static_cast<size_t>(st.st_size));
   uint8_t buf[65536];
   size_t n;
   while ((n = fread(buf, 1, sizeof(buf), f)) > 0) bytes.insert(bytes.end(), buf, buf + n);

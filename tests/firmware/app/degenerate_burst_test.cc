@@ -64,13 +64,15 @@ class DegenerateBurst : public ::testing::Test {
     return paths;
   }
 
-  // Runs the burst through a Job with auto geometry; expects a saved, unblurred photo and a
-  // warning holding `advice`.
-  void ExpectUnblurredWithWarning(const motiontest::Burst& b, const char* advice) {
+  // Runs the burst's files through a Job; expects a saved, unblurred photo of `pixels` pixels
+  // and a warning holding `advice`.
+  void ExpectUnblurredWithWarning(const std::vector<std::string>& paths, const char* advice,
+                                  Geometry geometry = Geometry::kAuto,
+                                  int64_t pixels = int64_t{kW} * kH) {
     std::unique_ptr<FileSensor> sensor;
-    ASSERT_TRUE(FileSensor::FromFiles(Write(b), &sensor).ok());
+    ASSERT_TRUE(FileSensor::FromFiles(paths, &sensor).ok());
     JobOptions o;
-    o.pipeline.geometry = Geometry::kAuto;
+    o.pipeline.geometry = geometry;
     o.pipeline.labels = 16;
     o.pipeline.reference = 2;
     o.render.f_number = 1.4f;
@@ -84,7 +86,7 @@ class DegenerateBurst : public ::testing::Test {
     ASSERT_TRUE(s.ok()) << s.message();
     EXPECT_EQ(report.warning.code(), Code::kDegenerate);
     EXPECT_NE(strstr(report.warning.message(), advice), nullptr) << report.warning.message();
-    EXPECT_GT(check.samples, int64_t{kW} * kH);
+    EXPECT_GT(check.samples, pixels);
     EXPECT_EQ(check.differing, 0) << "the photo is blurred somewhere";
     EXPECT_EQ(access(out.c_str(), R_OK), 0) << "no photo saved";
   }
@@ -96,7 +98,7 @@ TEST_F(DegenerateBurst, NoMotion) {
   motiontest::Burst b;
   ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(6), kW, kH, kFrames, &b));
   for (int32_t v = 0; v < kFrames; ++v) b.pixels[v] = b.pixels[b.scene.reference()];
-  ExpectUnblurredWithWarning(b, "sideways");
+  ExpectUnblurredWithWarning(Write(b), "sideways");
 }
 
 TEST_F(DegenerateBurst, PureRotation) {
@@ -104,7 +106,7 @@ TEST_F(DegenerateBurst, PureRotation) {
   p.max_translation = 0;
   motiontest::Burst b;
   ASSERT_TRUE(motiontest::MakeBurst(p, kW, kH, kFrames, &b));
-  ExpectUnblurredWithWarning(b, "sideways");
+  ExpectUnblurredWithWarning(Write(b), "sideways");
 }
 
 TEST_F(DegenerateBurst, TooFewFeatures) {
@@ -115,14 +117,32 @@ TEST_F(DegenerateBurst, TooFewFeatures) {
       b.pixels[v][i] = static_cast<uint8_t>(100 + (i / 3 % kW) / 16 + v);
     }
   }
-  ExpectUnblurredWithWarning(b, "texture");
+  ExpectUnblurredWithWarning(Write(b), "texture");
 }
 
 TEST_F(DegenerateBurst, BlurredFrame) {
   motiontest::Burst b;
   ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(9), kW, kH, kFrames, &b));
   motiontest::Blur(&b.pixels[3], kW, kH);
-  ExpectUnblurredWithWarning(b, "frame 3 is blurred");
+  ExpectUnblurredWithWarning(Write(b), "frame 3 is blurred");
+}
+
+// 16x8192 into the 640x480 working bound is under a pixel wide: no depth, but still a photo.
+TEST_F(DegenerateBurst, FramesTooThinForDepth) {
+  for (const bool tall : {true, false}) {
+    const int32_t w = tall ? 16 : 8192, h = tall ? 8192 : 16;
+    std::vector<uint16_t> samples(static_cast<size_t>(w) * h * 3);
+    for (size_t i = 0; i < samples.size(); ++i) samples[i] = static_cast<uint16_t>(i * 7 % 251);
+    std::vector<std::string> paths;
+    for (int32_t v = 0; v < 3; ++v) {
+      paths.push_back(dir_ + "/thin" + std::to_string(v) + ".ppm");
+      ASSERT_TRUE(test::WriteFile(paths.back(), test::EncodePnm("P6", w, h, 255, samples)));
+    }
+    for (const Geometry g : {Geometry::kAuto, Geometry::kRectified}) {
+      SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
+      ExpectUnblurredWithWarning(paths, "too thin for depth", g, int64_t{w} * h);
+    }
+  }
 }
 
 }  // namespace

@@ -17,27 +17,16 @@
 #include "firmware/jpeg/jpeg_writer.h"
 #include "sim/files/exif_focal.h"
 #include "tests/algo/motion/burst.h"
+#include "tests/firmware/cli/cli_fixture.h"
 #include "tests/sim/files/test_images.h"
 
 namespace lb {
 namespace {
 
+using clitest::Cli;
+using clitest::Result;
+using clitest::Slurp;
 using test::Bytes;
-
-struct Result {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string Slurp(const std::string& path) {
-  std::string s;
-  if (FILE* f = fopen(path.c_str(), "rb")) {
-    char buf[4096];
-    for (size_t n; (n = fread(buf, 1, sizeof(buf), f)) > 0;) s.append(buf, n);
-    fclose(f);
-  }
-  return s;
-}
 
 // A valid 64x48 RGB PNG of one grey, for tests that break one of its chunks.
 Bytes GreyPng() {
@@ -48,66 +37,6 @@ Bytes GreyPng() {
   Bytes png;
   return test::EncodePng(spec, &png) ? png : Bytes{};
 }
-
-class Cli : public ::testing::Test {
- protected:
-  void SetUp() override {
-    char tmpl[] = "/tmp/refocus-cli-XXXXXX";
-    ASSERT_NE(mkdtemp(tmpl), nullptr);
-    dir_ = tmpl;
-    out_dir_ = dir_ + "/out";
-    ASSERT_EQ(mkdir(out_dir_.c_str(), 0755), 0);
-  }
-  void TearDown() override { (void)system(("rm -rf " + dir_).c_str()); }
-
-  Result Run(const std::vector<std::string>& args) {
-    std::string cmd = REFOCUS_BIN;
-    for (const auto& a : args) cmd += " '" + a + "'";
-    cmd += " >" + dir_ + "/stdout 2>" + dir_ + "/stderr";
-    Result r;
-    const int status = system(cmd.c_str());
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = Slurp(dir_ + "/stdout");
-    r.err = Slurp(dir_ + "/stderr");
-    return r;
-  }
-
-  // A valid W x H RGB burst of `n` PPM files; returns their paths.
-  std::vector<std::string> PpmBurst(int n, int w, int h) {
-    std::vector<std::string> paths;
-    for (int i = 0; i < n; ++i) {
-      std::vector<uint16_t> samples(static_cast<size_t>(w) * h * 3);
-      for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x)
-          for (int c = 0; c < 3; ++c) samples[(y * w + x) * 3 + c] = test::Smooth(x + 2 * i, y, c);
-      paths.push_back(dir_ + "/f" + std::to_string(i) + ".ppm");
-      EXPECT_TRUE(test::WriteFile(paths.back(), test::EncodePnm("P6", w, h, 255, samples)));
-    }
-    return paths;
-  }
-
-  // The bad-input contract: exit 1, one line naming `names` and `problem`, no output file.
-  void ExpectCleanFailure(const Result& r, const std::string& names, const std::string& problem) {
-    EXPECT_EQ(r.exit_code, 1) << r.err;
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    EXPECT_NE(r.err.find(names), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find(problem), std::string::npos) << r.err;
-    EXPECT_TRUE(OutDirEmpty()) << "a file was left in " << out_dir_;
-  }
-
-  bool OutDirEmpty() {
-    DIR* d = opendir(out_dir_.c_str());
-    if (!d) return true;
-    int entries = 0;
-    while (dirent* e = readdir(d)) entries += e->d_name[0] != '.' || e->d_name[1] > '.';
-    closedir(d);
-    return entries == 0;
-  }
-
-  std::string Out() const { return out_dir_ + "/photo.jpg"; }
-
-  std::string dir_, out_dir_;
-};
 
 TEST_F(Cli, SyntheticRunWritesAJpegOfTheConfiguredSize) {
   Result r = Run({"run", "--synthetic", "--size", "200x150", "--labels", "16", "--out", Out()});
@@ -421,27 +350,14 @@ TEST_F(Cli, HugeViewsAreRefusedFromTheirHeaders) {
   ASSERT_TRUE(test::WriteFile(big, ZeroPng(16384, 16384)));
   std::vector<std::string> args = {"depth", "--disparity-out", out_dir_ + "/d.pfm", "--views"};
   for (int v = 0; v < 16; ++v) args.push_back(big);
-  const pid_t pid = fork();
-  ASSERT_GE(pid, 0);
-  if (pid == 0) {
-    if (!freopen((dir_ + "/stderr").c_str(), "w", stderr)) _exit(126);
-    std::vector<char*> argv = {const_cast<char*>(REFOCUS_BIN)};
-    for (auto& a : args) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    execv(REFOCUS_BIN, argv.data());
-    _exit(127);
-  }
-  int status = 0;
-  rusage usage = {};
-  ASSERT_EQ(wait4(pid, &status, 0, &usage), pid);
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 1);
-  const std::string err = Slurp(dir_ + "/stderr");
-  EXPECT_NE(err.find(big), std::string::npos) << err;
-  EXPECT_NE(err.find("16384x16384"), std::string::npos) << err;
-  EXPECT_LT(usage.ru_maxrss, 64 * 1024) << "peak RSS in KiB";
+  long rss_kib = 0;
+  const Result r = RunMeasured(args, &rss_kib);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find(big), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("16384x16384"), std::string::npos) << r.err;
+  EXPECT_LT(rss_kib, 64 * 1024) << "peak RSS in KiB";
   printf("16 views of a %zu-byte 16384x16384 PNG: refused at %ld KiB peak RSS\n", Slurp(big).size(),
-         usage.ru_maxrss);
+         rss_kib);
   EXPECT_TRUE(OutDirEmpty());
 }
 
@@ -547,6 +463,24 @@ TEST_F(Cli, TheFramesOrientationGoesIntoThePhoto) {
   const Result r = Run(args);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(ExifOrientation(Out().c_str()), 6);
+  // And from the photo into its re-render.
+  const std::string again = out_dir_ + "/again.jpg";
+  const Result rr = Run({"rerender", Out(), "--out", again});
+  ASSERT_EQ(rr.exit_code, 0) << rr.err;
+  EXPECT_EQ(ExifOrientation(again.c_str()), 6);
+}
+
+// Issue 13, defect 7: a size the camera cannot take is refused naming the file that has it.
+TEST_F(Cli, SizeRefusalsNameTheFile) {
+  const std::vector<std::string> tiny = PpmBurst(2, 8, 8);
+  Result r = Run({"run", "--out", Out(), tiny[0], tiny[1]});
+  ExpectCleanFailure(r, tiny[0], "8x8");
+  r = Run({"depth", "--disparity-out", out_dir_ + "/d.pfm", "--views", tiny[0], tiny[1]});
+  ExpectCleanFailure(r, tiny[0], "too small to follow the camera's motion");
+  const std::vector<std::string> tinier = PpmBurst(2, 4, 4);
+  r = Run({"depth", "--geometry", "rectified", "--disparity-out", out_dir_ + "/d.pfm", "--views",
+           tinier[0], tinier[1]});
+  ExpectCleanFailure(r, tinier[0], "4x4");
 }
 
 TEST_F(Cli, UsageErrorsExitWithTwo) {
