@@ -122,11 +122,10 @@ int DepthCommand(int argc, char** argv) {
   const char* preview = nullptr;
   int32_t ref = -1;
   DepthConfig c;
-  c.labels = 64;
   c.subpixel = false;
   bool range_given = false;
-  Geometry geometry = Geometry::kAuto;
-  int32_t focal_35mm = 0;
+  JobOptions settings;  // --geometry, --focal-35mm and --labels, as run takes them
+  settings.pipeline.geometry = Geometry::kAuto;
   std::string error;
   for (int i = 1; i < argc; ++i) {  // argv[0] is the subcommand's name
     const char* a = argv[i];
@@ -148,18 +147,14 @@ int DepthCommand(int argc, char** argv) {
       ok = need() && (pfm = argv[++i]);
     } else if (!strcmp(a, "--preview")) {
       ok = need() && (preview = argv[++i]);
-    } else if (!strcmp(a, "--geometry")) {
-      ok = need() && ParseGeometry(argv[++i], &geometry, &error);
-    } else if (!strcmp(a, "--focal-35mm")) {
-      ok = need() && ParseInt(argv[++i], 8, 2000, &focal_35mm, &error);
+    } else if (!strcmp(a, "--geometry") || !strcmp(a, "--focal-35mm") || !strcmp(a, "--labels")) {
+      ok = need() && ParseSettingNamed(a + 2, argv[++i], &settings, &error);
     } else if (!strcmp(a, "--ref")) {
-      ok = need() && ParseInt(argv[++i], 0, DepthConfig::kMaxViews - 1, &ref, &error);
-    } else if (!strcmp(a, "--labels")) {
-      ok = need() && ParseInt(argv[++i], 2, DepthConfig::kMaxLabels, &c.labels, &error);
+      ok = need() && ParseWholeNumber(argv[++i], 0, DepthConfig::kMaxViews - 1, &ref, &error);
     } else if (!strcmp(a, "--smoothness")) {
-      ok = need() && ParseInt(argv[++i], 0, 4096, &c.smooth_weight, &error);
+      ok = need() && ParseWholeNumber(argv[++i], 0, 4096, &c.smooth_weight, &error);
     } else if (!strcmp(a, "--cycles")) {
-      ok = need() && ParseInt(argv[++i], 0, 32, &c.max_cycles, &error);
+      ok = need() && ParseWholeNumber(argv[++i], 0, 32, &c.max_cycles, &error);
     } else if (!strcmp(a, "--disparity")) {
       ok = need() && ParseDisparityRange(argv[++i], &c.disp_min_q8, &c.disp_max_q8, &error);
       range_given = ok;
@@ -169,6 +164,9 @@ int DepthCommand(int argc, char** argv) {
     }
     if (!ok) return Usage(error.c_str());
   }
+  const Geometry geometry = settings.pipeline.geometry;
+  const int32_t focal_35mm = settings.focal_35mm;
+  c.labels = settings.pipeline.labels;
   if (files.size() < 2) return Usage("--views needs at least two files");
   if (files.size() > static_cast<size_t>(DepthConfig::kMaxViews)) {
     return Usage("--views takes at most 16 files");

@@ -17,7 +17,8 @@ const char kUsage[] =
     "\n"
     "Renders a new focus from a refocusable JPEG alone (one written by `refocus run`, or any file\n"
     "with a RangeInverse GDepth depth map and a GImage original), no burst needed.\n"
-    "  --out OUT.jpg          written atomically: the name holds a whole JPEG or nothing\n";
+    "  --out OUT.jpg          written atomically: the name holds a whole JPEG or nothing\n"
+    "Lens (refocusd.conf takes the same settings, with _ for -):\n";
 
 enum Opt { kOut = 256, kHelp };
 
@@ -30,11 +31,13 @@ int Usage(const std::string& error) {
 }  // namespace
 
 int RerenderCommand(int argc, char** argv) {
-  const std::vector<option> options = WithLensOptions({
-      {"out", required_argument, nullptr, kOut},
-      {"help", no_argument, nullptr, kHelp},
-  });
-  LensOptions lens;
+  const std::vector<option> options = WithSettings(
+      {
+          {"out", required_argument, nullptr, kOut},
+          {"help", no_argument, nullptr, kHelp},
+      },
+      {SettingGroup::kLens});
+  JobOptions lens;
   std::string out_path, error;
   optind = 1;
   opterr = 0;  // the messages below say it in one line
@@ -47,20 +50,20 @@ int RerenderCommand(int argc, char** argv) {
         out_path = optarg;
         break;
       case kHelp:
-        printf("%s%s", kUsage, kLensUsage);
+        printf("%s%s", kUsage, SettingsHelp(SettingGroup::kLens).c_str());
         return 0;
       case ':':
         return Usage(std::string(argv[optind - 1]) + " needs a value");
       case '?':
         return Usage(std::string("unknown option '") + argv[optind - 1] + "'");
       default:
-        ok = ParseLensOption(c, optarg, &lens, &error);
+        ok = ParseSettingOption(c, optarg, &lens, &error);
     }
     if (!ok) return Usage(error);
   }
   RerenderOptions o;
   o.render = lens.render;
-  o.max_blur_radius = lens.max_radius;
+  o.max_blur_radius = lens.pipeline.max_blur_radius;
   o.quality = lens.quality;
   if (optind != argc - 1) return Usage("give exactly one input file");
   if (out_path.empty()) return Usage("--out OUT.jpg is required");

@@ -24,41 +24,28 @@ const char kUsage[] =
     "  --synthetic            the built-in synthetic scene (a clone carries no photos)\n"
     "  --input DIR            every .ppm .pgm .png .jpg in DIR, sorted by name, as the burst\n"
     "  FILE...                these files, left to right, as the burst\n"
-    "  --size WxH             synthetic frame size (default 1280x960, 16x16 .. 8192x8192)\n"
-    "  --frames N             synthetic burst length (default 5)\n"
     "  --seed S               synthetic scene seed (default 1)\n"
     "  --motion M             synthetic camera motion: handheld or rectified (default: handheld\n"
     "                         with --geometry auto, rectified with --geometry rectified)\n"
-    "Depth:\n"
-    "  --geometry G           auto: a handheld burst, the camera motion is estimated from the\n"
-    "                         frames (default); rectified: equally spaced views, left to right\n"
-    "  --focal-35mm F         the lens as a 35 mm equivalent focal length (auto geometry; "
-    "default:\n"
-    "                         the sensor's or the files' EXIF, else a ~64 degree field of view)\n"
+    "Burst (the synthetic scene's; files bring their own size and count; --size is\n"
+    "--resolution's older name):\n";
+const char kDepthUsage[] =
     "  --ref K                reference frame, 0-based (default: the middle one)\n"
-    "  --labels N             depth labels (default 64)\n"
     "  --disparity MIN,MAX    label range, working px per view step (rectified geometry with\n"
-    "                         files; default 0,16; auto geometry finds its own)\n"
-    "  --working-size WxH     largest working resolution for depth (default 640x480)\n"
+    "                         files; default 0,16; auto geometry finds its own)\n";
+const char kOutputUsage[] =
     "Output:\n"
-    "  --out OUT.jpg          written atomically: the name holds a whole JPEG or nothing\n";
+    "  --out OUT.jpg          written atomically: the name holds a whole JPEG or nothing\n"
+    "Lens (refocusd.conf takes the same settings, with _ for -):\n";
 
-enum Opt {
-  kSynthetic = 256,
-  kInput,
-  kSize,
-  kFrames,
-  kSeed,
-  kMotion,
-  kGeometry,
-  kFocal,
-  kRef,
-  kLabels,
-  kDisparity,
-  kWorking,
-  kOut,
-  kHelp
-};
+enum Opt { kSynthetic = 256, kInput, kSeed, kMotion, kRef, kDisparity, kOut, kHelp };
+
+int Help() {
+  printf("%s%sDepth:\n%s%s%s%s", kUsage, SettingsHelp(SettingGroup::kBurst).c_str(),
+         SettingsHelp(SettingGroup::kDepth).c_str(), kDepthUsage, kOutputUsage,
+         SettingsHelp(SettingGroup::kLens).c_str());
+  return 0;
+}
 
 int Usage(const std::string& error) {
   fprintf(stderr, "refocus run: %s ('refocus run --help' lists the options)\n", error.c_str());
@@ -80,26 +67,22 @@ int RunCommand(int argc, char** argv) {
   SceneParams scene;
   int32_t seed = 1;
 
-  const std::vector<option> options = WithLensOptions({
-      {"synthetic", no_argument, nullptr, kSynthetic},
-      {"input", required_argument, nullptr, kInput},
-      {"size", required_argument, nullptr, kSize},
-      {"frames", required_argument, nullptr, kFrames},
-      {"seed", required_argument, nullptr, kSeed},
-      {"motion", required_argument, nullptr, kMotion},
-      {"geometry", required_argument, nullptr, kGeometry},
-      {"focal-35mm", required_argument, nullptr, kFocal},
-      {"ref", required_argument, nullptr, kRef},
-      {"labels", required_argument, nullptr, kLabels},
-      {"disparity", required_argument, nullptr, kDisparity},
-      {"working-size", required_argument, nullptr, kWorking},
-      {"out", required_argument, nullptr, kOut},
-      {"help", no_argument, nullptr, kHelp},
-  });
-  LensOptions lens;
+  const std::vector<option> options = WithSettings(
+      {
+          {"synthetic", no_argument, nullptr, kSynthetic},
+          {"input", required_argument, nullptr, kInput},
+          {"seed", required_argument, nullptr, kSeed},
+          {"motion", required_argument, nullptr, kMotion},
+          {"ref", required_argument, nullptr, kRef},
+          {"disparity", required_argument, nullptr, kDisparity},
+          {"out", required_argument, nullptr, kOut},
+          {"help", no_argument, nullptr, kHelp},
+      },
+      {SettingGroup::kBurst, SettingGroup::kDepth, SettingGroup::kLens});
   optind = 1;
   opterr = 0;  // the messages below say it in one line
-  for (int c; (c = getopt_long(argc, argv, ":", options.data(), nullptr)) != -1;) {
+  int index = -1;
+  for (int c; (index = -1, c = getopt_long(argc, argv, ":", options.data(), &index)) != -1;) {
     bool ok = true;
     switch (c) {
       case kSynthetic:
@@ -110,42 +93,22 @@ int RunCommand(int argc, char** argv) {
         if (!ok) error = "--input given twice";
         input_dir = optarg;
         break;
-      case kSize:
-        ok = ParseSize(optarg, &job.sensor.width, &job.sensor.height, &error);
-        synthetic_only = "--size";
-        break;
-      case kFrames:
-        ok = ParseInt(optarg, 1, 16, &job.sensor.frames, &error);
-        synthetic_only = "--frames";
-        break;
       case kSeed:
-        ok = ParseInt(optarg, 0, INT32_MAX, &seed, &error);
+        ok = ParseWholeNumber(optarg, 0, INT32_MAX, &seed, &error);
         break;
       case kMotion:
         motion = optarg;
         ok = !strcmp(optarg, "handheld") || !strcmp(optarg, "rectified");
         if (!ok) error = std::string("motion '") + optarg + "' is neither handheld nor rectified";
         break;
-      case kGeometry:
-        ok = ParseGeometry(optarg, &job.pipeline.geometry, &error);
-        break;
-      case kFocal:
-        ok = ParseInt(optarg, 8, 2000, &job.focal_35mm, &error);
-        break;
       case kRef:
-        ok = ParseInt(optarg, 0, 15, &job.pipeline.reference, &error);
-        break;
-      case kLabels:
-        ok = ParseInt(optarg, 2, 256, &job.pipeline.labels, &error);
+        ok = ParseWholeNumber(optarg, 0, PipelineConfig::kMaxFrames - 1, &job.pipeline.reference,
+                              &error);
         break;
       case kDisparity:
         ok = ParseDisparityRange(optarg, &job.pipeline.disp_min_q8, &job.pipeline.disp_max_q8,
                                  &error);
         range_given = true;
-        break;
-      case kWorking:
-        ok = ParseSize(optarg, &job.pipeline.max_working_width, &job.pipeline.max_working_height,
-                       &error);
         break;
       case kOut:
         ok = out_path.empty();
@@ -153,27 +116,26 @@ int RunCommand(int argc, char** argv) {
         out_path = optarg;
         break;
       case kHelp:
-        printf("%s%s", kUsage, kLensUsage);
-        return 0;
+        return Help();
       case ':':
         return Usage(std::string(argv[optind - 1]) + " needs a value");
       case '?':
         return Usage(std::string("unknown option '") + argv[optind - 1] + "'");
       default:
-        ok = ParseLensOption(c, optarg, &lens, &error);
+        ok = ParseSettingOption(c, optarg, &job, &error);
+        if (ok && SettingOfOption(c)->group == SettingGroup::kBurst) {
+          synthetic_only = options[static_cast<size_t>(index)].name;  // as the user spelled it
+        }
     }
     if (!ok) return Usage(error);
   }
-  job.render = lens.render;
-  job.pipeline.max_blur_radius = lens.max_radius;
-  job.quality = lens.quality;
   std::vector<std::string> files(argv + optind, argv + argc);
   if (out_path.empty()) return Usage("--out OUT.jpg is required");
   if (synthetic + !input_dir.empty() + !files.empty() > 1) {
     return Usage("give one input: --synthetic, --input DIR or FILE...");
   }
   if (synthetic_only && (!input_dir.empty() || !files.empty())) {
-    return Usage(std::string(synthetic_only) +
+    return Usage(std::string("--") + synthetic_only +
                  " is for the synthetic scene: files bring their own size and count");
   }
 
