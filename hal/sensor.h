@@ -34,6 +34,12 @@ class Sensor {
  public:
   virtual ~Sensor() = default;
   virtual const char* name() const = 0;
+  // Checks, without capturing and without keeping the device, that the camera is there and is
+  // one this backend can drive (a V4L2 node answers as a streaming capture node, libcamera lists
+  // the camera). The daemon runs it before it says "ready" and again while it waits for a camera
+  // plugged in later; the message names the device ("camera /dev/video7: no such device").
+  // Sources with nothing to look for beforehand (the synthetic scene) keep this default.
+  virtual Status Probe() { return Status::Ok(); }
   // Negotiates the mode; may allocate (it runs before the pipeline's no-allocation window).
   virtual Status Configure(const SensorConfig& config, SensorMode* mode) = 0;
   // Captures `mode.frames` frames into `sink`, frame i with FrameInfo::index == i.

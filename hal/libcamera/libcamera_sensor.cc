@@ -78,6 +78,9 @@ struct LibcameraSensor::Impl {
                   strerror_r(err, text, sizeof(text)), err);
   }
 
+  Status StartManager();
+  // The configured camera (or the first one) among those the manager lists now.
+  Status Find(std::shared_ptr<lc::Camera>* found) const;
   Status Open();
   Status ConfigureStream(const SensorConfig& config);
   Status MapBuffers();
@@ -89,27 +92,42 @@ struct LibcameraSensor::Impl {
   void Release();
 };
 
-Status LibcameraSensor::Impl::Open() {
-  if (!manager) {
-    auto m = std::make_unique<lc::CameraManager>();
-    if (int r = m->start(); r < 0) {
-      char text[96];
-      return Status(Code::kIoError, "libcamera: CameraManager::start failed: %s (errno %d)",
-                    strerror_r(-r, text, sizeof(text)), -r);
-    }
-    manager = std::move(m);
+Status LibcameraSensor::Impl::StartManager() {
+  if (manager) return Status::Ok();
+  auto m = std::make_unique<lc::CameraManager>();
+  if (int r = m->start(); r < 0) {
+    char text[96];
+    return Status(Code::kIoError, "libcamera: CameraManager::start failed: %s (errno %d)",
+                  strerror_r(-r, text, sizeof(text)), -r);
   }
-  std::vector<std::shared_ptr<lc::Camera>> cameras = manager->cameras();
+  manager = std::move(m);
+  return Status::Ok();
+}
+
+Status LibcameraSensor::Impl::Find(std::shared_ptr<lc::Camera>* found) const {
+  const std::vector<std::shared_ptr<lc::Camera>> cameras = manager->cameras();
   if (wanted_id.empty()) {
     if (cameras.empty()) return Status(Code::kNotFound, "libcamera: no camera found");
-    camera = cameras.front();
-  } else {
-    camera = manager->get(wanted_id);
-    if (!camera) {
-      return Status(Code::kNotFound, "libcamera: no camera \"%s\" (%zu cameras listed)",
-                    wanted_id.c_str(), cameras.size());
+    *found = cameras.front();
+    return Status::Ok();
+  }
+  for (const std::shared_ptr<lc::Camera>& c : cameras) {
+    if (c->id() == wanted_id) {
+      *found = c;
+      return Status::Ok();
     }
   }
+  std::string listed;
+  for (const std::shared_ptr<lc::Camera>& c : cameras) {
+    listed += (listed.empty() ? "'" : ", '") + c->id() + "'";
+  }
+  return Status(Code::kNotFound, "libcamera: no camera '%s' (found: %s)", wanted_id.c_str(),
+                listed.empty() ? "none" : listed.c_str());
+}
+
+Status LibcameraSensor::Impl::Open() {
+  LB_RETURN_IF_ERROR(StartManager());
+  LB_RETURN_IF_ERROR(Find(&camera));
   id = camera->id();
   if (int r = camera->acquire(); r < 0) {
     camera.reset();
@@ -398,6 +416,14 @@ Status LibcameraSensor::CaptureBurst(FrameSink& sink) {
   std::lock_guard<std::mutex> lock(d.mutex);
   d.completed.clear();
   return status;
+}
+
+Status LibcameraSensor::Probe() {
+  Impl& d = *impl_;
+  if (d.camera) return Status::Ok();  // configured: acquired by this sensor
+  LB_RETURN_IF_ERROR(d.StartManager());
+  std::shared_ptr<lc::Camera> camera;
+  return d.Find(&camera);
 }
 
 void LibcameraSensor::Stop() { impl_->Release(); }

@@ -28,6 +28,11 @@ class LibcameraSensor : public Sensor {
   LibcameraSensor& operator=(const LibcameraSensor&) = delete;
 
   const char* name() const override { return "libcamera"; }
+  // Starts the camera manager (kept for Configure) and looks for the configured camera, or any
+  // when none is named: kNotFound "libcamera: no camera found" or "libcamera: no camera 'X'
+  // (found: a, b)". Does not acquire the camera. A camera plugged in later shows up through
+  // libcamera's hotplug handling, which, like libcamera's device enumeration itself, needs udev.
+  Status Probe() override;
   Status Configure(const SensorConfig& config, SensorMode* mode) override;
   Status CaptureBurst(FrameSink& sink) override;
   void Stop() override;

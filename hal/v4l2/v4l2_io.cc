@@ -48,7 +48,7 @@ V4l2Io& SystemV4l2Io() {
   return io;
 }
 
-const char* ErrnoText(int err, char* buffer, size_t size) {
+const char* V4l2ErrnoText(int err, char* buffer, size_t size) {
   // The GNU strerror_r may return a static string instead of filling the buffer.
   return strerror_r(err, buffer, size);
 }

@@ -24,7 +24,10 @@ class V4l2Io {
 // The real kernel interface.
 V4l2Io& SystemV4l2Io();
 
-// strerror for a positive errno value, thread-safe.
-const char* ErrnoText(int err, char* buffer, size_t size);
+// strerror for a positive errno value, thread-safe; the text may be a static string instead of
+// `buffer`. Named apart from firmware/storage's lb::ErrnoText, which takes the same arguments
+// and returns nothing: under one name a program linking both got this one for every call that
+// was not inlined, and printed that function's unfilled buffer.
+const char* V4l2ErrnoText(int err, char* buffer, size_t size);
 
 }  // namespace lb

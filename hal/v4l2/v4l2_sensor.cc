@@ -19,6 +19,22 @@ int64_t MonotonicMs() {
   return static_cast<int64_t>(ts.tv_sec) * 1000 + ts.tv_nsec / 1000000;
 }
 
+// What a node that is no single-planar capture node is, for the message that refuses it.
+const char* NodeKind(uint32_t caps) {
+  if (caps & (V4L2_CAP_VIDEO_M2M | V4L2_CAP_VIDEO_M2M_MPLANE)) {
+    return "a memory-to-memory device: a codec or scaler";
+  }
+  if (caps & (V4L2_CAP_VIDEO_OUTPUT | V4L2_CAP_VIDEO_OUTPUT_MPLANE | V4L2_CAP_VIDEO_OUTPUT_OVERLAY))
+    return "a video output";
+  // A UVC camera has one of these next to its capture node.
+  if (caps & V4L2_CAP_META_CAPTURE) return "a metadata node: the pictures come from another node";
+  if (caps & (V4L2_CAP_VBI_CAPTURE | V4L2_CAP_SLICED_VBI_CAPTURE)) return "a VBI (teletext) node";
+  if (caps & V4L2_CAP_SDR_CAPTURE) return "a software-defined radio";
+  if (caps & (V4L2_CAP_RADIO | V4L2_CAP_TUNER)) return "a radio tuner";
+  if (caps & V4L2_CAP_TOUCH) return "a touch sensor";
+  return "no video capture capability";
+}
+
 }  // namespace
 
 V4l2Sensor::V4l2Sensor(const V4l2Options& options, V4l2Io* io)
@@ -35,7 +51,55 @@ Status V4l2Sensor::IoctlError(const char* what, int err) const {
   char text[96];
   Code code = err == ENODEV ? Code::kNotFound : err == EBUSY ? Code::kBusy : Code::kIoError;
   return Status(code, "%s: %s failed: %s (errno %d)", device_, what,
-                ErrnoText(err, text, sizeof(text)), err);
+                V4l2ErrnoText(err, text, sizeof(text)), err);
+}
+
+Status V4l2Sensor::CheckCaps(const v4l2_capability& cap) const {
+  const uint32_t caps =
+      (cap.capabilities & V4L2_CAP_DEVICE_CAPS) ? cap.device_caps : cap.capabilities;
+  const char* card = reinterpret_cast<const char*>(cap.card);
+  if (caps & V4L2_CAP_VIDEO_CAPTURE) {
+    if (caps & V4L2_CAP_STREAMING) return Status::Ok();
+    return Status(Code::kUnsupported,
+                  "%s (%.32s): a capture node without streaming I/O (read() only); mmap "
+                  "streaming is needed",
+                  device_, card);
+  }
+  if (caps & V4L2_CAP_VIDEO_CAPTURE_MPLANE) {
+    return Status(Code::kUnsupported,
+                  "%s (%.32s): a multi-planar capture node; the v4l2 backend reads single-planar "
+                  "nodes only",
+                  device_, card);
+  }
+  return Status(Code::kUnsupported, "%s (%.32s): not a capture device (%s; caps 0x%08x)", device_,
+                card, NodeKind(caps), caps);
+}
+
+Status V4l2Sensor::Probe() {
+  char text[96];
+  const int fd = io_->Open(device_, O_RDWR | O_NONBLOCK | O_CLOEXEC);
+  if (fd == -ENOENT || fd == -ENODEV || fd == -ENXIO) {
+    // ENODEV, ENXIO: a node whose driver is gone (an unplugged camera).
+    return Status(Code::kNotFound, "camera %s: no such device", device_);
+  }
+  if (fd == -EISDIR)
+    return Status(Code::kUnsupported, "camera %s: not a V4L2 device (a folder)", device_);
+  if (fd < 0) {
+    return Status(Code::kIoError, "camera %s: cannot open: %s (errno %d)", device_,
+                  V4l2ErrnoText(-fd, text, sizeof(text)), -fd);
+  }
+  v4l2_capability cap;
+  memset(&cap, 0, sizeof(cap));
+  const int r = io_->Ioctl(fd, VIDIOC_QUERYCAP, &cap);
+  (void)io_->Close(fd);
+  // ENOTTY: a file or a device of another kind; every V4L2 node answers QUERYCAP.
+  if (r == -ENOTTY || r == -EINVAL) {
+    return Status(Code::kUnsupported, "camera %s: not a V4L2 device", device_);
+  }
+  if (r < 0) return IoctlError("VIDIOC_QUERYCAP", -r).Prefix("camera ");
+  Status s = CheckCaps(cap);
+  if (!s.ok()) s.Prefix("camera ");
+  return s;
 }
 
 Status V4l2Sensor::Configure(const SensorConfig& config, SensorMode* mode) {
@@ -75,7 +139,7 @@ Status V4l2Sensor::OpenAndNegotiate(const SensorConfig& config) {
   if (fd < 0) {
     char text[96];
     return Status(fd == -ENOENT ? Code::kNotFound : Code::kIoError,
-                  "%s: cannot open: %s (errno %d)", device_, ErrnoText(-fd, text, sizeof(text)),
+                  "%s: cannot open: %s (errno %d)", device_, V4l2ErrnoText(-fd, text, sizeof(text)),
                   -fd);
   }
   fd_ = fd;
@@ -84,12 +148,7 @@ Status V4l2Sensor::OpenAndNegotiate(const SensorConfig& config) {
   memset(&cap, 0, sizeof(cap));
   if (int r = io_->Ioctl(fd_, VIDIOC_QUERYCAP, &cap); r < 0)
     return IoctlError("VIDIOC_QUERYCAP", -r);
-  uint32_t caps = (cap.capabilities & V4L2_CAP_DEVICE_CAPS) ? cap.device_caps : cap.capabilities;
-  if (!(caps & V4L2_CAP_VIDEO_CAPTURE) || !(caps & V4L2_CAP_STREAMING)) {
-    return Status(Code::kUnsupported,
-                  "%s (%.32s): not a single-planar streaming capture node (caps 0x%08x)", device_,
-                  reinterpret_cast<const char*>(cap.card), caps);
-  }
+  LB_RETURN_IF_ERROR(CheckCaps(cap));
 
   uint32_t listed[64];
   size_t count = 0;

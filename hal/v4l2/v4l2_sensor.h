@@ -39,6 +39,11 @@ class V4l2Sensor : public Sensor {
   V4l2Sensor& operator=(const V4l2Sensor&) = delete;
 
   const char* name() const override { return "v4l2"; }
+  // Opens the node, asks VIDIOC_QUERYCAP and closes it again (V4L2 allows several opens, so this
+  // works while another process streams): kNotFound when nothing is at the path, kUnsupported
+  // for a file or device that is no single-planar streaming capture node (the message says what
+  // it is: not a V4L2 device, an output, a memory-to-memory device, a metadata node ...).
+  Status Probe() override;
   Status Configure(const SensorConfig& config, SensorMode* mode) override;
   Status CaptureBurst(FrameSink& sink) override;
   void Stop() override;
@@ -54,6 +59,8 @@ class V4l2Sensor : public Sensor {
   };
 
   Status IoctlError(const char* what, int err) const;
+  // Why a node with these QUERYCAP answers cannot be streamed, or Ok.
+  Status CheckCaps(const v4l2_capability& cap) const;
   Status OpenAndNegotiate(const SensorConfig& config);
   Status SetFrameRate();
   Status MapBuffers();

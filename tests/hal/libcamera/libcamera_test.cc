@@ -124,5 +124,25 @@ TEST(LibcameraSensorTest, ErrorsWithoutACamera) {
   EXPECT_EQ(sensor.Configure(config, &mode).code(), Code::kNotFound);  // still answers
 }
 
+// What the daemon logs before "ready" when libcamera lacks the camera.
+TEST(LibcameraSensorTest, ProbeNamesTheMissingCamera) {
+  {
+    LibcameraOptions options;
+    options.camera_id = "/base/no/such/camera";
+    LibcameraSensor sensor(options);
+    Status s = sensor.Probe();
+    if (s.ok()) GTEST_SKIP() << "this machine has a camera named like that";
+    EXPECT_EQ(s.code(), Code::kNotFound) << s.message();
+    const std::string m = s.message();
+    EXPECT_EQ(m.rfind("libcamera: no camera '/base/no/such/camera' (found: ", 0), 0u) << m;
+    EXPECT_EQ(sensor.Probe().code(), Code::kNotFound);  // asked again, the same answer
+  }
+  LibcameraSensor any(LibcameraOptions{});
+  Status s = any.Probe();
+  if (s.ok()) GTEST_SKIP() << "this machine has a camera";
+  EXPECT_EQ(s.code(), Code::kNotFound);
+  EXPECT_STREQ(s.message(), "libcamera: no camera found");
+}
+
 }  // namespace
 }  // namespace lb

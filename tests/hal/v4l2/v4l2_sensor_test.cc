@@ -2,7 +2,11 @@
 
 #include <errno.h>
 #include <gtest/gtest.h>
+#include <stdlib.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -326,6 +330,116 @@ TEST(V4l2SensorTest, ReconfigureAndStopReleaseEverything) {
   // The destructor stops too.
   EXPECT_EQ(dev.open_fds, 0);
   EXPECT_EQ(dev.mapped, 0);
+}
+
+// Probe: what the daemon logs before "ready", and --check-config prints.
+Status ProbeFake(FakeV4l2* dev, const char* device = "/dev/video7") {
+  V4l2Options options;
+  options.device = device;
+  V4l2Sensor sensor(options, dev);
+  Status s = sensor.Probe();
+  EXPECT_EQ(dev->open_fds, 0) << "the probe keeps no descriptor";
+  return s;
+}
+
+TEST(V4l2ProbeTest, StreamingCaptureNodePasses) {
+  FakeV4l2 dev;
+  Status s = ProbeFake(&dev);
+  EXPECT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(dev.mapped, 0);
+  EXPECT_EQ(dev.streamon_calls, 0);
+}
+
+TEST(V4l2ProbeTest, MissingNodeIsNoSuchDevice) {
+  FakeV4l2 dev;
+  dev.exists = false;
+  Status s = ProbeFake(&dev);
+  EXPECT_EQ(s.code(), Code::kNotFound);
+  EXPECT_STREQ(s.message(), "camera /dev/video7: no such device");
+}
+
+TEST(V4l2ProbeTest, FileThatIsNoV4l2NodeSaysSo) {
+  FakeV4l2 dev;
+  dev.fail_request = VIDIOC_QUERYCAP;
+  dev.fail_errno = ENOTTY;
+  Status s = ProbeFake(&dev);
+  EXPECT_EQ(s.code(), Code::kUnsupported);
+  EXPECT_STREQ(s.message(), "camera /dev/video7: not a V4L2 device");
+}
+
+TEST(V4l2ProbeTest, NodesThatAreNoCameraSayWhatTheyAre) {
+  struct Case {
+    uint32_t caps;
+    const char* says;
+  };
+  const Case cases[] = {
+      {V4L2_CAP_VIDEO_OUTPUT | V4L2_CAP_STREAMING,
+       "camera /dev/video7 (fake): not a capture device (a video output; caps 0x04000002)"},
+      {V4L2_CAP_VIDEO_M2M_MPLANE | V4L2_CAP_STREAMING,
+       "camera /dev/video7 (fake): not a capture device (a memory-to-memory device: a codec or "
+       "scaler; caps 0x04004000)"},
+      {V4L2_CAP_META_CAPTURE | V4L2_CAP_STREAMING,
+       "camera /dev/video7 (fake): not a capture device (a metadata node: the pictures come from "
+       "another node; caps 0x04800000)"},
+      {V4L2_CAP_VIDEO_CAPTURE_MPLANE | V4L2_CAP_STREAMING,
+       "camera /dev/video7 (fake): a multi-planar capture node; the v4l2 backend reads "
+       "single-planar nodes only"},
+      {V4L2_CAP_VIDEO_CAPTURE | V4L2_CAP_READWRITE,
+       "camera /dev/video7 (fake): a capture node without streaming I/O (read() only); mmap "
+       "streaming is needed"},
+  };
+  for (const Case& c : cases) {
+    FakeV4l2 dev;
+    dev.caps = c.caps;
+    Status s = ProbeFake(&dev);
+    EXPECT_EQ(s.code(), Code::kUnsupported) << c.says;
+    EXPECT_STREQ(s.message(), c.says);
+    // Configure refuses the same nodes with the same reason.
+    V4l2Options options;
+    options.device = "/dev/video7";
+    V4l2Sensor sensor(options, &dev);
+    SensorMode mode;
+    s = sensor.Configure(Burst(), &mode);
+    EXPECT_EQ(s.code(), Code::kUnsupported);
+    EXPECT_EQ("camera " + std::string(s.message()), c.says) << s.message();
+  }
+}
+
+// The same through the real system calls, on what a mistyped `device` names.
+class V4l2SystemProbeTest : public ::testing::Test {
+ protected:
+  V4l2SystemProbeTest() {
+    char tmpl[] = "/tmp/v4l2_probe_XXXXXX";
+    dir_ = mkdtemp(tmpl) ? tmpl : "";
+  }
+  ~V4l2SystemProbeTest() override {
+    unlink((dir_ + "/file").c_str());
+    rmdir(dir_.c_str());
+  }
+  static std::string Probe(const std::string& device) {
+    V4l2Options options;
+    options.device = device.c_str();
+    return V4l2Sensor(options).Probe().message();
+  }
+  std::string dir_;
+};
+
+TEST_F(V4l2SystemProbeTest, DevNullIsNotAV4l2Device) {
+  EXPECT_EQ(Probe("/dev/null"), "camera /dev/null: not a V4L2 device");
+}
+
+TEST_F(V4l2SystemProbeTest, MissingPathIsNoSuchDevice) {
+  ASSERT_FALSE(dir_.empty());
+  EXPECT_EQ(Probe(dir_ + "/video7"), "camera " + dir_ + "/video7: no such device");
+}
+
+TEST_F(V4l2SystemProbeTest, RegularFileAndFolderAreNotV4l2Devices) {
+  ASSERT_FALSE(dir_.empty());
+  FILE* f = fopen((dir_ + "/file").c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  fclose(f);
+  EXPECT_EQ(Probe(dir_ + "/file"), "camera " + dir_ + "/file: not a V4L2 device");
+  EXPECT_EQ(Probe(dir_), "camera " + dir_ + ": not a V4L2 device (a folder)");
 }
 
 }  // namespace
