@@ -61,6 +61,7 @@ class Cli : public ::testing::Test {
   // Run, measuring the child's peak resident memory (KiB) with wait4.
   Result RunMeasured(const std::vector<std::string>& args, long* max_rss_kib) {
     Result r;
+    fflush(nullptr);  // the child would write out our buffered output again
     const pid_t pid = fork();
     if (pid < 0) return r;
     if (pid == 0) {

@@ -358,6 +358,12 @@ TEST_F(Cli, HugeViewsAreRefusedFromTheirHeaders) {
   EXPECT_LT(rss_kib, 64 * 1024) << "peak RSS in KiB";
   printf("16 views of a %zu-byte 16384x16384 PNG: refused at %ld KiB peak RSS\n", Slurp(big).size(),
          rss_kib);
+  // The same burst for run.
+  args = {"run", "--out", Out()};
+  for (int v = 0; v < 16; ++v) args.push_back(big);
+  const Result run = RunMeasured(args, &rss_kib);
+  ExpectCleanFailure(run, big, "16384x16384");
+  EXPECT_LT(rss_kib, 64 * 1024) << "peak RSS in KiB";
   EXPECT_TRUE(OutDirEmpty());
 }
 
