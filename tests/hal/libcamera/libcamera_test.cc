@@ -131,7 +131,6 @@ TEST(LibcameraSensorTest, ProbeNamesTheMissingCamera) {
     options.camera_id = "/base/no/such/camera";
     LibcameraSensor sensor(options);
     Status s = sensor.Probe();
-    if (s.ok()) GTEST_SKIP() << "this machine has a camera named like that";
     EXPECT_EQ(s.code(), Code::kNotFound) << s.message();
     const std::string m = s.message();
     EXPECT_EQ(m.rfind("libcamera: no camera '/base/no/such/camera' (found: ", 0), 0u) << m;
