@@ -1,11 +1,13 @@
 #include "firmware/daemon/camera_daemon.h"
 
 #include <signal.h>
-#include <sys/stat.h>
 
-#include <cerrno>
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstring>
+
+#include "firmware/daemon/startup_checks.h"
 
 namespace lb {
 
@@ -74,6 +76,68 @@ double CameraDaemon::SecondsSince(int64_t start_ns) const {
 }
 
 Status CameraDaemon::Start() {
+  // The worker never takes signals: they belong to the thread that waits on the button.
+  sigset_t all, old;
+  sigfillset(&all);
+  pthread_sigmask(SIG_SETMASK, &all, &old);
+  worker_ = std::thread(&CameraDaemon::Worker, this);
+  pthread_sigmask(SIG_SETMASK, &old, nullptr);
+  (void)CheckReady(true);
+  return Status::Ok();
+}
+
+bool CameraDaemon::Note(const Status& status, Problem* problem, const char* fixed) {
+  if (status.ok()) {
+    if (problem->text[0] == '\0') return false;
+    log_->Printf(LogLevel::kInfo, "%s", fixed);
+    problem->text[0] = '\0';
+    return true;
+  }
+  if (strcmp(problem->text, status.message()) == 0) return false;
+  log_->Printf(LogLevel::kError, "%s", status.message());
+  snprintf(problem->text, sizeof(problem->text), "%s", status.message());
+  return true;
+}
+
+void CameraDaemon::Problems(char* out, size_t size) const {
+  snprintf(out, size, "%s%s%s", camera_problem_.text,
+           camera_problem_.text[0] && folder_problem_.text[0] ? "; " : "", folder_problem_.text);
+}
+
+bool CameraDaemon::CheckReady(bool scheduled) {
+  // A missing camera or a read-only card must show before the first press, not as its photo
+  // failing. The folder is never created here: on a camera it is usually a card's mount point,
+  // and creating it would hide photos on internal storage under the card once it is mounted.
+  const Status camera = sensor_->Probe();
+  const Status folder = CheckPhotoFolder(config_.output_dir.c_str());
+  char fixed[Status::kMaxMessage + 64];
+  snprintf(fixed, sizeof(fixed), "sensor %s%s%s: the camera is there now", sensor_->name(),
+           config_.device.empty() ? "" : " ", config_.device.c_str());
+  bool changed = Note(camera, &camera_problem_, fixed);
+  snprintf(fixed, sizeof(fixed), "output folder %s: writable now", config_.output_dir.c_str());
+  changed = Note(folder, &folder_problem_, fixed) || changed;
+  if (camera.ok() && folder.ok()) {
+    BecomeReady();
+    return true;
+  }
+  // A problem that changed suggests someone at work on the camera: look again soon. One that
+  // stays is looked at less and less often, and not logged again. A press's check leaves the
+  // schedule alone unless it found a change.
+  if (changed || scheduled) {
+    retry_ms_ = changed ? kFirstRetryMs : std::min(2 * retry_ms_, kMaxRetryMs);
+    next_check_ns_ = clock_->MonotonicNs() + int64_t{retry_ms_} * 1000000;
+  }
+  if (changed) {
+    log_->Printf(LogLevel::kWarning,
+                 "not ready: will check again in %d s, backing off to every %d s; a press checks "
+                 "at once",
+                 retry_ms_ / 1000, kMaxRetryMs / 1000);
+  }
+  return false;
+}
+
+void CameraDaemon::BecomeReady() {
+  // Scanned only now: a card mounted since the start holds the photos the count continues from.
   const char* dir = config_.output_dir.c_str();
   int removed = 0;
   Status s = namer_.Scan(dir, &removed);
@@ -82,30 +146,27 @@ Status CameraDaemon::Start() {
     log_->Printf(LogLevel::kInfo,
                  "output: removed %d unfinished photo(s) left by an interrupted run", removed);
   }
-  // Never created here: on a camera the folder is usually a card's mount point, and creating it
-  // would hide photos on internal storage under the card once it is mounted.
-  struct stat st;
-  if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
-    log_->Printf(LogLevel::kWarning, "output: %s is not a folder (yet): photos fail until it is",
-                 dir);
-  }
-  // The worker never takes signals: they belong to the thread that waits on the button.
-  sigset_t all, old;
-  sigfillset(&all);
-  pthread_sigmask(SIG_SETMASK, &all, &old);
-  worker_ = std::thread(&CameraDaemon::Worker, this);
-  pthread_sigmask(SIG_SETMASK, &old, nullptr);
+  ready_.store(true);
   log_->Printf(LogLevel::kInfo, "ready: sensor %s%s%s, %dx%d, %d frames; photos to %s (next %04d)",
                sensor_->name(), config_.device.empty() ? "" : " ", config_.device.c_str(),
                config_.width, config_.height, config_.frames, dir, namer_.next_counter());
-  return Status::Ok();
 }
 
 Status CameraDaemon::Run() {
   Status result;
   while (!stop_.load()) {
+    int32_t wait_ms = kPollMs;
+    if (!ready_.load()) {
+      const int64_t left_ns = next_check_ns_ - clock_->MonotonicNs();
+      if (left_ns <= 0) {
+        (void)CheckReady(true);
+        continue;
+      }
+      // Rounded up, so the wait never ends just before the check is due.
+      wait_ms = static_cast<int32_t>(std::min<int64_t>(kPollMs, (left_ns + 999999) / 1000000));
+    }
     ButtonEvent event = ButtonEvent::kNone;
-    Status s = button_->Wait(kPollMs, &event);
+    Status s = button_->Wait(wait_ms, &event);
     if (!s.ok()) {
       log_->Printf(LogLevel::kError, "button: %s", s.message());
       result = s;
@@ -119,6 +180,15 @@ Status CameraDaemon::Run() {
 }
 
 void CameraDaemon::OnPress() {
+  if (!ready_.load() && !CheckReady(false)) {
+    char why[2 * Status::kMaxMessage];
+    Problems(why, sizeof(why));
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++counts_.presses;
+    ++counts_.refused;
+    log_->Printf(LogLevel::kWarning, "press: refused, not ready: %s", why);
+    return;
+  }
   std::lock_guard<std::mutex> lock(mutex_);
   ++counts_.presses;
   if (!busy_) {
@@ -141,6 +211,11 @@ void CameraDaemon::OnPress() {
 }
 
 void CameraDaemon::OnHalfPress() {
+  // The worker must not touch the sensor while the checks may still probe it from this thread.
+  if (!ready_.load() && !CheckReady(false)) {
+    log_->Printf(LogLevel::kDebug, "half press: not ready");
+    return;
+  }
   std::lock_guard<std::mutex> lock(mutex_);
   log_->Printf(LogLevel::kDebug, "half press");
   if (!busy_) {

@@ -7,6 +7,15 @@
 // failure the sensor is closed and opened again at the next press. A dropped frame first gets
 // `capture_retries` fresh bursts, since the depth stage needs evenly spaced views.
 //
+// Before the first photo the daemon checks what it can without capturing: the camera is there
+// and is one its backend can drive (Sensor::Probe), and the photo folder can be written
+// (CheckPhotoFolder). Each problem is logged once, and "ready" only when all hold. Until then the
+// checks run again after 1 s, doubling to every 30 s (a camera plugged in or a card mounted later
+// is found without polling the device all the time); a line is logged only when a problem
+// appears, changes or goes away. A press while not ready checks at once: it takes its photo if
+// everything holds now, else it is refused with the reason. Once ready the daemon stays ready;
+// a camera or card that goes away later fails the photos, each with its log line.
+//
 // One Job is configured once (on the first half press or press) and reused for every photo, so
 // nothing grows from press to press. Sensor, button, clock and log are borrowed; tests inject a
 // synthetic sensor, a scripted button and a fixed clock.
@@ -39,6 +48,10 @@ class CameraDaemon {
 
   // How often Run looks at the stop flag while the button is quiet.
   static constexpr int32_t kPollMs = 200;
+  // The wait before the checks run again while not ready: the first, doubled at each failed run
+  // that found the same problems, and at most the last.
+  static constexpr int32_t kFirstRetryMs = 1000;
+  static constexpr int32_t kMaxRetryMs = 30000;
 
   CameraDaemon(const DaemonConfig& config, Sensor* sensor, Button* button, const Clock* clock,
                Log* log);
@@ -46,17 +59,21 @@ class CameraDaemon {
   CameraDaemon(const CameraDaemon&) = delete;
   CameraDaemon& operator=(const CameraDaemon&) = delete;
 
-  // Scans the output folder (removing temporaries a killed run left) and starts the worker.
+  // Starts the worker and runs the checks. When they hold: scans the output folder (removing
+  // temporaries a killed run left) and logs "ready"; otherwise logs each problem and that it will
+  // check again. Not being ready is no error: Run keeps checking.
   Status Start();
-  // Handles button events until RequestStop or a button failure. Then the photo in progress (its
-  // press acknowledged) is finished, a queued press is dropped (logged), the worker ends and the
-  // sensor is released.
+  // Handles button events (and, while not ready, runs the checks when due) until RequestStop or
+  // a button failure. Then the photo in progress (its press acknowledged) is finished, a queued
+  // press is dropped (logged), the worker ends and the sensor is released.
   Status Run();
   // Async-signal-safe (a signal handler may call it).
   void RequestStop() { stop_.store(true); }
 
   State state() const;
   Counts counts() const;
+  // Every check holds, "ready" was logged.
+  bool ready() const { return ready_.load(); }
   // Tests: waits until no photo is in progress or queued; false on timeout.
   bool WaitIdle(int32_t timeout_ms);
 
@@ -83,8 +100,23 @@ class CameraDaemon {
     CameraDaemon* owner_;
   };
 
+  // One remembered problem of a check: "" while it holds.
+  struct Problem {
+    char text[Status::kMaxMessage] = {};
+  };
+
   void OnPress();
   void OnHalfPress();
+  // Runs the checks and logs what changed since the last run; on success scans the folder and
+  // logs "ready". `scheduled`: the run the schedule asked for (else a press's), which sets the
+  // next. Run thread only (Start before Run starts).
+  bool CheckReady(bool scheduled);
+  // Logs a new or changed problem (error), or `fixed` (info) when a problem went away; true when
+  // anything changed.
+  bool Note(const Status& status, Problem* problem, const char* fixed);
+  void BecomeReady();
+  // Both problems, "; " between, for the line that refuses a press.
+  void Problems(char* out, size_t size) const;
   void Shutdown();
   void Worker();
   void TakePhoto(int32_t number);
@@ -99,6 +131,12 @@ class CameraDaemon {
   const Clock* clock_;
   Log* log_;
   std::atomic<bool> stop_{false};
+  std::atomic<bool> ready_{false};
+
+  // Run thread only, until ready: the checks' last findings and schedule.
+  Problem camera_problem_, folder_problem_;
+  int32_t retry_ms_ = kFirstRetryMs;
+  int64_t next_check_ns_ = 0;
 
   // Worker-only.
   Job job_;

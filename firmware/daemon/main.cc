@@ -14,6 +14,7 @@
 #include "firmware/daemon/clock.h"
 #include "firmware/daemon/config.h"
 #include "firmware/daemon/log.h"
+#include "firmware/daemon/startup_checks.h"
 
 namespace {
 
@@ -25,13 +26,22 @@ const char kUsage[] =
     "the output folder. A half press (KEY_CAMERA_FOCUS) readies the sensor. Logs go to stderr\n"
     "(the journal under systemd); SIGTERM or SIGINT stop it after the photo in progress.\n"
     "\n"
+    "At start it checks the camera (there, and a capture device) and the output folder (there,\n"
+    "and writable) and says \"ready\" once both hold. Until then it logs each problem once,\n"
+    "checks again after 1 s, 2 s, 4 s ... and then every 30 s (a camera plugged in or a card\n"
+    "mounted later is found), and refuses a press with the reason unless a check at that press\n"
+    "passes. A button that cannot be opened stops it (exit 1).\n"
+    "\n"
     "  --config FILE     configuration (default /etc/refocusd.conf; every key is documented "
     "there)\n"
-    "  --check-config    read the configuration, report the first problem, and exit\n"
+    "  --check-config    read the configuration and check the camera, the button and the output\n"
+    "                    folder as at start; print every problem, one per line, and exit 1, or\n"
+    "                    \"configuration OK\" and exit 0 when everything holds\n"
     "  --version         print the version and the sensor backends of this build\n"
     "  --help            this text\n"
     "\n"
-    "Exit status: 0 stopped by a signal, 1 a configuration, device or button failure, 2 usage.\n";
+    "Exit status: 0 stopped by a signal (--check-config: all holds), 1 a configuration or button\n"
+    "failure (--check-config: any problem), 2 usage.\n";
 
 std::atomic<lb::CameraDaemon*> g_daemon{nullptr};
 
@@ -43,6 +53,35 @@ void OnStopSignal(int) {
 int Usage(const char* error) {
   fprintf(stderr, "refocusd: %s\n\n%s", error, kUsage);
   return 2;
+}
+
+// --check-config once the file reads: the checks refocusd runs at start (camera, output folder)
+// and the button it would open, each problem on its own line, so "configuration OK" means
+// refocusd would start and say "ready" now.
+int CheckConfig(const char* path, const lb::DaemonConfig& config) {
+  int problems = 0;
+  std::unique_ptr<lb::Sensor> sensor;
+  lb::Status s = lb::MakeSensor(config, &sensor);
+  if (s.ok()) s = sensor->Probe();
+  if (!s.ok()) {
+    fprintf(stderr, "refocusd: %s\n", s.message());
+    ++problems;
+  }
+  std::unique_ptr<lb::Button> button;
+  std::string button_path;
+  s = lb::OpenButton(config, &button, &button_path);
+  if (!s.ok()) {
+    fprintf(stderr, "refocusd: button: %s\n", s.message());
+    ++problems;
+  }
+  s = lb::CheckPhotoFolder(config.output_dir.c_str());
+  if (!s.ok()) {
+    fprintf(stderr, "refocusd: %s\n", s.message());
+    ++problems;
+  }
+  if (problems > 0) return 1;
+  printf("refocusd: %s: configuration OK\n", path);
+  return 0;
 }
 
 }  // namespace
@@ -84,10 +123,7 @@ int main(int argc, char** argv) {
     fprintf(stderr, "refocusd: %s\n", s.message());
     return 1;
   }
-  if (check_only) {
-    printf("refocusd: %s: configuration OK\n", config_path.c_str());
-    return 0;
-  }
+  if (check_only) return CheckConfig(config_path.c_str(), config);
 
   lb::FdLogSink sink(2, lb::FdLogSink::IsJournal(2));
   lb::Log log(&sink, config.log_level);

@@ -58,9 +58,18 @@ class TestButton : public Button {
 enum class Fault { kNone, kTimeout, kDrop };
 
 // The synthetic sensor with faults per burst and a gate: while closed, a burst waits at its start.
+// Its camera can be absent (Probe fails as a missing V4L2 node does); each Probe is counted and,
+// when a clock is set, its time noted.
 class TestSensor : public Sensor {
  public:
   const char* name() const override { return "test"; }
+  Status Probe() override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++probes;
+    if (clock != nullptr) probe_ns_.push_back(clock->MonotonicNs());
+    if (!present) return Status(Code::kNotFound, "camera test0: no such device");
+    return Status::Ok();
+  }
   Status Configure(const SensorConfig& config, SensorMode* mode) override {
     ++configures;
     return inner_.Configure(config, mode);
@@ -94,7 +103,19 @@ class TestSensor : public Sensor {
     return cv_.wait_for(lock, milliseconds(10000), [&] { return bursts_started_ >= n; });
   }
 
-  std::atomic<int> configures{0}, stops{0};
+  // Milliseconds between consecutive probes.
+  std::vector<int64_t> ProbeGapsMs() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::vector<int64_t> gaps;
+    for (size_t i = 1; i < probe_ns_.size(); ++i) {
+      gaps.push_back((probe_ns_[i] - probe_ns_[i - 1]) / 1000000);
+    }
+    return gaps;
+  }
+
+  std::atomic<int> configures{0}, stops{0}, probes{0};
+  std::atomic<bool> present{true};
+  const Clock* clock = nullptr;
 
  private:
   // Passes frames on until `index`, then reports it lost, as a driver's sequence gap does.
@@ -121,11 +142,19 @@ class TestSensor : public Sensor {
   std::deque<Fault> faults_;
   bool open_ = true;
   int bursts_started_ = 0;
+  std::vector<int64_t> probe_ns_;
 };
 
+// Photos named at a fixed second. Monotonic time is the system's, or, once Freeze was called,
+// stands still except where the test (or a SimulatedButton) moves it on.
 class FixedClock : public Clock {
  public:
-  int64_t MonotonicNs() const override { return system_.MonotonicNs(); }
+  int64_t MonotonicNs() const override {
+    const int64_t frozen = frozen_ns_.load();
+    return frozen >= 0 ? frozen : system_.MonotonicNs();
+  }
+  void Freeze(int64_t ns) { frozen_ns_.store(ns); }
+  void Advance(int64_t ns) { frozen_ns_.fetch_add(ns); }
   void LocalTime(tm* out) const override {
     *out = tm{};
     out->tm_year = 2026 - 1900;
@@ -138,6 +167,29 @@ class FixedClock : public Clock {
 
  private:
   SystemClock system_;
+  std::atomic<int64_t> frozen_ns_{-1};
+};
+
+// A quiet button in simulated time: each wait returns at once and moves the frozen clock on by
+// its timeout, until the clock reaches `end_ns`; from then on it waits in real time and the clock
+// stands still. So minutes of a daemon's waiting pass in milliseconds.
+class SimulatedButton : public Button {
+ public:
+  SimulatedButton(FixedClock* clock, int64_t end_ns) : clock_(clock), end_ns_(end_ns) {}
+  Status Wait(int32_t timeout_ms, ButtonEvent* event) override {
+    *event = ButtonEvent::kNone;
+    if (clock_->MonotonicNs() >= end_ns_) {
+      std::this_thread::sleep_for(milliseconds(timeout_ms));
+      return Status::Ok();
+    }
+    clock_->Advance(
+        std::min<int64_t>(int64_t{timeout_ms} * 1000000, end_ns_ - clock_->MonotonicNs()));
+    return Status::Ok();
+  }
+
+ private:
+  FixedClock* clock_;
+  int64_t end_ns_;
 };
 
 class RecordingSink : public LogSink {
@@ -187,8 +239,9 @@ class CameraDaemonTest : public ::testing::Test {
   }
   ~CameraDaemonTest() override { Stop(); }
 
-  void StartDaemon() {
-    daemon_ = std::make_unique<CameraDaemon>(config_, &sensor_, &button_, &clock_, &log_);
+  void StartDaemon(Button* button = nullptr) {
+    daemon_ = std::make_unique<CameraDaemon>(config_, &sensor_, button ? button : &button_, &clock_,
+                                             &log_);
     ASSERT_TRUE(daemon_->Start().ok());
     runner_ = std::thread([this] { run_status_ = daemon_->Run(); });
   }
@@ -341,10 +394,52 @@ TEST_F(CameraDaemonTest, DroppedFrameWithoutRetriesFailsThePhotoOnly) {
   EXPECT_EQ(daemon_->counts().failed, 1);
 }
 
-TEST_F(CameraDaemonTest, MissingFolderFailsUntilItAppears) {
+TEST_F(CameraDaemonTest, MissingFolderIsNotReadyUntilItAppears) {
   config_.output_dir = dir_.Path("card");
   StartDaemon();
-  EXPECT_EQ(sink_.Count("is not a folder (yet)"), 1) << sink_.All();
+  EXPECT_FALSE(daemon_->ready());
+  EXPECT_EQ(
+      sink_.Count("error: output folder " + dir_.Path("card") + ": no such file or directory"), 1)
+      << sink_.All();
+  EXPECT_EQ(sink_.Count("ready: sensor"), 0) << sink_.All();
+  PressAndWait();
+  EXPECT_EQ(sink_.Count("warning: press: refused, not ready: output folder " + dir_.Path("card") +
+                        ": no such file or directory"),
+            1)
+      << sink_.All();
+  // The card is mounted: the next press checks at once and takes its photo, number 1.
+  ASSERT_EQ(mkdir(dir_.Path("card").c_str(), 0755), 0);
+  PressAndWait();
+  EXPECT_EQ(sink_.Count("info: output folder " + dir_.Path("card") + ": writable now"), 1)
+      << sink_.All();
+  EXPECT_EQ(sink_.Count("photo 1: saved " + dir_.Path("card/") + kFirst), 1) << sink_.All();
+  const CameraDaemon::Counts c = daemon_->counts();
+  EXPECT_EQ(c.presses, 2);
+  EXPECT_EQ(c.refused, 1);
+  EXPECT_EQ(c.failed, 0);
+}
+
+TEST_F(CameraDaemonTest, FolderThatIsAFileIsNotReady) {
+  config_.output_dir = dir_.Path("card");
+  FILE* f = fopen(config_.output_dir.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  fclose(f);
+  StartDaemon();
+  PressAndWait();
+  EXPECT_FALSE(daemon_->ready());
+  EXPECT_EQ(sink_.Count("press: refused, not ready: output folder " + dir_.Path("card") +
+                        ": not a folder (a regular file)"),
+            1)
+      << sink_.All();
+  EXPECT_EQ(sink_.Count("ready: sensor"), 0) << sink_.All();
+}
+
+TEST_F(CameraDaemonTest, FolderGoneAfterReadyFailsThePhotoUntilItIsBack) {
+  config_.output_dir = dir_.Path("card");
+  ASSERT_EQ(mkdir(dir_.Path("card").c_str(), 0755), 0);
+  StartDaemon();
+  ASSERT_TRUE(daemon_->ready()) << sink_.All();
+  ASSERT_EQ(rmdir(dir_.Path("card").c_str()), 0);  // the card was taken out
   PressAndWait();
   EXPECT_EQ(sink_.Count("photo 1: not saved: " + dir_.Path("card/") + kFirst + ": the folder " +
                         dir_.Path("card") + ": no such file or directory"),
@@ -355,6 +450,101 @@ TEST_F(CameraDaemonTest, MissingFolderFailsUntilItAppears) {
   EXPECT_EQ(sink_.Count("photo 2: saved"), 1) << sink_.All();
   // A missing folder is no sensor fault: the sensor stays configured.
   EXPECT_EQ(sensor_.configures.load(), 1);
+}
+
+TEST_F(CameraDaemonTest, CameraPluggedInLaterIsFoundAndThenPressesWork) {
+  sensor_.present = false;
+  StartDaemon();
+  EXPECT_FALSE(daemon_->ready());
+  EXPECT_EQ(sink_.Count("error: camera test0: no such device"), 1) << sink_.All();
+  EXPECT_EQ(sink_.Count("warning: not ready: will check again in 1 s"), 1) << sink_.All();
+  EXPECT_EQ(sink_.Count("ready: sensor"), 0) << sink_.All();
+  // A half press while not ready leaves the sensor alone; a press is refused, with the reason.
+  button_.Push(ButtonEvent::kHalfPress);
+  PressAndWait();
+  EXPECT_EQ(sink_.Count("warning: press: refused, not ready: camera test0: no such device"), 1)
+      << sink_.All();
+  EXPECT_EQ(sensor_.configures.load(), 0);
+  EXPECT_EQ(Files(), std::vector<std::string>{});
+  // Plugged in: the next scheduled check (1 s after the start) finds it.
+  sensor_.present = true;
+  ASSERT_TRUE(sink_.WaitFor("ready: sensor test")) << sink_.All();
+  EXPECT_TRUE(daemon_->ready());
+  EXPECT_EQ(sink_.Count("info: sensor test: the camera is there now"), 1) << sink_.All();
+  PressAndWait();
+  EXPECT_EQ(Files(), std::vector<std::string>{kFirst});
+  ExpectWholeJpeg(kFirst);
+  EXPECT_EQ(daemon_->counts().refused, 1);
+  // Ready means done checking.
+  const int probes = sensor_.probes.load();
+  PressAndWait();
+  EXPECT_EQ(sensor_.probes.load(), probes);
+}
+
+TEST_F(CameraDaemonTest, PressChecksAtOnceAndTakesThePhotoWhenTheCameraIsBack) {
+  clock_.Freeze(0);  // no scheduled check ever comes due
+  sensor_.present = false;
+  StartDaemon();
+  EXPECT_EQ(sensor_.probes.load(), 1);
+  sensor_.present = true;
+  PressAndWait();
+  EXPECT_EQ(sensor_.probes.load(), 2);
+  EXPECT_EQ(Files(), std::vector<std::string>{kFirst}) << sink_.All();
+  EXPECT_EQ(sink_.Count("press: photo 1"), 1) << sink_.All();
+  EXPECT_EQ(daemon_->counts().refused, 0);
+}
+
+TEST_F(CameraDaemonTest, AbsentCameraIsCheckedWithBackoffAndLoggedOnce) {
+  // Two simulated minutes of waiting for a camera that never comes.
+  constexpr int64_t kEndNs = 120 * int64_t{1000000000};
+  clock_.Freeze(0);
+  sensor_.clock = &clock_;
+  sensor_.present = false;
+  SimulatedButton button(&clock_, kEndNs);
+  StartDaemon(&button);
+  for (int i = 0; i < 1000 && clock_.MonotonicNs() < kEndNs; ++i) {
+    std::this_thread::sleep_for(milliseconds(10));
+  }
+  ASSERT_EQ(clock_.MonotonicNs(), kEndNs);
+  Stop();
+  // At 0, 1, 3, 7, 15, 31, 61 and 91 s: 6 checks in the first minute, 2 a minute after that.
+  EXPECT_EQ(sensor_.ProbeGapsMs(),
+            (std::vector<int64_t>{1000, 2000, 4000, 8000, 16000, 30000, 30000}));
+  EXPECT_EQ(sink_.Count("no such device"), 1) << sink_.All();
+  EXPECT_EQ(sink_.Count("not ready"), 1) << sink_.All();
+  EXPECT_EQ(sink_.Count("stopped: 0 photo(s) saved"), 1) << sink_.All();
+}
+
+TEST_F(CameraDaemonTest, ChangedProblemIsLoggedAndLookedAtSoonAgain) {
+  clock_.Freeze(0);
+  sensor_.clock = &clock_;
+  sensor_.present = false;
+  config_.output_dir = dir_.Path("card");
+  StartDaemon();
+  EXPECT_EQ(sink_.Count("error: camera test0: no such device"), 1) << sink_.All();
+  EXPECT_EQ(sink_.Count("error: output folder"), 1) << sink_.All();
+  auto wait_probes = [this](int n) {
+    for (int i = 0; i < 1000 && sensor_.probes.load() < n; ++i) {
+      std::this_thread::sleep_for(milliseconds(10));
+    }
+    return sensor_.probes.load() == n;
+  };
+  // Checks at 1 and 3 s find the same; the camera appears before the one at 7 s.
+  clock_.Advance(1000000000);
+  ASSERT_TRUE(wait_probes(2));
+  clock_.Advance(2000000000);
+  ASSERT_TRUE(wait_probes(3));
+  EXPECT_EQ(sink_.Count("error: camera test0: no such device"), 1) << sink_.All();
+  sensor_.present = true;
+  clock_.Advance(4000000000);
+  ASSERT_TRUE(sink_.WaitFor("sensor test: the camera is there now")) << sink_.All();
+  // Still not ready (no folder), and the next check 1 s later, not 8 s.
+  EXPECT_FALSE(daemon_->ready());
+  EXPECT_EQ(sink_.Count("not ready: will check again in 1 s"), 2) << sink_.All();
+  ASSERT_EQ(mkdir(dir_.Path("card").c_str(), 0755), 0);
+  clock_.Advance(1000000000);
+  ASSERT_TRUE(sink_.WaitFor("ready: sensor test")) << sink_.All();
+  EXPECT_EQ(sensor_.ProbeGapsMs(), (std::vector<int64_t>{1000, 2000, 4000, 1000}));
 }
 
 TEST_F(CameraDaemonTest, FailedWriteLeavesNothingUnderTheName) {

@@ -2,7 +2,11 @@
 # Builds the board's Debian package in a cross build tree and checks it as an installer and the
 # board would see it: the four files at their places, the conffile, the architecture, a
 # dependency for every library the programs link, and the packaged refocusd running under
-# qemu-user (--version, and --check-config on the packaged configuration).
+# qemu-user: --version, and --check-config, which checks the camera, the button and the photo
+# folder besides the file. The packaged configuration must read (no line of it is refused), and
+# with its camera, button and folder pointed at ones this machine has (the synthetic camera, a
+# FIFO, a new folder) it must pass; where the machine lacks /dev/video0 and /var/lib/refocusd (the
+# usual build host) it must name both.
 #
 #   check_deb.sh BUILD_DIR [EMULATOR ARGS...]
 #
@@ -81,7 +85,29 @@ done
 out=$("${emulator[@]}" "$work/root/usr/bin/refocusd" --version) || fail "refocusd --version failed"
 echo "check_deb: packaged refocusd --version: $out"
 [[ $out == "refocusd $version (sensor backends: "* ]] || fail "unexpected --version output: $out"
-out=$("${emulator[@]}" "$work/root/usr/bin/refocusd" --check-config \
-  --config "$work/root/etc/refocusd.conf") || fail "the packaged configuration is rejected: $out"
+conf=$work/root/etc/refocusd.conf
+status=0
+out=$("${emulator[@]}" "$work/root/usr/bin/refocusd" --check-config --config "$conf" 2>&1) ||
+  status=$?
+echo "check_deb: packaged configuration (status $status):"
+echo "$out"
+# A refused line is "refocusd: FILE:LINE: ..."; the checks' lines name a device or a folder.
+[[ $out != *"$conf:"[0-9]* ]] || fail "the packaged configuration does not read: $out"
+if [[ ! -e /dev/video0 && ! -e /var/lib/refocusd ]]; then
+  ((status == 1)) || fail "--check-config passed without /dev/video0 and /var/lib/refocusd"
+  [[ $out == *"refocusd: camera /dev/video0: no such device"* ]] ||
+    fail "--check-config does not name the missing camera: $out"
+  [[ $out == *"refocusd: output folder /var/lib/refocusd: no such file or directory"* ]] ||
+    fail "--check-config does not name the missing folder: $out"
+fi
+mkdir -p "$work/photos"
+rm -f "$work/button" && mkfifo "$work/button"
+sed -e 's|^backend = v4l2$|backend = synthetic|' -e "s|^button = auto\$|button = $work/button|" \
+  -e "s|^output_dir = /var/lib/refocusd\$|output_dir = $work/photos|" "$conf" >"$work/check.conf"
+(($(grep -cE "^(backend = synthetic|button = $work/button|output_dir = $work/photos)\$" \
+  "$work/check.conf") == 3)) || fail "the packaged configuration lacks the backend, button or output_dir line"
+out=$("${emulator[@]}" "$work/root/usr/bin/refocusd" --check-config --config "$work/check.conf" 2>&1) ||
+  fail "the packaged configuration with a camera, button and folder at hand is rejected: $out"
+[[ $out == "refocusd: $work/check.conf: configuration OK" ]] || fail "unexpected --check-config output: $out"
 echo "check_deb: $out"
 echo "check_deb: OK"

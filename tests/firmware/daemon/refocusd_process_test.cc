@@ -3,6 +3,7 @@
 // name holds a whole JPEG or nothing and the next start clears the leftovers.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -47,22 +48,50 @@ TEST(RefocusdCommandTest, VersionHelpAndUsageErrors) {
   EXPECT_EQ(out, "refocusd: /nonexistent.conf: cannot open: No such file or directory\n");
 }
 
+void WriteFile(const std::string& path, const std::string& text) {
+  FILE* f = fopen(path.c_str(), "w");
+  ASSERT_NE(f, nullptr) << path;
+  fputs(text.c_str(), f);
+  fclose(f);
+}
+
 TEST(RefocusdCommandTest, CheckConfigReportsTheLine) {
   ScratchDir dir;
   const std::string good = dir.Path("good.conf"), bad = dir.Path("bad.conf");
-  FILE* f = fopen(good.c_str(), "w");
-  ASSERT_NE(f, nullptr);
-  fputs("backend = synthetic\nf_number = 2\n", f);
-  fclose(f);
-  f = fopen(bad.c_str(), "w");
-  ASSERT_NE(f, nullptr);
-  fputs("backend = synthetic\n# comment\nf_number = 0.5\n", f);
-  fclose(f);
+  ASSERT_EQ(mkfifo(dir.Path("button").c_str(), 0600), 0);
+  // Everything at start holds: the synthetic camera, a FIFO button, a writable folder.
+  WriteFile(good, "backend = synthetic\nf_number = 2\nbutton = " + dir.Path("button") +
+                      "\noutput_dir = " + dir.dir() + "\n");
+  WriteFile(bad, "backend = synthetic\n# comment\nf_number = 0.5\n");
   std::string out;
   EXPECT_EQ(RunRefocusd({"--check-config", "--config", good}, &out), 0);
   EXPECT_EQ(out, "refocusd: " + good + ": configuration OK\n");
   EXPECT_EQ(RunRefocusd({"--check-config", "--config", bad}, &out), 1);
   EXPECT_EQ(out, "refocusd: " + bad + ":3: f_number: '0.5' is not a number from 1 to 22\n");
+}
+
+// Issue 13 defect 5: --check-config said OK for a camera and a folder refocusd could not use.
+TEST(RefocusdCommandTest, CheckConfigChecksTheCameraTheButtonAndTheFolder) {
+  ScratchDir dir;
+  const std::string conf = dir.Path("refocusd.conf");
+  ASSERT_EQ(mkfifo(dir.Path("button").c_str(), 0600), 0);
+  WriteFile(dir.Path("photos"), "");
+  WriteFile(conf, "backend = v4l2\ndevice = " + dir.Path("video7") + "\nbutton = " +
+                      dir.Path("button") + "\noutput_dir = " + dir.Path("photos") + "\n");
+  std::string out;
+  EXPECT_EQ(RunRefocusd({"--check-config", "--config", conf}, &out), 1);
+  EXPECT_EQ(out, "refocusd: camera " + dir.Path("video7") +
+                     ": no such device\nrefocusd: output folder " + dir.Path("photos") +
+                     ": not a folder (a regular file)\n");
+
+  WriteFile(conf, "device = /dev/null\nbutton = " + dir.Path("no-button") +
+                      "\noutput_dir = " + dir.Path("card/DCIM") + "\n");
+  EXPECT_EQ(RunRefocusd({"--check-config", "--config", conf}, &out), 1);
+  EXPECT_EQ(
+      out,
+      "refocusd: camera /dev/null: not a V4L2 device\nrefocusd: button: " + dir.Path("no-button") +
+          ": cannot open: No such file or directory (errno 2)\nrefocusd: output folder " +
+          dir.Path("card/DCIM") + ": no such file or directory\n");
 }
 
 TEST(RefocusdCommandTest, MissingButtonIsAClearStartupError) {
@@ -73,6 +102,47 @@ TEST(RefocusdCommandTest, MissingButtonIsAClearStartupError) {
   EXPECT_NE(d.log().find("error: " + dir.Path("no-such-button") + ": cannot open"),
             std::string::npos)
       << d.log();
+}
+
+// Issue 13 defect 5: refocusd said "ready" with a folder it could not write, and the first press
+// was lost. Now it says why it is not ready, refuses a press with the reason, keeps checking,
+// and is ready once the folder is there.
+TEST(RefocusdProcessTest, OutputFolderThatIsAFileIsNotReadyUntilItIsAFolder) {
+  ScratchDir dir;
+  const std::string photos = dir.Path("photos");
+  WriteFile(photos, "");
+  RefocusdProcess d(dir.dir(), "output_dir = " + photos + "\n");
+  ASSERT_TRUE(d.Start());
+  ASSERT_TRUE(d.WaitForLine("not ready: will check again in 1 s", kStartMs)) << d.log();
+  EXPECT_EQ(d.Count("error: output folder " + photos + ": not a folder (a regular file)"), 1)
+      << d.log();
+  d.Press();
+  ASSERT_TRUE(d.WaitForLine(
+      "press: refused, not ready: output folder " + photos + ": not a folder (a regular file)",
+      kStartMs))
+      << d.log();
+  EXPECT_EQ(d.Count("ready: sensor"), 0) << d.log();
+  // The card is mounted: found by a later check, without a press.
+  ASSERT_EQ(unlink(photos.c_str()), 0);
+  ASSERT_EQ(mkdir(photos.c_str(), 0755), 0);
+  ASSERT_TRUE(d.WaitForLine("ready: sensor synthetic", kStartMs)) << d.log();
+  EXPECT_EQ(d.Count("info: output folder " + photos + ": writable now"), 1) << d.log();
+  d.Press();
+  ASSERT_TRUE(d.WaitForLine("photo 1: saved " + photos + "/IMG_", kPhotoMs)) << d.log();
+  d.Signal(SIGTERM);
+  EXPECT_EQ(d.Wait(kStartMs), 0) << d.log();
+  EXPECT_EQ(d.Count("stopped: 1 photo(s) saved, 0 failed, 1 press(es) refused"), 1) << d.log();
+}
+
+TEST(RefocusdProcessTest, SigtermWhileWaitingForTheCameraStopsAtOnce) {
+  ScratchDir dir;
+  RefocusdProcess d(dir.dir(), "backend = v4l2\ndevice = " + dir.Path("video7") + "\n");
+  ASSERT_TRUE(d.Start());
+  ASSERT_TRUE(d.WaitForLine("not ready:", kStartMs)) << d.log();
+  EXPECT_EQ(d.Count("error: camera " + dir.Path("video7") + ": no such device"), 1) << d.log();
+  d.Signal(SIGTERM);
+  EXPECT_EQ(d.Wait(2000), 0) << d.log();
+  EXPECT_EQ(d.Count("ready: sensor"), 0) << d.log();
 }
 
 TEST(RefocusdProcessTest, SigtermLetsThePhotoInProgressFinish) {
