@@ -181,7 +181,7 @@ Status CameraDaemon::Run() {
 
 void CameraDaemon::OnPress() {
   if (!ready_.load() && !CheckReady(false)) {
-    char why[2 * Status::kMaxMessage];
+    char why[2 * Status::kMaxMessage + 8];
     Problems(why, sizeof(why));
     std::lock_guard<std::mutex> lock(mutex_);
     ++counts_.presses;
