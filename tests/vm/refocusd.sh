@@ -1,9 +1,11 @@
-# VM scenario (run by run_vm.sh with busybox sh): the refocusd daemon on real drivers. Presses
-# of a uinput KEY_CAMERA button reach it through evdev (a half press readies the sensor, a press
-# while busy is queued); the V4L2 sensor takes 5-frame bursts from vivid. Then the faults, each followed by a press that must succeed: the sensor stops
-# delivering (vivid drops every buffer: timeout), frames are dropped (vivid drops half), the
-# photo folder (a 1 MiB tmpfs) is full. Ends with SIGTERM: exit 0. Every photo name must hold a
-# whole JPEG, and no temporary may stay behind.
+# VM scenario (run by run_vm.sh with busybox sh): the refocusd daemon on real drivers. It starts
+# before its camera (vivid unloaded): it says the node is missing and that it is not ready,
+# refuses a press with that reason, and finds vivid once it is loaded. Presses of a uinput
+# KEY_CAMERA button reach it through evdev (a half press readies the sensor, a press while busy
+# is queued); the V4L2 sensor takes 5-frame bursts from vivid. Then the faults, each followed by
+# a press that must succeed: the sensor stops delivering (vivid drops every buffer: timeout),
+# frames are dropped (vivid drops half), the photo folder (a 1 MiB tmpfs) is full. Ends with
+# SIGTERM: exit 0. Every photo name must hold a whole JPEG, and no temporary may stay behind.
 set -u
 status=0
 photos=/photos
@@ -40,8 +42,15 @@ uinput_key </tmp/keys >/tmp/keys.node &
 exec 3>/tmp/keys
 for i in 1 2 3 4 5 6 7 8 9 10; do [ -s /tmp/keys.node ] && break; sleep 0.2; done
 node=$(cat /tmp/keys.node)
-video=$(grep -l vivid /sys/class/video4linux/video*/name | head -n1 | sed 's|.*/\(video[0-9]*\)/name|/dev/\1|')
+vivid_node() {
+  grep -l vivid /sys/class/video4linux/video*/name 2>/dev/null | head -n1 |
+    sed 's|.*/\(video[0-9]*\)/name|/dev/\1|'
+}
+video=$(vivid_node)
 echo "scenario: button $node, sensor $video"
+# The camera is plugged in after the daemon started: vivid unloaded until then.
+rmmod vivid || bad "cannot unload vivid"
+[ -e "$video" ] && bad "$video still there without vivid"
 cat >/tmp/refocusd.conf <<EOF
 backend = v4l2
 device = $video
@@ -57,7 +66,17 @@ log_level = debug
 EOF
 refocusd --config /tmp/refocusd.conf 2>$log &
 pid=$!
-wait_for "ready:" 1 30
+
+# 0. No camera yet: a clear line, not ready, a press refused with the reason; then vivid loads.
+wait_for "not ready: will check again in 1 s" 1 30 &&
+  [ "$(count "error: camera $video: no such device")" = 1 ] && [ "$(count 'ready: sensor')" = 0 ] &&
+  ok "started without its camera: $(grep -m1 'camera ' $log)" || bad "no 'not ready' for the missing camera"
+echo press >&3
+wait_for "press: refused, not ready: camera $video: no such device" 1 30 && ok "press while not ready: refused"
+insmod $(grep '/vivid.ko' /modules.list) || bad "cannot load vivid again"
+[ "$(vivid_node)" = "$video" ] || bad "vivid came back as '$(vivid_node)', not $video"
+wait_for "ready: sensor v4l2 $video" 1 60 && [ "$(count 'the camera is there now')" = 1 ] &&
+  ok "camera plugged in later: found" || bad "vivid loaded later was not found"
 
 # 1. A half press readies the sensor; a press: a 5-frame burst from vivid becomes a JPEG.
 echo half >&3

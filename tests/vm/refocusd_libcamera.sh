@@ -36,7 +36,7 @@ working_size = 160x120
 CONF
 refocusd --config /tmp/refocusd.conf 2>$log &
 pid=$!
-wait_for "ready:" 30
+wait_for "ready: sensor" 30
 echo half >&3
 wait_for "half press: sensor ready" 60 && ok "$(grep 'half press:' $log)"
 echo unhalf >&3
