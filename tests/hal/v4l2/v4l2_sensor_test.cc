@@ -421,11 +421,18 @@ class V4l2SystemProbeTest : public ::testing::Test {
     options.device = device.c_str();
     return V4l2Sensor(options).Probe().message();
   }
+  // qemu-user answers ioctls it cannot translate, V4L2's among them, with ENOSYS (the ARM test
+  // runs): the probe then rightly names that failure instead.
+  static bool Emulated(const std::string& message) {
+    return message.find("VIDIOC_QUERYCAP failed: Function not implemented") != std::string::npos;
+  }
   std::string dir_;
 };
 
 TEST_F(V4l2SystemProbeTest, DevNullIsNotAV4l2Device) {
-  EXPECT_EQ(Probe("/dev/null"), "camera /dev/null: not a V4L2 device");
+  const std::string m = Probe("/dev/null");
+  if (Emulated(m)) GTEST_SKIP() << m;
+  EXPECT_EQ(m, "camera /dev/null: not a V4L2 device");
 }
 
 TEST_F(V4l2SystemProbeTest, MissingPathIsNoSuchDevice) {
@@ -438,8 +445,10 @@ TEST_F(V4l2SystemProbeTest, RegularFileAndFolderAreNotV4l2Devices) {
   FILE* f = fopen((dir_ + "/file").c_str(), "w");
   ASSERT_NE(f, nullptr);
   fclose(f);
-  EXPECT_EQ(Probe(dir_ + "/file"), "camera " + dir_ + "/file: not a V4L2 device");
   EXPECT_EQ(Probe(dir_), "camera " + dir_ + ": not a V4L2 device (a folder)");
+  const std::string m = Probe(dir_ + "/file");
+  if (Emulated(m)) GTEST_SKIP() << m;
+  EXPECT_EQ(m, "camera " + dir_ + "/file: not a V4L2 device");
 }
 
 }  // namespace
