@@ -150,7 +150,7 @@ TEST(RefocusdProcessTest, SigtermLetsThePhotoInProgressFinish) {
   // Slow enough (half a second) that the signal lands while the photo is being taken.
   RefocusdProcess d(dir.dir(), "resolution = 480x360\nlabels = 16\n");
   ASSERT_TRUE(d.Start());
-  ASSERT_TRUE(d.WaitForLine("ready:", kStartMs)) << d.log();
+  ASSERT_TRUE(d.WaitForLine("ready: sensor", kStartMs)) << d.log();
   d.Press();
   ASSERT_TRUE(d.WaitForLine("press: photo 1", kStartMs)) << d.log();
   d.Signal(SIGTERM);
@@ -169,7 +169,7 @@ TEST(RefocusdProcessTest, KilledAtRandomMomentsLeavesWholePhotosOrNothing) {
   RefocusdProcess d(dir.dir(), "");
   // One clean photo first, to learn how long a photo takes on this machine.
   ASSERT_TRUE(d.Start());
-  ASSERT_TRUE(d.WaitForLine("ready:", kStartMs)) << d.log();
+  ASSERT_TRUE(d.WaitForLine("ready: sensor", kStartMs)) << d.log();
   timespec t0, t1;
   clock_gettime(CLOCK_MONOTONIC, &t0);
   d.Press();
@@ -190,7 +190,7 @@ TEST(RefocusdProcessTest, KilledAtRandomMomentsLeavesWholePhotosOrNothing) {
     std::vector<std::string> photos, temps;
     ListPhotos(d.out_dir(), &photos, &temps);
     ASSERT_TRUE(d.Start());
-    ASSERT_TRUE(d.WaitForLine("ready:", kStartMs)) << d.log();
+    ASSERT_TRUE(d.WaitForLine("ready: sensor", kStartMs)) << d.log();
     // Leftovers of the previous kill are gone before the first press.
     std::vector<std::string> after;
     ListPhotos(d.out_dir(), &photos, &after);
@@ -226,7 +226,7 @@ TEST(RefocusdProcessTest, KilledAtRandomMomentsLeavesWholePhotosOrNothing) {
   }
   // The last kill's leftovers go at the next start too.
   ASSERT_TRUE(d.Start());
-  ASSERT_TRUE(d.WaitForLine("ready:", kStartMs)) << d.log();
+  ASSERT_TRUE(d.WaitForLine("ready: sensor", kStartMs)) << d.log();
   d.Signal(SIGTERM);
   EXPECT_EQ(d.Wait(kPhotoMs), 0) << d.log();
   std::vector<std::string> photos, temps;

@@ -20,7 +20,7 @@ TEST(RefocusdSoakTest, FiveHundredPressesGrowNothing) {
   ScratchDir dir;
   RefocusdProcess d(dir.dir(), "resolution = 128x96\nlabels = 8\n");
   ASSERT_TRUE(d.Start());
-  ASSERT_TRUE(d.WaitForLine("ready:", 10000)) << d.log();
+  ASSERT_TRUE(d.WaitForLine("ready: sensor", 10000)) << d.log();
   long rss_warm = 0;
   int fds_warm = 0;
   for (int i = 1; i <= kPresses; ++i) {
