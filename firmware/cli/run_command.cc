@@ -146,6 +146,18 @@ int RunCommand(int argc, char** argv) {
     Status s = input_dir.empty() ? FileSensor::FromFiles(files, &fs)
                                  : FileSensor::FromDirectory(input_dir.c_str(), &fs);
     if (!s.ok()) return Fail(s.message());
+    // The frames' size from their headers, checked here so that the message names a file.
+    SensorMode mode;
+    s = fs->Configure(SensorConfig(), &mode);
+    if (!s.ok()) return Fail(s.message());
+    if (mode.width < 16 || mode.height < 16 || mode.width > PipelineConfig::kMaxWidth ||
+        mode.height > PipelineConfig::kMaxHeight) {
+      char msg[600];
+      snprintf(msg, sizeof(msg), "%s: %dx%d frames: refocus takes 16x16 .. %dx%d",
+               fs->paths()[0].c_str(), mode.width, mode.height, PipelineConfig::kMaxWidth,
+               PipelineConfig::kMaxHeight);
+      return Fail(msg);
+    }
     file_sensor = fs.get();
     sensor = std::move(fs);
     job.sensor.width = job.sensor.height = 0;  // the files decide

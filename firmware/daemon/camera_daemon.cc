@@ -149,7 +149,8 @@ void CameraDaemon::BecomeReady() {
   ready_.store(true);
   log_->Printf(LogLevel::kInfo, "ready: sensor %s%s%s, %dx%d, %d frames; photos to %s (next %04d)",
                sensor_->name(), config_.device.empty() ? "" : " ", config_.device.c_str(),
-               config_.width, config_.height, config_.frames, dir, namer_.next_counter());
+               config_.job.sensor.width, config_.job.sensor.height, config_.job.sensor.frames, dir,
+               namer_.next_counter());
 }
 
 Status CameraDaemon::Run() {

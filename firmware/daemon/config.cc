@@ -1,13 +1,14 @@
 #include "firmware/daemon/config.h"
 
 #include <cerrno>
-#include <cmath>
+#include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <vector>
 
 #include "firmware/app/focus.h"
-#include "firmware/app/size_text.h"
+#include "firmware/app/settings.h"
 
 namespace lb {
 namespace {
@@ -28,78 +29,13 @@ bool Fail(Why* why, const char* format, ...) {
   return false;
 }
 
-bool Int(const char* v, int64_t lo, int64_t hi, int64_t* out, Why* why) {
-  char* end = nullptr;
-  errno = 0;
-  const long long x = strtoll(v, &end, 10);
-  if (errno || end == v || *end != '\0' || x < lo || x > hi) {
-    return Fail(why, "'%s' is not a whole number from %lld to %lld", v, static_cast<long long>(lo),
-                static_cast<long long>(hi));
-  }
-  *out = x;
-  return true;
-}
-
 bool Int32(const char* v, int32_t lo, int32_t hi, int32_t* out, Why* why) {
-  int64_t x = 0;
-  if (!Int(v, lo, hi, &x, why)) return false;
-  *out = static_cast<int32_t>(x);
-  return true;
-}
-
-bool Float(const char* v, float lo, float hi, float* out, Why* why) {
-  char* end = nullptr;
-  errno = 0;
-  const float x = strtof(v, &end);
-  if (errno || end == v || *end != '\0' || !std::isfinite(x) || x < lo || x > hi) {
-    return Fail(why, "'%s' is not a number from %g to %g", v, static_cast<double>(lo),
-                static_cast<double>(hi));
-  }
-  *out = x;
-  return true;
-}
-
-bool Size(const char* v, int32_t* w, int32_t* h, Why* why) {
-  if (!ParseSizeText(v, 16, 8192, w, h)) {
-    return Fail(why, "'%s' is not WxH between 16x16 and 8192x8192", v);
-  }
-  return true;
+  return ParseWholeNumber(v, lo, hi, out, why);
 }
 
 bool Text(const char* v, std::string* out, Why* why) {
   if (strlen(v) > kMaxText) return Fail(why, "longer than %zu characters", kMaxText);
   *out = v;
-  return true;
-}
-
-// "center", "point X,Y" or "region X,Y,W,H" in full-resolution pixels.
-bool Focus(const char* v, FocusRegion* out, Why* why) {
-  int x = 0, y = 0, w = 0, h = 0;
-  char tail = 0;
-  if (strcmp(v, "center") == 0) {
-    *out = FocusRegion();
-  } else if (sscanf(v, "point %d,%d%c", &x, &y, &tail) == 2 && x >= 0 && y >= 0) {
-    *out = FocusAtPoint(x, y);  // the same square as refocus --focus X,Y
-  } else if (sscanf(v, "region %d,%d,%d,%d%c", &x, &y, &w, &h, &tail) == 4 && x >= 0 && y >= 0 &&
-             w > 0 && h > 0) {
-    *out = {x, y, w, h};
-  } else {
-    return Fail(why, "'%s' is none of: center, point X,Y, region X,Y,W,H", v);
-  }
-  return true;
-}
-
-bool ApertureShape(const char* v, Aperture* out, Why* why) {
-  int blades = 0;
-  char tail = 0;
-  if (strcmp(v, "disc") == 0) {
-    out->blades = 0;
-  } else if (sscanf(v, "%d-blade%c", &blades, &tail) == 1 && blades >= 3 && blades <= 12 &&
-             strchr(v, ' ') == nullptr) {
-    out->blades = blades;
-  } else {
-    return Fail(why, "'%s' is neither disc nor N-blade with N from 3 to 12", v);
-  }
   return true;
 }
 
@@ -124,24 +60,14 @@ const Key kKeys[] = {
        c->device = strcmp(v, "auto") == 0 ? "" : v;
        return true;
      }},
-    {"resolution",
-     [](const char* v, DaemonConfig* c, Why* why) {
-       if (strcmp(v, "native") == 0) {
-         c->width = c->height = 0;
-         return true;
-       }
-       return Size(v, &c->width, &c->height, why);
-     }},
-    {"frames", [](const char* v, DaemonConfig* c,
-                  Why* why) { return Int32(v, 2, PipelineConfig::kMaxFrames, &c->frames, why); }},
     {"fps",
      [](const char* v, DaemonConfig* c, Why* why) { return Int32(v, 0, 240, &c->fps, why); }},
     {"frame_timeout_ms", [](const char* v, DaemonConfig* c,
                             Why* why) { return Int32(v, 100, 60000, &c->frame_timeout_ms, why); }},
     {"seed",
      [](const char* v, DaemonConfig* c, Why* why) {
-       int64_t x = 0;
-       if (!Int(v, 0, INT32_MAX, &x, why)) return false;
+       int32_t x = 0;
+       if (!Int32(v, 0, INT32_MAX, &x, why)) return false;
        c->seed = static_cast<uint64_t>(x);
        return true;
      }},
@@ -172,58 +98,8 @@ const Key kKeys[] = {
        c->output_dir = v;
        return true;
      }},
-    {"quality",
-     [](const char* v, DaemonConfig* c, Why* why) { return Int32(v, 1, 100, &c->quality, why); }},
     {"make", [](const char* v, DaemonConfig* c, Why* why) { return Text(v, &c->make, why); }},
     {"model", [](const char* v, DaemonConfig* c, Why* why) { return Text(v, &c->model, why); }},
-    {"labels",
-     [](const char* v, DaemonConfig* c, Why* why) { return Int32(v, 2, 256, &c->labels, why); }},
-    {"geometry",
-     [](const char* v, DaemonConfig* c, Why* why) {
-       if (strcmp(v, "auto") == 0) {
-         c->geometry = Geometry::kAuto;
-       } else if (strcmp(v, "rectified") == 0) {
-         c->geometry = Geometry::kRectified;
-       } else {
-         return Fail(why, "'%s' is neither auto nor rectified", v);
-       }
-       return true;
-     }},
-    {"focal_35mm",
-     [](const char* v, DaemonConfig* c, Why* why) {
-       const bool ok = Int32(v, 0, 2000, &c->focal_35mm, why);
-       if (ok && c->focal_35mm != 0 && c->focal_35mm < 8) return Fail(why, "%s mm is no lens", v);
-       return ok;
-     }},
-    {"working_size", [](const char* v, DaemonConfig* c,
-                        Why* why) { return Size(v, &c->working_width, &c->working_height, why); }},
-    {"focus",
-     [](const char* v, DaemonConfig* c, Why* why) { return Focus(v, &c->render.focus, why); }},
-    {"f_number", [](const char* v, DaemonConfig* c,
-                    Why* why) { return Float(v, 1.0f, 22.0f, &c->render.f_number, why); }},
-    {"aperture", [](const char* v, DaemonConfig* c,
-                    Why* why) { return ApertureShape(v, &c->render.aperture, why); }},
-    {"aperture_rotation",
-     [](const char* v, DaemonConfig* c, Why* why) {
-       return Float(v, -360.0f, 360.0f, &c->render.aperture.rotation_deg, why);
-     }},
-    {"blade_curvature",
-     [](const char* v, DaemonConfig* c, Why* why) {
-       return Float(v, 0.0f, 1.0f, &c->render.aperture.curvature, why);
-     }},
-    {"highlight_threshold",
-     [](const char* v, DaemonConfig* c, Why* why) {
-       int32_t t = 0;
-       if (!Int32(v, 0, 255, &t, why)) return false;
-       c->render.highlight_threshold = static_cast<uint8_t>(t);
-       return true;
-     }},
-    {"highlight_gain",
-     [](const char* v, DaemonConfig* c, Why* why) {
-       return Float(v, 1.0f, 8.0f, &c->render.highlight_gain, why);
-     }},
-    {"max_blur_radius", [](const char* v, DaemonConfig* c,
-                           Why* why) { return Int32(v, 0, 128, &c->max_blur_radius, why); }},
     {"log_level",
      [](const char* v, DaemonConfig* c, Why* why) {
        if (ParseLogLevel(v, &c->log_level)) return true;
@@ -231,6 +107,20 @@ const Key kKeys[] = {
      }},
 };
 constexpr int kKeyCount = sizeof(kKeys) / sizeof(kKeys[0]);
+
+// The shared settings' names as refocusd.conf spells them (f_number), after refocusd's own keys.
+const std::vector<std::string>& SettingKeys() {
+  static const std::vector<std::string> keys = [] {
+    std::vector<std::string> out;
+    for (int i = 0; const Setting* s = SettingAt(i); ++i) {
+      std::string key = s->name;
+      for (char& ch : key) ch = ch == '-' ? '_' : ch;
+      out.push_back(key);
+    }
+    return out;
+  }();
+  return keys;
+}
 
 void Trim(std::string* s) {
   const char* space = " \t\r";
@@ -245,7 +135,21 @@ void Trim(std::string* s) {
 
 }  // namespace
 
-const char* ConfigKeyName(int i) { return i >= 0 && i < kKeyCount ? kKeys[i].name : nullptr; }
+const char* ConfigKeyName(int i) {
+  if (i >= 0 && i < kKeyCount) return kKeys[i].name;
+  const std::vector<std::string>& settings = SettingKeys();
+  const size_t j = static_cast<size_t>(i - kKeyCount);
+  return i >= kKeyCount && j < settings.size() ? settings[j].c_str() : nullptr;
+}
+
+JobOptions DaemonJobDefaults() {
+  JobOptions o;
+  o.sensor.width = 1280;
+  o.sensor.height = 960;
+  o.pipeline.labels = 32;  // half the command line's: a board's seconds count
+  o.pipeline.geometry = Geometry::kAuto;
+  return o;
+}
 
 const char* BackendName(Backend backend) {
   switch (backend) {
@@ -260,7 +164,8 @@ const char* BackendName(Backend backend) {
 }
 
 Status ParseConfig(const char* name, const char* text, DaemonConfig* config) {
-  int first_line[kKeyCount] = {};
+  const int count = kKeyCount + static_cast<int>(SettingKeys().size());
+  std::vector<int> first_line(static_cast<size_t>(count), 0);
   int line_no = 0;
   int focus_line = 0;
   const char* p = text;
@@ -280,31 +185,35 @@ Status ParseConfig(const char* name, const char* text, DaemonConfig* config) {
     Trim(&key);
     Trim(&value);
     int k = 0;
-    while (k < kKeyCount && key != kKeys[k].name) ++k;
-    if (k == kKeyCount) {
+    while (k < count && key != ConfigKeyName(k)) ++k;
+    if (k == count) {
       return Status(Code::kInvalidArgument, "%s:%d: unknown key '%.60s'", name, line_no,
                     key.c_str());
     }
-    if (first_line[k] != 0) {
+    const char* const known = ConfigKeyName(k);
+    int& first = first_line[static_cast<size_t>(k)];
+    if (first != 0) {
       return Status(Code::kInvalidArgument, "%s:%d: %s is already set on line %d", name, line_no,
-                    kKeys[k].name, first_line[k]);
+                    known, first);
     }
-    first_line[k] = line_no;
+    first = line_no;
     if (value.empty()) {
-      return Status(Code::kInvalidArgument, "%s:%d: %s has no value", name, line_no, kKeys[k].name);
+      return Status(Code::kInvalidArgument, "%s:%d: %s has no value", name, line_no, known);
     }
     Why why;
-    if (!kKeys[k].parse(value.c_str(), config, &why)) {
-      return Status(Code::kInvalidArgument, "%s:%d: %s: %s", name, line_no, kKeys[k].name,
-                    why.c_str());
+    const bool ok = k < kKeyCount
+                        ? kKeys[k].parse(value.c_str(), config, &why)
+                        : SettingAt(k - kKeyCount)->parse(value.c_str(), &config->job, &why);
+    if (!ok) {
+      return Status(Code::kInvalidArgument, "%s:%d: %s: %s", name, line_no, known, why.c_str());
     }
-    if (strcmp(kKeys[k].name, "focus") == 0) focus_line = line_no;
+    if (strcmp(known, "focus") == 0) focus_line = line_no;
   }
-  const FocusRegion& f = config->render.focus;
-  if (config->width > 0 && f.width > 0 &&
-      (f.x + f.width > config->width || f.y + f.height > config->height)) {
-    return Status(Code::kInvalidArgument, "%s:%d: focus lies outside the %dx%d picture", name,
-                  focus_line, config->width, config->height);
+  // As the command line checks it once the frame size is known (the native size: at start).
+  const SensorConfig& sensor = config->job.sensor;
+  if (sensor.width > 0) {
+    Status s = CheckFocusRegion(config->job.render.focus, sensor.width, sensor.height);
+    if (!s.ok()) return s.Prefix("%s:%d: focus: ", name, focus_line);
   }
   return Status::Ok();
 }
@@ -332,20 +241,9 @@ Status LoadConfig(const char* path, DaemonConfig* config) {
 }
 
 JobOptions MakeJobOptions(const DaemonConfig& config) {
-  JobOptions o;
-  o.sensor.width = config.width;
-  o.sensor.height = config.height;
-  o.sensor.frames = config.frames;
+  JobOptions o = config.job;
   o.sensor.timeout_ms = config.frame_timeout_ms;
   o.pipeline.reference = -1;  // the middle frame
-  o.pipeline.labels = config.labels;
-  o.pipeline.geometry = config.geometry;
-  o.focal_35mm = config.focal_35mm;
-  o.pipeline.max_working_width = config.working_width;
-  o.pipeline.max_working_height = config.working_height;
-  o.pipeline.max_blur_radius = config.max_blur_radius;
-  o.render = config.render;
-  o.quality = config.quality;
   o.make = config.make.c_str();
   o.model = config.model.c_str();
   o.software = "refocusd";

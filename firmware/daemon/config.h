@@ -18,13 +18,15 @@ const char* BackendName(Backend backend);
 // What a press does while a photo is being taken.
 enum class BusyPolicy : uint8_t { kQueue, kRefuse };
 
+// The photo settings refocusd starts from: the shared table's defaults (firmware/app/settings.h)
+// but for fewer depth labels, and auto geometry (a camera is handheld).
+JobOptions DaemonJobDefaults();
+
 struct DaemonConfig {
   // Sensor.
   Backend backend = Backend::kV4l2;
-  std::string device;                  // "" (auto): v4l2 /dev/video0, libcamera the first camera
-  int32_t width = 1280, height = 960;  // 0 x 0 = the sensor's native size
-  int32_t frames = 5;
-  int32_t fps = 0;  // v4l2 only; 0 = the driver's choice
+  std::string device;  // "" (auto): v4l2 /dev/video0, libcamera the first camera
+  int32_t fps = 0;     // v4l2 only; 0 = the driver's choice
   int32_t frame_timeout_ms = 2000;
   uint64_t seed = 1;  // synthetic scene
   // Button.
@@ -34,15 +36,10 @@ struct DaemonConfig {
   int32_t capture_retries = 1;  // fresh bursts after a dropped frame
   // Storage.
   std::string output_dir = "/var/lib/refocusd";
-  int32_t quality = 92;
   std::string make = "LensBlur", model = "LensBlur camera";
-  // Depth and lens.
-  int32_t labels = 32;
-  Geometry geometry = Geometry::kAuto;
-  int32_t focal_35mm = 0;  // 35 mm equivalent focal length of the lens, mm; 0 = unknown
-  int32_t working_width = 640, working_height = 480;
-  RenderParams render;  // focus, f-number, aperture
-  int32_t max_blur_radius = 32;
+  // The shared settings: resolution (job.sensor, 0 x 0 = the sensor's native size), frames,
+  // depth, lens and JPEG quality.
+  JobOptions job = DaemonJobDefaults();
   // Log.
   LogLevel log_level = LogLevel::kInfo;
 };
@@ -56,7 +53,8 @@ Status LoadConfig(const char* path, DaemonConfig* config);
 // The job settings the configuration implies; make and model point into `config`.
 JobOptions MakeJobOptions(const DaemonConfig& config);
 
-// The keys ParseConfig accepts, i = 0, 1, ... until nullptr (tests check each is documented).
+// The keys ParseConfig accepts, i = 0, 1, ... until nullptr: refocusd's own, then the shared
+// settings' (tests check each is documented).
 const char* ConfigKeyName(int i);
 
 }  // namespace lb

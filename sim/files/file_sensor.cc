@@ -8,7 +8,6 @@
 #include <cerrno>
 #include <cstring>
 
-#include "algo/pipeline/pipeline.h"
 #include "sim/files/exif_focal.h"
 #include "sim/files/image_file.h"
 
@@ -122,13 +121,6 @@ Status FileSensor::Configure(const SensorConfig& config, SensorMode* mode) {
                     paths_[i].c_str(), PixelFormatName(info.format), paths_[0].c_str(),
                     PixelFormatName(first.format));
     }
-  }
-  // The camera's limits, checked here so the message can name the file.
-  if (first.width < 16 || first.height < 16 || first.width > PipelineConfig::kMaxWidth ||
-      first.height > PipelineConfig::kMaxHeight) {
-    return Status(Code::kUnsupported, "%s: %dx%d frames: the pipeline takes 16x16 .. %dx%d",
-                  paths_[0].c_str(), first.width, first.height, PipelineConfig::kMaxWidth,
-                  PipelineConfig::kMaxHeight);
   }
   if ((config.width != 0 && config.width != first.width) ||
       (config.height != 0 && config.height != first.height)) {

@@ -230,10 +230,10 @@ class CameraDaemonTest : public ::testing::Test {
  protected:
   CameraDaemonTest() {
     config_.backend = Backend::kSynthetic;
-    config_.width = 128;
-    config_.height = 96;
-    config_.frames = 5;
-    config_.labels = 8;
+    config_.job.sensor.width = 128;
+    config_.job.sensor.height = 96;
+    config_.job.sensor.frames = 5;
+    config_.job.pipeline.labels = 8;
     config_.output_dir = dir_.dir();
     config_.log_level = LogLevel::kDebug;
   }
@@ -271,8 +271,8 @@ class CameraDaemonTest : public ::testing::Test {
     std::string error;
     ASSERT_TRUE(test::DecodeYcc(test::ReadFile(dir_.Path(name)), &w, &h, &ycc, &error))
         << name << ": " << error;
-    EXPECT_EQ(w, config_.width);
-    EXPECT_EQ(h, config_.height);
+    EXPECT_EQ(w, config_.job.sensor.width);
+    EXPECT_EQ(h, config_.job.sensor.height);
   }
 
   test::ScratchDir dir_;

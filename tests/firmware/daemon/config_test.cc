@@ -7,6 +7,7 @@
 #include <string>
 
 #include "firmware/app/focus.h"
+#include "firmware/app/settings.h"
 #include "tests/firmware/jpeg/jpeg_test_util.h"
 
 namespace lb {
@@ -36,19 +37,19 @@ TEST(ConfigTest, ShippedFileParsesToTheDefaults) {
   const DaemonConfig d;
   EXPECT_EQ(parsed.backend, d.backend);
   EXPECT_EQ(parsed.device, d.device);
-  EXPECT_EQ(parsed.width, d.width);
-  EXPECT_EQ(parsed.height, d.height);
-  EXPECT_EQ(parsed.frames, d.frames);
+  EXPECT_EQ(parsed.job.sensor.width, d.job.sensor.width);
+  EXPECT_EQ(parsed.job.sensor.height, d.job.sensor.height);
+  EXPECT_EQ(parsed.job.sensor.frames, d.job.sensor.frames);
   EXPECT_EQ(parsed.frame_timeout_ms, d.frame_timeout_ms);
   EXPECT_EQ(parsed.button, d.button);
   EXPECT_EQ(parsed.busy, d.busy);
   EXPECT_EQ(parsed.capture_retries, d.capture_retries);
   EXPECT_EQ(parsed.output_dir, d.output_dir);
-  EXPECT_EQ(parsed.quality, d.quality);
-  EXPECT_EQ(parsed.labels, d.labels);
-  EXPECT_EQ(parsed.render.f_number, d.render.f_number);
-  EXPECT_EQ(parsed.render.aperture.blades, d.render.aperture.blades);
-  EXPECT_EQ(parsed.render.focus.width, 0);
+  EXPECT_EQ(parsed.job.quality, d.job.quality);
+  EXPECT_EQ(parsed.job.pipeline.labels, d.job.pipeline.labels);
+  EXPECT_EQ(parsed.job.render.f_number, d.job.render.f_number);
+  EXPECT_EQ(parsed.job.render.aperture.blades, d.job.render.aperture.blades);
+  EXPECT_EQ(parsed.job.render.focus.width, 0);
   EXPECT_EQ(parsed.log_level, d.log_level);
 }
 
@@ -83,16 +84,16 @@ TEST(ConfigTest, ValuesReachTheSettings) {
   ASSERT_TRUE(s.ok()) << s.message();
   EXPECT_EQ(c.backend, Backend::kSynthetic);
   EXPECT_EQ(c.device, "/dev/video4");
-  EXPECT_EQ(c.width, 640);
-  EXPECT_EQ(c.height, 480);
-  EXPECT_EQ(c.frames, 7);
+  EXPECT_EQ(c.job.sensor.width, 640);
+  EXPECT_EQ(c.job.sensor.height, 480);
+  EXPECT_EQ(c.job.sensor.frames, 7);
   EXPECT_EQ(c.frame_timeout_ms, 500);
   EXPECT_EQ(c.busy, BusyPolicy::kRefuse);
   EXPECT_EQ(c.output_dir, "/media/card/DCIM");
-  EXPECT_EQ(c.render.focus.x, 10);
-  EXPECT_EQ(c.render.focus.height, 40);
-  EXPECT_FLOAT_EQ(c.render.f_number, 1.4f);
-  EXPECT_EQ(c.render.aperture.blades, 6);
+  EXPECT_EQ(c.job.render.focus.x, 10);
+  EXPECT_EQ(c.job.render.focus.height, 40);
+  EXPECT_FLOAT_EQ(c.job.render.f_number, 1.4f);
+  EXPECT_EQ(c.job.render.aperture.blades, 6);
   EXPECT_EQ(c.log_level, LogLevel::kDebug);
 
   const JobOptions o = MakeJobOptions(c);
@@ -111,24 +112,27 @@ TEST(ConfigTest, GeometryAndLensReachTheJob) {
   EXPECT_EQ(o.focal_35mm, 28);
   EXPECT_EQ(Error("geometry = tripod\n"),
             "test.conf:1: geometry: 'tripod' is neither auto nor rectified");
-  EXPECT_EQ(Error("focal_35mm = 4\n"), "test.conf:1: focal_35mm: 4 mm is no lens");
+  EXPECT_EQ(Error("focal_35mm = 4\n"),
+            "test.conf:1: focal_35mm: '4' is neither 0 (unknown) nor a focal length from 8 to "
+            "2000 mm");
   EXPECT_EQ(Error("focal_35mm = 9000\n"),
-            "test.conf:1: focal_35mm: '9000' is not a whole number from 0 to 2000");
+            "test.conf:1: focal_35mm: '9000' is neither 0 (unknown) nor a focal length from 8 to "
+            "2000 mm");
 }
 
 TEST(ConfigTest, NativeResolutionAutoDeviceAndPointFocus) {
   DaemonConfig c;
   c.device = "/dev/video9";
-  ASSERT_TRUE(Parse("resolution = native\ndevice = auto\nfocus = point 5,6\n", &c).ok());
-  EXPECT_EQ(c.width, 0);
-  EXPECT_EQ(c.height, 0);
+  ASSERT_TRUE(Parse("resolution = native\ndevice = auto\nfocus = point 50,60\n", &c).ok());
+  EXPECT_EQ(c.job.sensor.width, 0);
+  EXPECT_EQ(c.job.sensor.height, 0);
   EXPECT_EQ(c.device, "");
   // Issue 13, defect 6: a point means what it means on the command line (firmware/app/focus.h).
-  const FocusRegion cli = FocusAtPoint(5, 6);
-  EXPECT_EQ(c.render.focus.x, cli.x);
-  EXPECT_EQ(c.render.focus.y, cli.y);
-  EXPECT_EQ(c.render.focus.width, cli.width);
-  EXPECT_EQ(c.render.focus.height, cli.height);
+  const FocusRegion cli = FocusAtPoint(50, 60);
+  EXPECT_EQ(c.job.render.focus.x, cli.x);
+  EXPECT_EQ(c.job.render.focus.y, cli.y);
+  EXPECT_EQ(c.job.render.focus.width, cli.width);
+  EXPECT_EQ(c.job.render.focus.height, cli.height);
   EXPECT_EQ(cli.width, 2 * kFocusPointHalfSide);
 }
 
@@ -136,7 +140,8 @@ TEST(ConfigTest, ErrorsNameTheFileTheLineAndTheProblem) {
   EXPECT_EQ(Error("frames = 5\n\nburst = 3\n"), "test.conf:3: unknown key 'burst'");
   // Issue 13, defect 6: no integer overflow turns a size into another one.
   EXPECT_EQ(Error("resolution = 4294967616x240\n"),
-            "test.conf:1: resolution: '4294967616x240' is not WxH between 16x16 and 8192x8192");
+            "test.conf:1: resolution: '4294967616x240' is neither native nor WxH between 16x16 "
+            "and 8192x8192");
   EXPECT_EQ(Error("frames 5\n"), "test.conf:1: 'frames 5' is not 'key = value'");
   EXPECT_EQ(Error("frames = 5\nframes = 6\n"), "test.conf:2: frames is already set on line 1");
   EXPECT_EQ(Error("quality =\n"), "test.conf:1: quality has no value");
@@ -145,18 +150,80 @@ TEST(ConfigTest, ErrorsNameTheFileTheLineAndTheProblem) {
   EXPECT_EQ(Error("backend = usb\n"),
             "test.conf:1: backend: 'usb' is none of: v4l2, libcamera, synthetic");
   EXPECT_EQ(Error("resolution = 640*480\n"),
-            "test.conf:1: resolution: '640*480' is not WxH between 16x16 and 8192x8192");
+            "test.conf:1: resolution: '640*480' is neither native nor WxH between 16x16 and "
+            "8192x8192");
   EXPECT_EQ(Error("aperture = 2-blade\n"),
-            "test.conf:1: aperture: '2-blade' is neither disc nor N-blade with N from 3 to 12");
+            "test.conf:1: aperture: '2-blade' is none of: disc, N-blade, polygon:N with N from 3 "
+            "to 12");
   EXPECT_EQ(Error("f_number = nan\n"), "test.conf:1: f_number: 'nan' is not a number from 1 to 22");
   EXPECT_EQ(Error("busy_press = drop\n"),
             "test.conf:1: busy_press: 'drop' is neither queue nor refuse");
   EXPECT_EQ(Error("focus = middle\n"),
-            "test.conf:1: focus: 'middle' is none of: center, point X,Y, region X,Y,W,H");
+            "test.conf:1: focus: 'middle' is none of: center, X,Y (a point), X,Y,W,H (a "
+            "rectangle), in pixels of the photo");
   EXPECT_EQ(Error("log_level = loud\n"),
             "test.conf:1: log_level: 'loud' is none of: debug, info, warning, error");
-  EXPECT_EQ(Error("resolution = 320x240\n# x\nfocus = region 300,10,40,40\n"),
-            "test.conf:3: focus lies outside the 320x240 picture");
+  EXPECT_EQ(Error("resolution = 320x240\n# x\nfocus = region 330,10,40,40\n"),
+            "test.conf:3: focus: the focus region 330,10,40,40 lies outside the 320x240 photo");
+  EXPECT_EQ(Error("f-number = 2\n"), "test.conf:1: unknown key 'f-number'");
+  EXPECT_EQ(Error("size = 320x240\n"), "test.conf:1: unknown key 'size'");
+}
+
+// Issue 13: one parser for the command line and the file. Every shared setting, given the same
+// text under its two spellings, sets the same job.
+TEST(ConfigTest, EverySharedSettingMeansWhatTheCommandLineMeans) {
+  const char* const value_of[][2] = {
+      {"focus", "100,80"},
+      {"f-number", "1.8"},
+      {"aperture", "polygon:7"},
+      {"aperture-rotation", "15"},
+      {"blade-curvature", "0.5"},
+      {"highlight-threshold", "200"},
+      {"highlight-gain", "3"},
+      {"max-blur-radius", "40"},
+      {"quality", "80"},
+      {"resolution", "640x480"},
+      {"frames", "7"},
+      {"geometry", "rectified"},
+      {"focal-35mm", "28"},
+      {"labels", "48"},
+      {"working-size", "320x240"},
+  };
+  int covered = 0;
+  for (const auto& [name, value] : value_of) {
+    SCOPED_TRACE(name);
+    const Setting* s = FindSetting(name);
+    ASSERT_NE(s, nullptr);
+    JobOptions cli = DaemonConfig().job;
+    std::string why;
+    ASSERT_TRUE(s->parse(value, &cli, &why)) << why;
+    std::string key = name;
+    for (char& ch : key) ch = ch == '-' ? '_' : ch;
+    DaemonConfig c;
+    const Status st = Parse((key + " = " + value + "\n").c_str(), &c);
+    ASSERT_TRUE(st.ok()) << st.message();
+    const JobOptions& conf = c.job;
+    EXPECT_EQ(conf.render.focus.x, cli.render.focus.x);
+    EXPECT_EQ(conf.render.focus.width, cli.render.focus.width);
+    EXPECT_EQ(conf.render.f_number, cli.render.f_number);
+    EXPECT_EQ(conf.render.aperture.blades, cli.render.aperture.blades);
+    EXPECT_EQ(conf.render.aperture.rotation_deg, cli.render.aperture.rotation_deg);
+    EXPECT_EQ(conf.render.aperture.curvature, cli.render.aperture.curvature);
+    EXPECT_EQ(conf.render.highlight_threshold, cli.render.highlight_threshold);
+    EXPECT_EQ(conf.render.highlight_gain, cli.render.highlight_gain);
+    EXPECT_EQ(conf.pipeline.max_blur_radius, cli.pipeline.max_blur_radius);
+    EXPECT_EQ(conf.quality, cli.quality);
+    EXPECT_EQ(conf.sensor.width, cli.sensor.width);
+    EXPECT_EQ(conf.sensor.frames, cli.sensor.frames);
+    EXPECT_EQ(conf.pipeline.geometry, cli.pipeline.geometry);
+    EXPECT_EQ(conf.focal_35mm, cli.focal_35mm);
+    EXPECT_EQ(conf.pipeline.labels, cli.pipeline.labels);
+    EXPECT_EQ(conf.pipeline.max_working_width, cli.pipeline.max_working_width);
+    ++covered;
+  }
+  int settings = 0;
+  while (SettingAt(settings) != nullptr) ++settings;
+  EXPECT_EQ(covered, settings) << "a setting without a case here";
 }
 
 TEST(ConfigTest, UnreadableFilesAreClearErrors) {
