@@ -22,14 +22,6 @@ inline CameraIntrinsics DefaultIntrinsics(int32_t width, int32_t height) {
   return {f, f, 0.5 * width, 0.5 * height};
 }
 
-// Focal length in pixels from an EXIF focal length and the sensor width (both mm, or a 35 mm
-// equivalent focal length with sensor_width_mm = 36), principal point at the centre.
-inline CameraIntrinsics IntrinsicsFromFocal(double focal_mm, double sensor_width_mm, int32_t width,
-                                            int32_t height) {
-  const double f = focal_mm / sensor_width_mm * width;
-  return {f, f, 0.5 * width, 0.5 * height};
-}
-
 // A 35 mm equivalent focal length (mm) as px of a width x height image, and back: the equivalent
 // is defined on the 43.27 mm diagonal of a 36 x 24 mm frame, so any aspect ratio works.
 inline double FocalPxFrom35mm(double focal_35mm, int32_t width, int32_t height) {
@@ -40,8 +32,9 @@ inline double Focal35mmFromPx(double focal_px, int32_t width, int32_t height) {
   return focal_px / FocalPxFrom35mm(1.0, width, height);
 }
 
-// The lens's radial distortion, one term, and the focal length's error k0 (bundle.h): a
-// distorted normalised point (x, y) is the pinhole's (x, y) times this.
+// The lens's radial distortion, one term, and the focal length's error k0 (bundle.h): an
+// observed (distorted) normalised point (x, y) times this is the pinhole's point, as bundle.h
+// undistorts the observations.
 inline double UndistortScale(double k1, double x, double y, double k0 = 0) {
   return 1 + k0 + k1 * (x * x + y * y);
 }

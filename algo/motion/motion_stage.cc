@@ -2,8 +2,13 @@
 
 #include <algorithm>
 
+#include "algo/motion/parallax.h"
+#include "algo/motion/rail.h"
+
 namespace lb {
 namespace {
+
+static_assert(MotionConfig::kMaxViews <= kMaxRailViews);
 
 int32_t Cell(const MotionConfig& c) {
   if (c.cell > 0) return c.cell;
@@ -28,64 +33,6 @@ double RotationChord(const ViewMotion& m) {
 }
 
 }  // namespace
-
-bool MotionStage::IsRail(const MotionResult& r, double axis[3]) const {
-  const MotionConfig& c = config_;
-  if (!(c.rail_off_axis > 0) || r.views < 3) return false;
-  // The rail's direction: the translations, each turned to point the way of later frames.
-  double u[3] = {0, 0, 0};
-  for (int32_t v = 0; v < r.views; ++v) {
-    const double sign = v > r.reference ? 1.0 : -1.0;
-    if (v == r.reference) continue;
-    for (int32_t k = 0; k < 3; ++k) u[k] += sign * r.motion[v].translation[k];
-  }
-  const double uu = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
-  if (!(uu > 0)) return false;
-  double spacing[MotionConfig::kMaxViews] = {}, mean = 0;
-  for (int32_t v = 0; v < r.views; ++v) {
-    if (v == r.reference) continue;
-    const double* t = r.motion[v].translation;
-    const double sign = v > r.reference ? 1.0 : -1.0;
-    const double tt = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
-    const double along = sign * (t[0] * u[0] + t[1] * u[1] + t[2] * u[2]);
-    // Off the line by more than rail_off_axis of its length (sin of the angle), or backwards.
-    if (!(along > 0) || tt * uu - along * along > c.rail_off_axis * c.rail_off_axis * tt * uu) {
-      return false;
-    }
-    spacing[v] = __builtin_sqrt(tt) / (sign * (v - r.reference));
-    mean += spacing[v] / (r.views - 1);
-  }
-  for (int32_t v = 0; v < r.views; ++v) {
-    if (v == r.reference) continue;
-    const double d = spacing[v] - mean;
-    if ((d < 0 ? -d : d) > c.rail_spacing * mean) return false;
-  }
-  // The turn small motion confuses with depth: about z x u, the axis that shifts the image
-  // along the rail. Turns about the rail itself and about the optical axis show on their own.
-  const double a[3] = {-u[1], u[0], 0};
-  const double aa = a[0] * a[0] + a[1] * a[1];
-  if (!(aa > 1e-6 * uu)) return false;  // a rail along the optical axis: nothing confused
-  for (int32_t k = 0; k < 3; ++k) axis[k] = a[k] / __builtin_sqrt(aa);
-  return true;
-}
-
-const char* MotionDiagnosisName(MotionDiagnosis d) {
-  switch (d) {
-    case MotionDiagnosis::kOk:
-      return "ok";
-    case MotionDiagnosis::kTooFewFeatures:
-      return "too few features";
-    case MotionDiagnosis::kBlurredFrame:
-      return "blurred frame";
-    case MotionDiagnosis::kLostTracking:
-      return "lost tracking";
-    case MotionDiagnosis::kNoMotion:
-      return "no motion";
-    case MotionDiagnosis::kPureRotation:
-      return "pure rotation";
-  }
-  return "?";
-}
 
 Status MotionStage::Validate(const MotionConfig& c) {
   if (c.views < 2 || c.views > MotionConfig::kMaxViews) {
@@ -315,13 +262,12 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
     }
   }
   for (int32_t round = 0; round < c.bundle_rounds; ++round) {
-    // The distortion joins once the poses have settled without it: from the identity start a
-    // free k1 can run off before the rotations have taken their share.
+    // The focal length joins once the poses have settled without it: from the identity start a
+    // free k0 can run off before the rotations have taken their share.
     const bool settled = round > 0 || c.bundle_rounds == 1;
-    double* k1 = c.estimate_distortion && settled ? &result->k1 : nullptr;
     double* k0 = c.estimate_focal && settled ? &result->k0 : nullptr;
     LB_RETURN_IF_ERROR(bundle_.Solve(in, c.bundle_iterations, c.huber_px, result->motion,
-                                     inv_depth_, k1, k0, &report));
+                                     inv_depth_, nullptr, k0, &report));
     if (round + 1 == c.bundle_rounds) break;
     // Drop the observations the fit cannot explain (mismatched corners, moving things), and
     // points left with none.
@@ -346,7 +292,8 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
   // frames lie on one line at equal steps came from a rail (a slider, a rig) that holds the
   // camera's orientation: it is solved again with that turn held, and with the lens's radial
   // distortion, which the turn no longer absorbs (on tsukuba it is k1 = -0.046).
-  result->rail = IsRail(*result, in.prior_axis);
+  result->rail = IsRail(result->motion, result->views, result->reference,
+                        {c.rail_off_axis, c.rail_spacing}, in.prior_axis);
   if (result->rail && c.rail_rotation_prior > 0) {
     in.rotation_prior = c.rail_rotation_prior;
     LB_RETURN_IF_ERROR(bundle_.Solve(in, c.bundle_iterations, c.huber_px, result->motion,
@@ -377,33 +324,18 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
   std::sort(sorted_, sorted_ + m);
   result->inv_depth_min = sorted_[(m - 1) * 2 / 100];
   result->inv_depth_max = sorted_[(m - 1) * 98 / 100];
-  // Parallax: how far depth moves a point in the view, against the same ray at the median
-  // depth. Without translation the fit can still give wild depths (w t stays tiny), so this,
-  // not |t| or the depth spread alone, says whether the burst holds depth.
-  const double w_med = sorted_[m / 2];
+  // Parallax (parallax.h), against the same ray at the median depth.
+  ParallaxPoints pts;
+  pts.xy = out_xy_;
+  pts.inv_depth = out_w_;
+  pts.count = m;
+  pts.inv_depth_ref = sorted_[m / 2];
+  pts.measured = k;
+  pts.projected = result->intrinsics;
+  pts.k1 = result->k1;
+  pts.k0 = result->k0;
   for (int32_t v = 0; v < c.views; ++v) {
-    if (v == reference) continue;
-    for (int32_t j = 0; j < m; ++j) {
-      double p[2][3];
-      double r[3] = {(out_xy_[2 * j] + 0.5 - k.cx) / k.fx, (out_xy_[2 * j + 1] + 0.5 - k.cy) / k.fy,
-                     1.0};
-      const double u = UndistortScale(result->k1, r[0], r[1], result->k0);
-      r[0] *= u;
-      r[1] *= u;
-      const ViewMotion& mo = result->motion[v];
-      const double ws[2] = {out_w_[j], w_med};
-      for (int s = 0; s < 2; ++s) {
-        for (int i = 0; i < 3; ++i) {
-          p[s][i] = mo.rotation[i][0] * r[0] + mo.rotation[i][1] * r[1] + mo.rotation[i][2] * r[2] +
-                    ws[s] * mo.translation[i];
-        }
-      }
-      const double dx = result->intrinsics.fx * (p[0][0] / p[0][2] - p[1][0] / p[1][2]);
-      const double dy = result->intrinsics.fy * (p[0][1] / p[0][2] - p[1][1] / p[1][2]);
-      sorted_[j] = __builtin_sqrt(dx * dx + dy * dy);
-    }
-    std::sort(sorted_, sorted_ + m);
-    result->parallax_px[v] = sorted_[(m - 1) * 90 / 100];
+    if (v != reference) result->parallax_px[v] = ParallaxPx(pts, result->motion[v], sorted_);
   }
   return Status::Ok();
 }

@@ -4,9 +4,9 @@
 //
 // Steps: grey pyramids (pyramid.h), corners on the reference (corners.h), pyramidal
 // Lucas-Kanade into every view (tracker.h), small-motion bundle adjustment under a Huber loss
-// with the worst observations dropped and the adjustment rerun (bundle.h), the rail test (frames
-// on a line at equal steps: adjusted again with the turn across the rail held and the lens's
-// radial distortion fitted), then the checks.
+// with the worst observations dropped and the adjustment rerun (bundle.h), the rail test (rail.h:
+// frames on a line at equal steps are adjusted again with the turn across the rail held and the
+// lens's radial distortion fitted), the parallax each view shows (parallax.h), then the checks.
 //
 // Scale convention: inverse depths are signed and scaled to mean |w| 1 over the points, and
 // translations are in the inverse unit. Only the product inv_depth * translation reaches pixels
@@ -45,20 +45,19 @@ struct MotionConfig {
   int32_t height = 0;
   int32_t views = 0;
   int32_t pyramid_levels = 4;  // follows motions up to ~(radius + 1) * 2^(levels - 1) px
-  int32_t cell = 0;            // corner grid cell in px; 0 = max(12, width / 20)
+  int32_t cell = 0;            // corner grid cell in px; 0 = max(8, width / 80)
   TrackerParams tracker;
   int32_t min_features = 40;        // corners, and followed points per view, below: degenerate
   int32_t bundle_iterations = 100;  // per round
   int32_t bundle_rounds = 3;        // adjust, drop observations off by > outlier_px, adjust again
   double huber_px = 0.5;
-  // Radial k1 in every burst's adjustment (bundle.h; a rail's always has it). Off by default:
-  // on a handheld burst k1, the turn across the baseline and the depth offset share one flat
-  // valley, and real frames can slide along it (README, "Motion and auto geometry").
-  bool estimate_distortion = false;
-  // A rail (motion_stage.cc): every frame's translation within rail_off_axis (the sine of the
-  // angle) of one line and its length per frame step within rail_spacing of their mean. The
-  // adjustment then runs once more, with k1, and with this prior weight (bundle.h) on the turn
-  // that shifts the image along the rail, which holds it at ~0. rail_off_axis 0: never a rail.
+  // A rail (rail.h): every frame's translation within rail_off_axis (the sine of the angle) of
+  // one line and its length per frame step within rail_spacing of their mean. The adjustment
+  // then runs once more, with radial k1, and with this prior weight (bundle.h) on the turn that
+  // shifts the image along the rail, which holds it at ~0. rail_off_axis 0: never a rail. Only a
+  // rail's adjustment fits k1: on a handheld burst k1, the turn across the baseline and the depth
+  // offset share one flat valley, and real frames can slide along it (README, "Motion and auto
+  // geometry").
   double rail_off_axis = 0.05;  // ~2.9 degrees
   double rail_spacing = 0.1;
   double rail_rotation_prior = 1000;
@@ -84,7 +83,6 @@ enum class MotionDiagnosis : uint8_t {
   kNoMotion,        // the frames show the same view: the camera did not move
   kPureRotation,    // the camera turned but did not move sideways: no parallax
 };
-const char* MotionDiagnosisName(MotionDiagnosis d);
 
 struct MotionResult {
   MotionDiagnosis diagnosis = MotionDiagnosis::kOk;
@@ -147,8 +145,6 @@ class MotionStage {
   Status Track(const ConstImageU8* views, int32_t reference, MotionResult* result);
   Status Adjust(const CameraIntrinsics& k, int32_t reference, MotionResult* result);
   Status Check(MotionResult* result);
-  // True for a rail; `axis` receives the unit axis of the turn its prior holds.
-  bool IsRail(const MotionResult& result, double axis[3]) const;
 
   MotionConfig config_;
   size_t arena_bytes_ = 0;
