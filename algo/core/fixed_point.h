@@ -27,11 +27,6 @@ constexpr int32_t FromDouble(double v) {
   return static_cast<int32_t>(scaled >= 0 ? scaled + 0.5 : scaled - 0.5);
 }
 
-template <int Frac>
-constexpr double ToDouble(int64_t v) {
-  return static_cast<double>(v) / static_cast<double>(int64_t{1} << Frac);
-}
-
 // Arithmetic shift right with round-half-up (adds 2^(s-1) first). s must be >= 1.
 template <typename T>
 constexpr T RoundShift(T v, int s) {

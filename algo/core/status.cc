@@ -5,34 +5,6 @@
 
 namespace lb {
 
-const char* CodeName(Code code) {
-  switch (code) {
-    case Code::kOk:
-      return "ok";
-    case Code::kInvalidArgument:
-      return "invalid argument";
-    case Code::kOutOfMemory:
-      return "out of memory";
-    case Code::kCorruptData:
-      return "corrupt data";
-    case Code::kIoError:
-      return "I/O error";
-    case Code::kNotFound:
-      return "not found";
-    case Code::kUnsupported:
-      return "unsupported";
-    case Code::kTimeout:
-      return "timeout";
-    case Code::kBusy:
-      return "busy";
-    case Code::kDegenerate:
-      return "degenerate input";
-    case Code::kInternal:
-      return "internal error";
-  }
-  return "unknown";
-}
-
 Status::Status(Code code, const char* format, ...) : code_(code) {
   va_list args;
   va_start(args, format);

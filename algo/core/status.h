@@ -23,8 +23,6 @@ enum class Code : uint8_t {
   kInternal,         // a broken invariant: a bug
 };
 
-const char* CodeName(Code code);
-
 class [[nodiscard]] Status {
  public:
   static constexpr size_t kMaxMessage = 240;
