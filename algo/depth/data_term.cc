@@ -1,5 +1,6 @@
 #include "algo/depth/data_term.h"
 
+#include "algo/core/int_math.h"
 #include "algo/depth/data_term_kernels.h"
 #include "algo/depth/warp_cost.h"
 
@@ -12,8 +13,6 @@ constexpr int32_t kLumaRows = 5;  // and 2 rows up and down
 inline void Prefetch(const uint8_t* p, size_t bytes) {
   for (size_t i = 0; i < bytes; i += 64) __builtin_prefetch(p + i);
 }
-
-inline int32_t Clamp(int32_t v, int32_t lo, int32_t hi) { return v < lo ? lo : (v > hi ? hi : v); }
 
 // BT.601 luma, Q8 weights summing to 256, rounded; stored +/-128 (xor 0x80) so signed byte
 // compares order it; borders replicated into the padding.

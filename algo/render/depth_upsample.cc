@@ -3,15 +3,9 @@
 #include <cmath>
 #include <initializer_list>
 
+#include "algo/core/int_math.h"
+
 namespace lb {
-namespace {
-
-int32_t Abs(int32_t v) { return v < 0 ? -v : v; }
-int32_t Min(int32_t a, int32_t b) { return a < b ? a : b; }
-int32_t Max(int32_t a, int32_t b) { return a > b ? a : b; }
-
-}  // namespace
-
 void DepthUpsampler::Carve(Arena& arena, int32_t width, int32_t height, int32_t scale,
                            int32_t working_width, int32_t working_height) {
   width_ = width, height_ = height, scale_ = scale, ww_ = working_width, wh_ = working_height;

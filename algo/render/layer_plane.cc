@@ -1,114 +1,10 @@
 #include "algo/render/layer_plane.h"
 
+#include "algo/core/int_math.h"
+#include "algo/render/layer_rows.h"
+
 namespace lb {
 namespace {
-
-int32_t Min(int32_t a, int32_t b) { return a < b ? a : b; }
-int32_t Max(int32_t a, int32_t b) { return a > b ? a : b; }
-int32_t Clamp(int32_t v, int32_t lo, int32_t hi) { return v < lo ? lo : (v > hi ? hi : v); }
-
-// Rounded signed division, den > 0 (half away from zero; the same on every platform). The
-// operands fit int32 (|num| < 2^31 - 2^16), so a 32-bit division suffices.
-int32_t RoundDiv(int32_t num, int32_t den) {
-  return num >= 0 ? (num + den / 2) / den : -((-num + den / 2) / den);
-}
-// RoundDiv(num, 65536).
-int32_t RoundShift16(int32_t num) {
-  return num >= 0 ? (num + 32768) >> 16 : -((-num + 32768) >> 16);
-}
-
-// Adds one kernel row's weighted sums to acc[x0..x1]. p[i] is the row prefix up to column i.
-// The plain C reference loop, written so compilers vectorise it: sums are formed in wrapping
-// uint32; their true values are below 2^31 in magnitude (see layer_plane.h), so the final sum
-// read as int32 is exact.
-// On x86-64 an AVX2 clone (8 lanes, native 32-bit multiplies) is picked once at load time by
-// the CPU's flags; integer arithmetic, so both clones give the same bits.
-#if defined(__x86_64__) && !defined(__clang__)
-__attribute__((target_clones("avx2", "default")))
-#endif
-void GatherRow(const uint32_t* p, const KernelRow& k, uint32_t* acc, int32_t x0, int32_t x1) {
-  const uint32_t* pa = p + k.left - 1;
-  const uint32_t* pb = p + k.left;
-  const uint32_t* pc = p + k.right + 1;
-  const uint32_t* pd = p + k.right + 2;
-  const uint32_t w = static_cast<uint32_t>(k.w), wl = static_cast<uint32_t>(k.wl),
-                 wr = static_cast<uint32_t>(k.wr);
-  for (int32_t x = x0; x <= x1; ++x) {
-    const uint32_t t = w * (pc[x] - pb[x]) + wl * (pb[x] - pa[x]) + wr * (pd[x] - pc[x]);
-    acc[x] += t;
-  }
-}
-
-// Lays one layer row over what is behind: out = out * (1 - alpha) + colour, Q16, rounded.
-#if defined(__x86_64__) && !defined(__clang__)
-__attribute__((target_clones("avx2", "default")))
-#endif
-void CompositeRow(int32_t* out, const int32_t* colour, const int32_t* alpha, int32_t x0,
-                  int32_t x1) {
-  for (int32_t x = x0; x <= x1; ++x) {
-    const int64_t keep = 65536 - alpha[x];
-    out[x] = static_cast<int32_t>(((out[x] * keep + 32768) >> 16) + colour[x]);
-  }
-}
-
-// Interpolates a reduced layer's blended rows (C colour planes then alpha, `stride` apart,
-// col[-1] .. col[n] valid) at output columns [x0, x1] and lays it over `out` in the same pass:
-// column x lies between low-res columns q = (x - f/2) >> level and q + 1 at the weight frac[x]
-// (Q8) of q + 1, and each interval's f columns share the endpoints.
-template <int C>
-void LerpComposite(const int32_t* col, ptrdiff_t stride, const uint8_t* frac, int32_t level,
-                   int32_t x0, int32_t x1, int32_t* out, ptrdiff_t out_stride) {
-  const int32_t f = 1 << level;
-  for (int32_t x = x0; x <= x1;) {
-    const int32_t q = (x - f / 2) >> level;
-    const int32_t end = Min(x1, ((q + 1) << level) + f / 2 - 1);
-    int32_t a[C + 1];
-    int64_t d[C + 1];
-    for (int32_t c = 0; c <= C; ++c) {
-      a[c] = col[c * stride + q];
-      d[c] = col[c * stride + q + 1] - a[c];
-    }
-    for (; x <= end; ++x) {
-      const int32_t alpha = a[C] + static_cast<int32_t>((d[C] * frac[x] + 128) >> 8);
-      const int64_t keep = 65536 - alpha;
-      for (int32_t c = 0; c < C; ++c) {
-        const int32_t colour = a[c] + static_cast<int32_t>((d[c] * frac[x] + 128) >> 8);
-        int32_t& o = out[c * out_stride + x];
-        o = static_cast<int32_t>(((o * keep + 32768) >> 16) + colour);
-      }
-      int32_t& o = out[C * out_stride + x];
-      o = static_cast<int32_t>(((o * keep + 32768) >> 16) + alpha);
-    }
-  }
-}
-
-// box[x >> level] += (sum of v over its 2^level columns within [x0, x1]) << up. Whole groups
-// have a fixed length, so the inner loop is unrolled for each level.
-template <int L>
-void SumGroupsT(const int16_t* v, int32_t x0, int32_t x1, int32_t up, int32_t* box) {
-  int32_t x = x0;
-  for (; x + (1 << L) - 1 <= x1; x += 1 << L) {
-    int32_t sum = 0;
-    for (int32_t k = 0; k < (1 << L); ++k) sum += v[x + k];
-    box[x >> L] += sum * (1 << up);
-  }
-  int32_t sum = 0;
-  for (int32_t k = x; k <= x1; ++k) sum += v[k];
-  if (x <= x1) box[x >> L] += sum * (1 << up);
-}
-
-void SumGroups(const int16_t* v, int32_t x0, int32_t x1, int32_t level, int32_t up, int32_t* box) {
-  switch (level) {
-    case 1:
-      return SumGroupsT<1>(v, x0, x1, up, box);
-    case 2:
-      return SumGroupsT<2>(v, x0, x1, up, box);
-    case 3:
-      return SumGroupsT<3>(v, x0, x1, up, box);
-    default:
-      return SumGroupsT<4>(v, x0, x1, up, box);
-  }
-}
 
 struct KernelPlan {
   float radius;
@@ -139,10 +35,23 @@ int32_t LayerPlane::Reach(int32_t sub, const int32_t* radii_q4, int32_t radii) {
   return reach;
 }
 
-void LayerPlane::Carve(Arena& arena, int32_t width, int32_t height, int32_t channels,
-                       int32_t strip_rows, int32_t sub, const int32_t* radii_q4, int32_t radii,
-                       int32_t layers, int32_t extra_rows) {
-  width_ = width, height_ = height, channels_ = channels, strip_rows_ = strip_rows, sub_ = sub;
+Status LayerPlane::Carve(Arena& arena, int32_t width, int32_t height, int32_t channels,
+                         int32_t strip_rows, int32_t sub, const int32_t* radii_q4, int32_t radii,
+                         int32_t layers, int32_t extra_rows) {
+  // radius_, level_, half_ and reciprocal_ hold kMaxKernels entries.
+  if (radii < 1 || radii > kMaxKernels) {
+    return Status(Code::kInvalidArgument, "layer plane: %d blur radii outside 1..%d", radii,
+                  kMaxKernels);
+  }
+  if (layers < 1 || layers > 2 * kMaxKernels - 1) {
+    return Status(Code::kInvalidArgument, "layer plane: %d depth layers outside 1..%d", layers,
+                  2 * kMaxKernels - 1);
+  }
+  if (channels < 1 || channels > 2) {
+    return Status(Code::kInvalidArgument, "layer plane: %d channels (1 or 2)", channels);
+  }
+  rows_ = &layer_rows::BestKernels();
+  width_ = width, height_ = height, channels_ = channels;
   layers_ = layers, radii_ = radii;
   int32_t max_half = 0;
   window_rows_ = 1, low_rows_ = 1, reach_ = 0;
@@ -187,6 +96,7 @@ void LayerPlane::Carve(Arena& arena, int32_t width, int32_t height, int32_t chan
       frac_[l][x] = static_cast<uint8_t>(u & 255);
     }
   }
+  return Status::Ok();
 }
 
 void LayerPlane::Begin(const ApertureShape& shape, int32_t shift) {
@@ -318,7 +228,9 @@ void LayerPlane::BuildPrefixT(int32_t k, int32_t level, int32_t h, int32_t jlo, 
           if ((pure & bit) && shift <= 8) {
             // Wholly in the layer: weight 256 everywhere, and as v * 256 is a multiple of
             // 2^shift, the sum of (v * 256) >> shift is (sum of v) << (8 - shift) exactly.
-            for (int32_t c = 0; c < C; ++c) SumGroups(v[c], t0, t1, level, 8 - shift, box[c]);
+            for (int32_t c = 0; c < C; ++c) {
+              layer_rows::SumGroupsC(v[c], t0, t1, level, 8 - shift, box[c]);
+            }
             for (int32_t q = t0 >> level; q <= t1 >> level; ++q) {
               box[C][q] += 256 * (Min(t1, ((q + 1) << level) - 1) - (q << level) + 1);
             }
@@ -368,24 +280,16 @@ void LayerPlane::GatherNormalise(int32_t kernel, int32_t m, int32_t jlo, int32_t
     for (int32_t c = 0; c < planes; ++c) {
       const uint32_t* p =
           prefix_ + ((j - base) * planes + c) * static_cast<ptrdiff_t>(pitch_) + pad;
-      GatherRow(p, kr, acc_ + c * static_cast<ptrdiff_t>(pitch_), x0, x1);
+      rows_->gather(p, kr, acc_ + c * static_cast<ptrdiff_t>(pitch_), x0, x1);
     }
   }
   // alpha = acc / (total * 256) in Q16 (rec = 2^40 / total); colour likewise, undoing the shift.
   const uint64_t rec = reciprocal_[kernel];
-  const uint32_t* acc_a = acc_ + channels_ * static_cast<ptrdiff_t>(pitch_);
-  int32_t* alpha = layer + channels_ * stride;
-  for (int32_t x = x0; x <= x1; ++x) {
-    const uint64_t a = (uint64_t{acc_a[x]} * rec) >> 32;
-    alpha[x] = static_cast<int32_t>(a > 65536 ? 65536 : a);
-  }
+  layer_rows::NormaliseAlphaRowC(acc_ + channels_ * static_cast<ptrdiff_t>(pitch_), rec, x0, x1,
+                                 layer + channels_ * stride);
   for (int32_t c = 0; c < channels_; ++c) {
-    const uint32_t* acc = acc_ + c * static_cast<ptrdiff_t>(pitch_);
-    int32_t* colour = layer + c * stride;
-    for (int32_t x = x0; x <= x1; ++x) {
-      const int64_t sum = static_cast<int32_t>(acc[x]);
-      colour[x] = static_cast<int32_t>((sum * static_cast<int64_t>(rec)) >> (32 - shift_));
-    }
+    layer_rows::NormaliseColourRowC(acc_ + c * static_cast<ptrdiff_t>(pitch_), rec, shift_, x0, x1,
+                                    layer + c * stride);
   }
 }
 
@@ -393,7 +297,7 @@ void LayerPlane::Composite(const int32_t* layer, ptrdiff_t stride, int32_t x0, i
                            int32_t* out) {
   const int32_t* alpha = layer + channels_ * stride;
   for (int32_t c = 0; c <= channels_; ++c) {
-    CompositeRow(out + c * static_cast<ptrdiff_t>(width_), layer + c * stride, alpha, x0, x1);
+    rows_->composite(out + c * static_cast<ptrdiff_t>(width_), layer + c * stride, alpha, x0, x1);
   }
 }
 
@@ -487,18 +391,13 @@ void LayerPlane::RenderRun(int32_t k, int32_t y0, int32_t n, const uint16_t* lay
     for (int32_t c = 0; c < planes; ++c) {
       const int32_t* a = ra + c * static_cast<ptrdiff_t>(pitch_);
       const int32_t* b = rb + c * static_cast<ptrdiff_t>(pitch_);
-      int32_t* col = box_ + c * static_cast<ptrdiff_t>(pitch_) + 1;
-      for (int32_t q = q_lo; q <= q_hi; ++q) {
-        col[q] = static_cast<int32_t>((a[q] * (256 - fy) + b[q] * fy + 128) >> 8);
-      }
-      col[q_lo - 1] = col[q_lo];
-      col[q_hi + 1] = col[q_hi];
+      layer_rows::BlendRowsC(a, b, fy, q_lo, q_hi, box_ + c * static_cast<ptrdiff_t>(pitch_) + 1);
     }
     int32_t* out = out_ + (y - y0) * row_stride;
     if (channels_ == 1) {
-      LerpComposite<1>(box_ + 1, pitch_, frac_[level], level, x0, x1, out, width_);
+      layer_rows::LerpCompositeC<1>(box_ + 1, pitch_, frac_[level], level, x0, x1, out, width_);
     } else {
-      LerpComposite<2>(box_ + 1, pitch_, frac_[level], level, x0, x1, out, width_);
+      layer_rows::LerpCompositeC<2>(box_ + 1, pitch_, frac_[level], level, x0, x1, out, width_);
     }
   }
 }
@@ -514,18 +413,9 @@ void LayerPlane::RenderStrip(int32_t y0, int32_t n, const uint16_t* layer_of, in
     const int32_t* out = out_ + (y - y0) * planes * static_cast<ptrdiff_t>(width_);
     const int32_t* out_a = out + channels_ * static_cast<ptrdiff_t>(width_);
     for (int32_t c = 0; c < channels_; ++c) {
-      const int32_t* o = out + c * static_cast<ptrdiff_t>(width_);
-      const int16_t* v = ValueRow(y, c);
-      uint8_t* d = dst[c].Row(y - y0);
-      for (int32_t x = 0; x < width_; ++x) {
-        // A pixel always covers itself, so alpha is positive; the fallback is for safety. Most
-        // pixels are fully covered (alpha 1.0): a shift instead of a division.
-        const int32_t value = out_a[x] == 65536 ? RoundShift16(o[x])
-                              : out_a[x] > 0    ? RoundDiv(o[x], out_a[x])
-                                                : v[x];
-        const int32_t b = value + bias;
-        d[x] = static_cast<uint8_t>(b < 0 ? 0 : (b > 255 ? 255 : b));
-      }
+      // A pixel always covers itself, so alpha is positive (ResolveRowC keeps a fallback).
+      layer_rows::ResolveRowC(out + c * static_cast<ptrdiff_t>(width_), out_a, ValueRow(y, c),
+                              width_, bias, dst[c].Row(y - y0));
     }
   }
 }

@@ -27,14 +27,18 @@
 
 #include "algo/core/arena.h"
 #include "algo/core/image.h"
+#include "algo/core/status.h"
 #include "algo/render/aperture.h"
+#include "algo/render/layer_rows.h"
 
 namespace lb {
 
 class LayerPlane {
  public:
-  static constexpr int32_t kMaxChannels = 2;
+  // Kernels (distinct radii) a plane holds: RenderStage::kMaxRadii is this bound, and the
+  // 2 x kMaxKernels - 1 layers must fit the 8-bit layer index of a layer_of entry.
   static constexpr int32_t kMaxKernels = 40;
+  static_assert(2 * kMaxKernels - 1 <= 255, "layer indices are 8 bits in layer_of");
   static constexpr int32_t kMaxLevel = 4;
   // Largest radius (px of the level it runs at) blurred at a level; above, the next level.
   static constexpr float kLevelRadius = 8.0f;
@@ -42,9 +46,11 @@ class LayerPlane {
   // `sub` is 1 for luma, 2 for chroma (radii are given in luma px, Q4); `layers` the number of
   // depth layers; kernels[i] has radius radii_q4[i] / 16 / sub.
   // `extra_rows` of ring are kept for a caller that reads ahead (the chroma of the next strip).
-  void Carve(Arena& arena, int32_t width, int32_t height, int32_t channels, int32_t strip_rows,
-             int32_t sub, const int32_t* radii_q4, int32_t radii, int32_t layers,
-             int32_t extra_rows);
+  // Refuses (and carves nothing) radii outside 1..kMaxKernels, layers outside
+  // 1..2 kMaxKernels - 1 and channels other than 1 or 2. Picks the row kernels for this CPU.
+  [[nodiscard]] Status Carve(Arena& arena, int32_t width, int32_t height, int32_t channels,
+                             int32_t strip_rows, int32_t sub, const int32_t* radii_q4,
+                             int32_t radii, int32_t layers, int32_t extra_rows);
   // Rows beyond a strip (above or below) that rendering it reads, for a configuration.
   static int32_t Reach(int32_t sub, const int32_t* radii_q4, int32_t radii);
 
@@ -69,7 +75,6 @@ class LayerPlane {
   // ring had already recycled (a sizing bug; checked once per row, reported by the stage).
   bool Holds(int32_t y) const;
   bool stale() const { return stale_; }
-  int32_t ring_rows() const { return ring_rows_; }
 
   // Renders plane rows [y0, y0 + n) of every layer (back to front), `radius_of_layer[k]` being
   // the kernel index of layer k; writes 8-bit results (value + bias) into dst[0 .. channels).
@@ -99,7 +104,7 @@ class LayerPlane {
   void Composite(const int32_t* layer, ptrdiff_t layer_stride, int32_t x0, int32_t x1,
                  int32_t* out);
 
-  int32_t width_ = 0, height_ = 0, channels_ = 1, strip_rows_ = 0, sub_ = 1;
+  int32_t width_ = 0, height_ = 0, channels_ = 1;
   int32_t layers_ = 0, radii_ = 0, ring_rows_ = 0, pitch_ = 0, shift_ = 0, next_row_ = 0;
   int32_t reach_ = 0, kernel_rows_ = 0, window_rows_ = 0, low_rows_ = 0;
   float radius_[kMaxKernels] = {};  // this plane's px
@@ -121,6 +126,7 @@ class LayerPlane {
   int32_t* layer_ = nullptr;      // low_rows x (channels + 1) x pitch: normalised layer, Q16
   int32_t* out_ = nullptr;        // strip_rows x (channels + 1) x width, premultiplied Q16
   KernelRow* kernels_ = nullptr;  // radii x kernel_rows
+  const layer_rows::Kernels* rows_ = &layer_rows::kReference;  // picked at Carve
   uint8_t* frac_[kMaxLevel + 1] = {};  // per level and column: the right low-res tap's weight
 };
 

@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include "algo/core/int_math.h"
+
 namespace lb {
 
 void LensModel::Set(float f_number, int32_t working_scale, int32_t max_radius,
@@ -12,12 +14,6 @@ void LensModel::Set(float f_number, int32_t working_scale, int32_t max_radius,
   focus_disp_q8_ = focus_disp_q8;
   cap_q4_ = max_radius * 16;
 }
-
-namespace {
-
-int32_t Clamp(int32_t v, int32_t lo, int32_t hi) { return v < lo ? lo : (v > hi ? hi : v); }
-
-}  // namespace
 
 int32_t FocusDisparityQ8(ConstImageU16 disp, int32_t s, int32_t x, int32_t y, int32_t w, int32_t h,
                          uint32_t* histogram) {

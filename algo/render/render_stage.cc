@@ -3,11 +3,10 @@
 
 #include <cmath>
 
+#include "algo/core/int_math.h"
+
 namespace lb {
 namespace {
-
-int32_t Min(int32_t a, int32_t b) { return a < b ? a : b; }
-int32_t Max(int32_t a, int32_t b) { return a > b ? a : b; }
 
 // Largest |value| in a plane after the highlight boost, and the shift of c = (v * a) >> shift
 // that keeps a whole kernel's sum ((2 half + 1)^2 cells x 256 x c) below 2^31.
@@ -109,9 +108,10 @@ Status RenderStage::Carve(Arena& arena) {
   upsampler_.Carve(arena, c.width, c.height, c.working_scale, c.working_width, c.working_height);
   // The luma ring also serves the chroma rows that the next chroma strip reads ahead.
   const int32_t look_ahead = Max(0, 2 * chroma_reach_ - luma_reach_) + 2;
-  luma_.Carve(arena, c.width, c.height, 1, RenderConfig::kStripRows, 1, radii_q4, radii_, layers_,
-              look_ahead);
-  chroma_.Carve(arena, cw, ch, 2, RenderConfig::kStripRows / 2, 2, radii_q4, radii_, layers_, 0);
+  LB_RETURN_IF_ERROR(luma_.Carve(arena, c.width, c.height, 1, RenderConfig::kStripRows, 1, radii_q4,
+                                 radii_, layers_, look_ahead));
+  LB_RETURN_IF_ERROR(chroma_.Carve(arena, cw, ch, 2, RenderConfig::kStripRows / 2, 2, radii_q4,
+                                   radii_, layers_, 0));
   if (arena.overflowed()) {
     return Status(Code::kOutOfMemory, "render: arena of %zu bytes is too small (%zu needed)",
                   arena.size(), arena.used());

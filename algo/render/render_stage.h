@@ -89,8 +89,10 @@ class RenderStage {
   // Signed blur radius (Q4 full-resolution px; + nearer, - farther) of a disparity, after Begin.
   int32_t SignedRadiusQ4(int32_t disp_q8) const { return lens_.SignedRadiusQ4(disp_q8); }
 
-  static constexpr int32_t kMaxRadii = 40;  // distinct layer radii (0..max_radius)
-  // Radii of the depth layers, Q4 px, ascending from 0; returns how many (out may be null).
+  // Distinct layer radii (0..max_radius): each is a kernel of both layer planes.
+  static constexpr int32_t kMaxRadii = LayerPlane::kMaxKernels;
+  // Radii of the depth layers, Q4 px, ascending from 0; returns how many, at most kMaxRadii
+  // (out may be null).
   static int32_t LayerRadiiQ4(int32_t max_radius, int32_t* out);
   static Status ValidateParams(const RenderParams& params);
 

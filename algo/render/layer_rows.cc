@@ -1,0 +1,188 @@
+// The C reference of the layer row kernels (layer_rows.h) and, on x86-64, the same bodies
+// compiled for AVX2: each body is an always-inline function, instantiated once in a plain
+// function and once in a target("avx2") one, so both come from one source.
+#include "algo/render/layer_rows.h"
+
+#include "algo/core/int_math.h"
+
+#if defined(__x86_64__)
+#define LB_ROW_AVX2 __attribute__((target("avx2")))
+#endif
+
+namespace lb::layer_rows {
+namespace {
+
+#define LB_ROW_BODY inline __attribute__((always_inline))
+
+// Rounded signed division, den > 0 (half away from zero; the same on every platform). The
+// operands fit int32 (|num| < 2^31 - 2^16), so a 32-bit division suffices.
+int32_t RoundDiv(int32_t num, int32_t den) {
+  return num >= 0 ? (num + den / 2) / den : -((-num + den / 2) / den);
+}
+// RoundDiv(num, 65536).
+int32_t RoundShift16(int32_t num) {
+  return num >= 0 ? (num + 32768) >> 16 : -((-num + 32768) >> 16);
+}
+
+// Written so compilers vectorise it: the three weighted spans in wrapping uint32.
+LB_ROW_BODY void GatherBody(const uint32_t* p, const KernelRow& k, uint32_t* acc, int32_t x0,
+                            int32_t x1) {
+  const uint32_t* pa = p + k.left - 1;
+  const uint32_t* pb = p + k.left;
+  const uint32_t* pc = p + k.right + 1;
+  const uint32_t* pd = p + k.right + 2;
+  const uint32_t w = static_cast<uint32_t>(k.w), wl = static_cast<uint32_t>(k.wl),
+                 wr = static_cast<uint32_t>(k.wr);
+  for (int32_t x = x0; x <= x1; ++x) {
+    const uint32_t t = w * (pc[x] - pb[x]) + wl * (pb[x] - pa[x]) + wr * (pd[x] - pc[x]);
+    acc[x] += t;
+  }
+}
+
+LB_ROW_BODY void CompositeBody(int32_t* out, const int32_t* colour, const int32_t* alpha,
+                               int32_t x0, int32_t x1) {
+  for (int32_t x = x0; x <= x1; ++x) {
+    const int64_t keep = 65536 - alpha[x];
+    out[x] = static_cast<int32_t>(((out[x] * keep + 32768) >> 16) + colour[x]);
+  }
+}
+
+// Whole groups have a fixed length, so the inner loop is unrolled for each level.
+template <int L>
+void SumGroupsT(const int16_t* v, int32_t x0, int32_t x1, int32_t up, int32_t* box) {
+  int32_t x = x0;
+  for (; x + (1 << L) - 1 <= x1; x += 1 << L) {
+    int32_t sum = 0;
+    for (int32_t k = 0; k < (1 << L); ++k) sum += v[x + k];
+    box[x >> L] += sum * (1 << up);
+  }
+  int32_t sum = 0;
+  for (int32_t k = x; k <= x1; ++k) sum += v[k];
+  if (x <= x1) box[x >> L] += sum * (1 << up);
+}
+
+}  // namespace
+
+void GatherRowC(const uint32_t* p, const KernelRow& k, uint32_t* acc, int32_t x0, int32_t x1) {
+  GatherBody(p, k, acc, x0, x1);
+}
+
+void CompositeRowC(int32_t* out, const int32_t* colour, const int32_t* alpha, int32_t x0,
+                   int32_t x1) {
+  CompositeBody(out, colour, alpha, x0, x1);
+}
+
+template <int C>
+void LerpCompositeC(const int32_t* col, ptrdiff_t stride, const uint8_t* frac, int32_t level,
+                    int32_t x0, int32_t x1, int32_t* out, ptrdiff_t out_stride) {
+  const int32_t f = 1 << level;
+  for (int32_t x = x0; x <= x1;) {
+    const int32_t q = (x - f / 2) >> level;
+    const int32_t end = Min(x1, ((q + 1) << level) + f / 2 - 1);
+    int32_t a[C + 1];
+    int64_t d[C + 1];
+    for (int32_t c = 0; c <= C; ++c) {
+      a[c] = col[c * stride + q];
+      d[c] = col[c * stride + q + 1] - a[c];
+    }
+    for (; x <= end; ++x) {
+      const int32_t alpha = a[C] + static_cast<int32_t>((d[C] * frac[x] + 128) >> 8);
+      const int64_t keep = 65536 - alpha;
+      for (int32_t c = 0; c < C; ++c) {
+        const int32_t colour = a[c] + static_cast<int32_t>((d[c] * frac[x] + 128) >> 8);
+        int32_t& o = out[c * out_stride + x];
+        o = static_cast<int32_t>(((o * keep + 32768) >> 16) + colour);
+      }
+      int32_t& o = out[C * out_stride + x];
+      o = static_cast<int32_t>(((o * keep + 32768) >> 16) + alpha);
+    }
+  }
+}
+
+template void LerpCompositeC<1>(const int32_t*, ptrdiff_t, const uint8_t*, int32_t, int32_t,
+                                int32_t, int32_t*, ptrdiff_t);
+template void LerpCompositeC<2>(const int32_t*, ptrdiff_t, const uint8_t*, int32_t, int32_t,
+                                int32_t, int32_t*, ptrdiff_t);
+
+void SumGroupsC(const int16_t* v, int32_t x0, int32_t x1, int32_t level, int32_t up, int32_t* box) {
+  switch (level) {
+    case 1:
+      return SumGroupsT<1>(v, x0, x1, up, box);
+    case 2:
+      return SumGroupsT<2>(v, x0, x1, up, box);
+    case 3:
+      return SumGroupsT<3>(v, x0, x1, up, box);
+    default:
+      return SumGroupsT<4>(v, x0, x1, up, box);
+  }
+}
+
+void NormaliseAlphaRowC(const uint32_t* acc, uint64_t rec, int32_t x0, int32_t x1, int32_t* alpha) {
+  for (int32_t x = x0; x <= x1; ++x) {
+    const uint64_t a = (uint64_t{acc[x]} * rec) >> 32;
+    alpha[x] = static_cast<int32_t>(a > 65536 ? 65536 : a);
+  }
+}
+
+void NormaliseColourRowC(const uint32_t* acc, uint64_t rec, int32_t shift, int32_t x0, int32_t x1,
+                         int32_t* colour) {
+  for (int32_t x = x0; x <= x1; ++x) {
+    const int64_t sum = static_cast<int32_t>(acc[x]);
+    colour[x] = static_cast<int32_t>((sum * static_cast<int64_t>(rec)) >> (32 - shift));
+  }
+}
+
+void BlendRowsC(const int32_t* a, const int32_t* b, int64_t fy, int32_t q0, int32_t q1,
+                int32_t* col) {
+  for (int32_t q = q0; q <= q1; ++q) {
+    col[q] = static_cast<int32_t>((a[q] * (256 - fy) + b[q] * fy + 128) >> 8);
+  }
+  col[q0 - 1] = col[q0];
+  col[q1 + 1] = col[q1];
+}
+
+void ResolveRowC(const int32_t* out, const int32_t* alpha, const int16_t* v, int32_t width,
+                 int32_t bias, uint8_t* dst) {
+  for (int32_t x = 0; x < width; ++x) {
+    // Most pixels are fully covered (alpha 1.0): a shift instead of a division.
+    const int32_t value = alpha[x] == 65536 ? RoundShift16(out[x])
+                          : alpha[x] > 0    ? RoundDiv(out[x], alpha[x])
+                                            : v[x];
+    dst[x] = static_cast<uint8_t>(Clamp(value + bias, 0, 255));
+  }
+}
+
+const Kernels kReference = {GatherRowC, CompositeRowC};
+
+#if defined(LB_ROW_AVX2)
+namespace {
+
+LB_ROW_AVX2 void GatherRowAvx2(const uint32_t* p, const KernelRow& k, uint32_t* acc, int32_t x0,
+                               int32_t x1) {
+  GatherBody(p, k, acc, x0, x1);
+}
+
+LB_ROW_AVX2 void CompositeRowAvx2(int32_t* out, const int32_t* colour, const int32_t* alpha,
+                                  int32_t x0, int32_t x1) {
+  CompositeBody(out, colour, alpha, x0, x1);
+}
+
+}  // namespace
+
+const Kernels* Avx2Kernels() {
+  static constexpr Kernels kAvx2 = {GatherRowAvx2, CompositeRowAvx2};
+  return __builtin_cpu_supports("avx2") ? &kAvx2 : nullptr;
+}
+#else
+const Kernels* Avx2Kernels() { return nullptr; }
+#endif
+
+const Kernels& BestKernels() {
+  static const Kernels* const best = [] {
+    const Kernels* avx2 = Avx2Kernels();
+    return avx2 != nullptr ? avx2 : &kReference;
+  }();
+  return *best;
+}
+
+}  // namespace lb::layer_rows
