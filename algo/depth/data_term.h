@@ -11,8 +11,11 @@
 // Range: pixel cost 0..255, window sum 0..2295, D (a mean of window sums) 0..2295, uint16.
 // No costs are stored: each call computes the rows it is asked for, through a 3-row ring.
 //
-// Every kernel has a plain C reference; a SIMD variant (AVX2 on x86-64, chosen at run time in
-// Carve) gives the same bits.
+// Every kernel has a plain C reference (data_term_ref.cc); SIMD twins give the same bits: AVX2
+// on x86-64 (data_term_avx2.cc, when the CPU has it, else the C cost kernel compiled for SSSE3)
+// and NEON on ARM (data_term_neon.cc), chosen once in Carve (data_term_kernels.h). Each twin the
+// CPU has is forced and compared with the reference kernel by kernel by
+// tests/algo/depth/data_term_kernels_test.cc, and as a whole by data_term_test.cc.
 #pragma once
 
 #include <cstddef>

@@ -127,7 +127,7 @@ LB_AVX2 void CostRowAvx2T(const uint8_t* ref, const uint8_t* img, const uint8_t*
       _mm256_broadcastsi128_si256(_mm_loadu_si128(reinterpret_cast<const __m128i*>(table)));
   const __m256i f128 = _mm256_set1_epi16(static_cast<int16_t>(f * 128));
   const __m256i trunc8 = _mm256_set1_epi8(static_cast<char>(trunc < 255 ? trunc : 255));
-  if (n < 32) return CostRowC(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+  if (n < 32) return CostRowCAvx2(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
   for (int32_t step = 0; step < n; step += 32) {
     const int32_t x = step + 32 <= n ? step : n - 32;
     const Rgb32 r = LoadRgb32(ref + 3 * x);
@@ -233,11 +233,15 @@ LB_AVX2 void SelectRowAvx2(const uint16_t* const* rows, int32_t others, int32_t 
 
 }  // namespace
 
-const DataTerm::Kernels* SimdKernels() {
+const DataTerm::Kernels* Avx2Kernels() {
   static constexpr DataTerm::Kernels kAvx2 = {CensusRowAvx2, CostRowAvx2, HSumRowAvx2,
                                               SelectRowAvx2};
   return __builtin_cpu_supports("avx2") ? &kAvx2 : nullptr;
 }
 
+}  // namespace lb::dtk
+#else
+namespace lb::dtk {
+const DataTerm::Kernels* Avx2Kernels() { return nullptr; }
 }  // namespace lb::dtk
 #endif

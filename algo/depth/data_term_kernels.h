@@ -1,6 +1,8 @@
 // The data term's row kernels (data_term.h): a plain C reference (data_term_ref.cc) and SIMD
 // twins that give the same bits (data_term_avx2.cc on x86-64, data_term_neon.cc on ARM), picked
-// once when the data term is carved. Internal to algo/depth.
+// once when the data term is carved. On x86-64 the C cost kernel is also compiled for SSSE3 (the
+// table of a CPU without AVX2) and for AVX2 (the AVX2 kernel's short rows). Every table is run
+// against the reference by tests/algo/depth/data_term_kernels_test.cc. Internal to algo/depth.
 #pragma once
 
 #include <cstddef>
@@ -31,12 +33,32 @@ inline uint32_t RecipQ15(int32_t keep) {
 void CensusRowC(const uint8_t* const* rows, int32_t x0, int32_t x1, int32_t w, uint8_t* out);
 void CostRowC(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, const uint8_t* cimg,
               ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc, int32_t cw, uint8_t* out);
+#if defined(__x86_64__)
+// CostRowC's source compiled for SSSE3 and for AVX2 (the caller checks the CPU).
+void CostRowCSsse3(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, const uint8_t* cimg,
+                   ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc, int32_t cw, uint8_t* out);
+void CostRowCAvx2(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, const uint8_t* cimg,
+                  ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc, int32_t cw, uint8_t* out);
+#endif
 void HSumRowC(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum);
 void SelectRowC(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1, uint16_t* out);
 
 extern const DataTerm::Kernels kReference;
-// This target's SIMD kernels when the processor has them, else nullptr.
+// Each table when this build and processor have it, else nullptr: AVX2 intrinsics (x86-64),
+// the C reference compiled for SSSE3 (x86-64), NEON intrinsics (ARM).
+const DataTerm::Kernels* Avx2Kernels();
+const DataTerm::Kernels* Ssse3Kernels();
+const DataTerm::Kernels* NeonKernels();
+// The fastest of those (AVX2, NEON, SSSE3), decided on the first call; nullptr when none.
 const DataTerm::Kernels* SimdKernels();
+
+// Every table this processor runs, the reference first (tests compare them all).
+struct Variant {
+  const char* name;
+  const DataTerm::Kernels* kernels;
+};
+inline constexpr int32_t kMaxVariants = 4;
+int32_t Variants(Variant* out);  // out: kMaxVariants entries
 
 }  // namespace dtk
 }  // namespace lb

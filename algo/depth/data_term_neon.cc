@@ -164,11 +164,15 @@ void SelectRowNeon(const uint16_t* const* rows, int32_t others, int32_t x0, int3
 
 }  // namespace
 
-const DataTerm::Kernels* SimdKernels() {
+const DataTerm::Kernels* NeonKernels() {
   static constexpr DataTerm::Kernels kNeon = {CensusRowNeon, CostRowNeon, HSumRowNeon,
                                               SelectRowNeon};
   return &kNeon;
 }
 
+}  // namespace lb::dtk
+#else
+namespace lb::dtk {
+const DataTerm::Kernels* NeonKernels() { return nullptr; }
 }  // namespace lb::dtk
 #endif

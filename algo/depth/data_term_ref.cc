@@ -1,6 +1,8 @@
 // The C reference kernels of the data term: the definition the SIMD twins are tested against.
 #include "algo/depth/data_term_kernels.h"
 
+#include <initializer_list>
+
 namespace lb::dtk {
 namespace {
 
@@ -38,16 +40,17 @@ inline uint32_t CensusAt(const uint8_t* c, ptrdiff_t plane, int32_t x) {
   return (uint32_t{c[x]} << 16) | (uint32_t{c[plane + x]} << 8) | c[2 * plane + x];
 }
 
+namespace {
+
 // The per-pixel cost over n valid pixels: ref/img are RGB8 rows already aligned so that pixel
 // i of ref pairs with samples i and i + 1 of img (weights 256 - f and f, Q8); cref/cimg are
 // census planes `plane` bytes apart.
-// Cloned for SSSE3/AVX2 on x86-64 (the fallback when the AVX2 kernel is off); the arithmetic is
-// integer, so every clone gives the same bits.
-#if defined(__x86_64__)
-__attribute__((target_clones("avx2", "ssse3", "default")))
-#endif
-void CostRowC(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, const uint8_t* cimg,
-              ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc, int32_t cw, uint8_t* out) {
+// One source for CostRowC and its x86-64 builds for SSSE3 and AVX2 (below): always inlined, so
+// each wrapper compiles it for its own target; integer arithmetic, so all give the same bits.
+inline __attribute__((always_inline)) void CostBody(const uint8_t* ref, const uint8_t* img,
+                                                    const uint8_t* cref, const uint8_t* cimg,
+                                                    ptrdiff_t plane, int32_t n, int32_t f,
+                                                    int32_t trunc, int32_t cw, uint8_t* out) {
   if (f == 0) {
     for (int32_t x = 0; x < n; ++x) {
       const int32_t dr = ref[3 * x] - img[3 * x];
@@ -87,6 +90,29 @@ void CostRowC(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, const
     out[x] = static_cast<uint8_t>(cost > 255 ? 255 : cost);
   }
 }
+
+}  // namespace
+
+void CostRowC(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, const uint8_t* cimg,
+              ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc, int32_t cw, uint8_t* out) {
+  CostBody(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+}
+
+#if defined(__x86_64__)
+__attribute__((target("ssse3"))) void CostRowCSsse3(const uint8_t* ref, const uint8_t* img,
+                                                    const uint8_t* cref, const uint8_t* cimg,
+                                                    ptrdiff_t plane, int32_t n, int32_t f,
+                                                    int32_t trunc, int32_t cw, uint8_t* out) {
+  CostBody(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+}
+
+__attribute__((target("avx2"))) void CostRowCAvx2(const uint8_t* ref, const uint8_t* img,
+                                                  const uint8_t* cref, const uint8_t* cimg,
+                                                  ptrdiff_t plane, int32_t n, int32_t f,
+                                                  int32_t trunc, int32_t cw, uint8_t* out) {
+  CostBody(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+}
+#endif
 
 // Horizontal 3-sum (0..765) of a cost row whose pixels -1 and w replicate the borders.
 void HSumRowC(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum) {
@@ -130,8 +156,32 @@ void SelectRowC(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t
 
 const DataTerm::Kernels kReference = {CensusRowC, CostRowC, HSumRowC, SelectRowC};
 
-#if !defined(__x86_64__) && !defined(__ARM_NEON)
-const DataTerm::Kernels* SimdKernels() { return nullptr; }
+const DataTerm::Kernels* Ssse3Kernels() {
+#if defined(__x86_64__)
+  static constexpr DataTerm::Kernels kSsse3 = {CensusRowC, CostRowCSsse3, HSumRowC, SelectRowC};
+  return __builtin_cpu_supports("ssse3") ? &kSsse3 : nullptr;
+#else
+  return nullptr;
 #endif
+}
+
+const DataTerm::Kernels* SimdKernels() {
+  static const DataTerm::Kernels* const best = [] {
+    for (const DataTerm::Kernels* k : {Avx2Kernels(), NeonKernels(), Ssse3Kernels()}) {
+      if (k != nullptr) return k;
+    }
+    return static_cast<const DataTerm::Kernels*>(nullptr);
+  }();
+  return best;
+}
+
+int32_t Variants(Variant* out) {
+  int32_t n = 0;
+  out[n++] = {"C", &kReference};
+  if (const DataTerm::Kernels* k = Ssse3Kernels()) out[n++] = {"C for SSSE3", k};
+  if (const DataTerm::Kernels* k = Avx2Kernels()) out[n++] = {"AVX2", k};
+  if (const DataTerm::Kernels* k = NeonKernels()) out[n++] = {"NEON", k};
+  return n;
+}
 
 }  // namespace lb::dtk

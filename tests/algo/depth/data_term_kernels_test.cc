@@ -1,0 +1,161 @@
+// The data term's row kernels one by one (data_term_kernels.h): every table this processor
+// runs (AVX2, the C cost kernel compiled for SSSE3, NEON), forced rather than chosen, against
+// the C reference, bit for bit, on random rows and on rows at the ends of the ranges (black and
+// white images, the largest census weight and truncation, every view count, window sums at the
+// 2295 cap), at widths around the vector steps.
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "algo/depth/data_term_kernels.h"
+
+namespace lb {
+namespace {
+
+const int32_t kWidths[] = {1, 2, 7, 15, 16, 17, 31, 32, 33, 47, 63, 64, 65, 97, 130};
+
+std::vector<dtk::Variant> Others() {
+  dtk::Variant v[dtk::kMaxVariants];
+  const int32_t n = dtk::Variants(v);
+  return std::vector<dtk::Variant>(v + 1, v + n);  // v[0] is the reference
+}
+
+#define LB_SKIP_WITHOUT_VARIANTS()                                                  \
+  if (Others().empty()) {                                                           \
+    GTEST_SKIP() << "this processor runs no data term kernels but the C reference"; \
+  }
+
+// Random bytes (kind 0), a smooth ramp with noise (1), or black and white (2: the extremes).
+std::vector<uint8_t> Bytes(std::mt19937& rng, size_t n, int32_t kind) {
+  std::vector<uint8_t> b(n);
+  for (size_t i = 0; i < n; ++i) {
+    const uint32_t r = rng();
+    b[i] = static_cast<uint8_t>(kind == 0 ? r : kind == 1 ? (i * 5 + (r & 15)) : (r & 1) * 255);
+  }
+  return b;
+}
+
+TEST(DataTermKernels, CensusVariantsEqualTheReference) {
+  LB_SKIP_WITHOUT_VARIANTS();
+  std::mt19937 rng(11);
+  for (int32_t w : kWidths) {
+    for (int32_t kind = 0; kind < 3; ++kind) {
+      std::vector<std::vector<uint8_t>> rows;
+      const uint8_t* p[5];
+      for (int32_t i = 0; i < 5; ++i) rows.push_back(Bytes(rng, w + 4, kind));
+      for (int32_t i = 0; i < 5; ++i) p[i] = rows[i].data() + 2;
+      const int32_t x0 = static_cast<int32_t>(rng() % w);
+      std::vector<uint8_t> want(3 * w, 0xa5);
+      dtk::kReference.census(p, x0, w, w, want.data());
+      for (const dtk::Variant& v : Others()) {
+        std::vector<uint8_t> got(3 * w, 0xa5);
+        v.kernels->census(p, x0, w, w, got.data());
+        ASSERT_EQ(got, want) << v.name << " w " << w << " kind " << kind;
+      }
+    }
+  }
+}
+
+TEST(DataTermKernels, CostVariantsEqualTheReference) {
+  LB_SKIP_WITHOUT_VARIANTS();
+  std::mt19937 rng(12);
+  const int32_t fracs[] = {0, 1, 2, 127, 128, 129, 254, 255};
+  const int32_t truncs[] = {0, 1, 45, 254, 255, 256, 765};
+  for (int32_t n : kWidths) {
+    for (int32_t kind = 0; kind < 3; ++kind) {
+      const ptrdiff_t plane = n + 1;
+      const std::vector<uint8_t> ref = Bytes(rng, 3 * n, kind), img = Bytes(rng, 3 * (n + 1), kind);
+      const std::vector<uint8_t> cref = Bytes(rng, 3 * plane, kind == 2 ? 2 : 0);
+      const std::vector<uint8_t> cimg = Bytes(rng, 3 * plane, kind == 2 ? 2 : 0);
+      for (int32_t f : fracs) {
+        const int32_t trunc = truncs[rng() % 7];
+        const int32_t cw = kind == 2 ? 10 : static_cast<int32_t>(rng() % 11);
+        std::vector<uint8_t> want(n);
+        dtk::kReference.cost(ref.data(), img.data(), cref.data(), cimg.data(), plane, n, f, trunc,
+                             cw, want.data());
+        for (const dtk::Variant& v : Others()) {
+          std::vector<uint8_t> got(n);
+          v.kernels->cost(ref.data(), img.data(), cref.data(), cimg.data(), plane, n, f, trunc, cw,
+                          got.data());
+          ASSERT_EQ(got, want) << v.name << " n " << n << " f " << f << " trunc " << trunc << " cw "
+                               << cw << " kind " << kind;
+        }
+#if defined(__x86_64__)
+        // The C source's own builds for SSSE3 and AVX2 (the second is the AVX2 kernel's
+        // fallback for short rows), each when the processor has the instructions.
+        std::vector<uint8_t> got(n);
+        if (__builtin_cpu_supports("ssse3")) {
+          dtk::CostRowCSsse3(ref.data(), img.data(), cref.data(), cimg.data(), plane, n, f, trunc,
+                             cw, got.data());
+          ASSERT_EQ(got, want) << "C for SSSE3 n " << n << " f " << f;
+        }
+        if (__builtin_cpu_supports("avx2")) {
+          dtk::CostRowCAvx2(ref.data(), img.data(), cref.data(), cimg.data(), plane, n, f, trunc,
+                            cw, got.data());
+          ASSERT_EQ(got, want) << "C for AVX2 n " << n << " f " << f;
+        }
+#endif
+      }
+    }
+  }
+}
+
+TEST(DataTermKernels, HSumVariantsEqualTheReference) {
+  LB_SKIP_WITHOUT_VARIANTS();
+  std::mt19937 rng(13);
+  for (int32_t w : kWidths) {
+    for (int32_t kind = 0; kind < 3; ++kind) {
+      const std::vector<uint8_t> cost = Bytes(rng, w + 2, kind);
+      const int32_t x0 = static_cast<int32_t>(rng() % w);
+      std::vector<uint16_t> want(w, 0xbeef);
+      dtk::kReference.hsum(cost.data() + 1, x0, w, want.data());
+      for (const dtk::Variant& v : Others()) {
+        std::vector<uint16_t> got(w, 0xbeef);
+        v.kernels->hsum(cost.data() + 1, x0, w, got.data());
+        ASSERT_EQ(got, want) << v.name << " w " << w << " kind " << kind;
+      }
+    }
+  }
+}
+
+TEST(DataTermKernels, SelectVariantsEqualTheReference) {
+  LB_SKIP_WITHOUT_VARIANTS();
+  std::mt19937 rng(14);
+  for (int32_t w : kWidths) {
+    for (int32_t others = 1; others <= 15; ++others) {
+      const int32_t kind = static_cast<int32_t>(rng() % 3);
+      // Horizontal 3-sums 0..765: random, or all at the cap (window sums of 2295), or 0 / 765.
+      std::vector<std::vector<uint16_t>> sums(3 * others, std::vector<uint16_t>(w));
+      std::vector<const uint16_t*> rows;
+      for (auto& r : sums) {
+        for (uint16_t& s : r) {
+          const uint32_t v = rng();
+          s = static_cast<uint16_t>(kind == 0 ? v % 766 : kind == 1 ? 765 : (v & 1) * 765);
+        }
+        rows.push_back(r.data());
+      }
+      const int32_t x0 = static_cast<int32_t>(rng() % w);
+      std::vector<uint16_t> want(w, 0xbeef);
+      dtk::kReference.select(rows.data(), others, x0, w, want.data());
+      for (const dtk::Variant& v : Others()) {
+        std::vector<uint16_t> got(w, 0xbeef);
+        v.kernels->select(rows.data(), others, x0, w, got.data());
+        ASSERT_EQ(got, want) << v.name << " w " << w << " others " << others << " kind " << kind;
+      }
+    }
+  }
+}
+
+TEST(DataTermKernels, TheChosenTableIsOneOfTheVariants) {
+  const DataTerm::Kernels* simd = dtk::SimdKernels();
+  if (simd == nullptr) GTEST_SKIP() << "no SIMD table on this processor";
+  bool found = false;
+  for (const dtk::Variant& v : Others()) found = found || v.kernels == simd;
+  EXPECT_TRUE(found);
+  EXPECT_EQ(simd, dtk::SimdKernels());  // decided once
+}
+
+}  // namespace
+}  // namespace lb
