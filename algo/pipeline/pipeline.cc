@@ -5,8 +5,15 @@
 #include "algo/core/color.h"
 #include "algo/depth/depth_order.h"
 #include "algo/pipeline/auto_geometry.h"
+#include "algo/pipeline/ingest.h"
 
 namespace lb {
+
+// Plan's scale is at most kMaxWidth / 8 (the smallest working bound RequiredBytes accepts), so
+// the box sums of the ingest fit their uint32 accumulator (ingest.h).
+static_assert(PipelineConfig::kMaxWidth / 8 <= ingest::kMaxBoxScale &&
+                  PipelineConfig::kMaxHeight / 8 <= ingest::kMaxBoxScale,
+              "the ingest's box sums could overflow uint32");
 
 Pipeline::Layout Pipeline::Plan(const PipelineConfig& c) {
   int32_t s = 1;
@@ -231,26 +238,9 @@ void Pipeline::IngestRow(const uint8_t* src, const uint8_t* uv, int32_t y) {
   // Integer box downscale: accumulate `scale_` rows, then write their mean (rounded).
   const int32_t s = scale_;
   if (y >= work_h_ * s) return;
-  for (int32_t wx = 0; wx < work_w_; ++wx) {
-    const uint8_t* p = rgb + 3 * wx * s;
-    uint32_t r = 0, g = 0, b = 0;
-    for (int32_t k = 0; k < s; ++k) {
-      r += p[3 * k];
-      g += p[3 * k + 1];
-      b += p[3 * k + 2];
-    }
-    acc_[3 * wx] += r;
-    acc_[3 * wx + 1] += g;
-    acc_[3 * wx + 2] += b;
-  }
-  if ((y + 1) % s == 0) {
-    const uint32_t n = static_cast<uint32_t>(s * s);
-    uint8_t* out = working_[frame_.index].Row(y / s);
-    for (int32_t i = 0; i < work_w_ * 3; ++i) {
-      out[i] = static_cast<uint8_t>((acc_[i] + n / 2) / n);
-      acc_[i] = 0;
-    }
-  }
+  ingest::BoxAccumulateRowC(rgb, work_w_, s, acc_);
+  if ((y + 1) % s == 0)
+    ingest::BoxEmitRowC(acc_, work_w_ * 3, s, working_[frame_.index].Row(y / s));
 }
 
 void Pipeline::FlushChroma(int32_t y) {
