@@ -41,9 +41,8 @@ Status DepthStage::Validate(const DepthConfig& c) {
   if (c.color_trunc < 1 || c.color_trunc > 765 || c.census_weight < 0 || c.census_weight > 10 ||
       c.smooth_weight < 0 || c.smooth_weight > 4096 || c.smooth_trunc < 1 || c.smooth_trunc > 64 ||
       c.edge_threshold < 0 || c.edge_threshold > 255 || c.edge_weight_q8 < 0 ||
-      c.edge_weight_q8 > 256 || c.max_cycles < 0 || c.max_cycles > 32 || c.move_margin < 0 ||
-      c.move_margin > 65535 || c.coarse_step < 1 || c.coarse_step > 16 || c.fine_window < 1 ||
-      c.fine_window > 255) {
+      c.edge_weight_q8 > 256 || c.max_cycles < 0 || c.max_cycles > 32 || c.coarse_step < 1 ||
+      c.coarse_step > 16 || c.fine_window < 1 || c.fine_window > 255) {
     return Status(Code::kInvalidArgument,
                   "depth: cost parameters out of range (colour %d, census %d, smoothness %d "
                   "trunc %d edge %d/%d, cycles %d, coarse step %d window %d)",
@@ -235,21 +234,21 @@ void DepthStage::WinnerTakeAll() {
   }
 }
 
-int64_t DepthStage::Energy(const uint8_t* labels) {
-  const int32_t w = config_.width, h = config_.height;
-  uint16_t* scratch = fine_.cost_alpha;
-  prev_label_ = -1;  // cost_alpha is used as scratch below
+int64_t DepthStageProbe::Energy(DepthStage& s, const uint8_t* labels) {
+  const int32_t w = s.config_.width, h = s.config_.height;
+  uint16_t* scratch = s.fine_.cost_alpha;
+  s.prev_label_ = -1;  // cost_alpha is used as scratch below
   int64_t data = 0;
-  for (int32_t label = 0; label < config_.labels; ++label) {
-    LabelCosts(label, scratch);
+  for (int32_t label = 0; label < s.config_.labels; ++label) {
+    s.LabelCosts(label, scratch);
     for (int32_t p = 0; p < w * h; ++p) {
       if (labels[p] == label) data += scratch[p];
     }
   }
   // The smoothness part with zero data costs: reuse LabelEnergy over a zero cost image.
   for (int32_t p = 0; p < w * h; ++p) scratch[p] = 0;
-  return data + LabelEnergy(labels, scratch, fine_.weight_right, fine_.weight_down, w, h,
-                            config_.smooth_trunc);
+  return data + LabelEnergy(labels, scratch, s.fine_.weight_right, s.fine_.weight_down, w, h,
+                            s.config_.smooth_trunc);
 }
 
 // Sub-label disparity: a parabola through D at f_p - 1, f_p, f_p + 1 (as recorded by the

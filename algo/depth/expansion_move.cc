@@ -18,9 +18,7 @@ inline int32_t Abs(int32_t v) { return v < 0 ? -v : v; }
 // or -B (q takes alpha); -B is the smaller of the two (the triangle inequality), so if
 // u_p - B * sum(w_pq) > 0, p keeps its label in every optimal move, and if u_p + sum(C - A) < 0,
 // p takes alpha. The bound u_p > trunc * sum(w_pq) settles textured pixels without looking at
-// the neighbours. With a move margin, pixels for which alpha costs more than that above their
-// label also keep it: a restricted move, still an exact cut over the pixels it frees, so the
-// energy still never rises, over a much smaller graph.
+// the neighbours.
 //
 // Written as e_pq = B + C - A of each pair (symmetric in p and q, >= 0), C - A = e_pq - w_pq b_p
 // with b_p = V(fp, alpha) / w_pq, so u_p + sum(C - A) = u_p - b_p sum(w_pq) + sum(e_pq): one
@@ -29,7 +27,6 @@ inline int32_t Abs(int32_t v) { return v < 0 ? -v : v; }
 int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1) {
   Grid& g = grid();
   const int32_t w = g.width, h = g.height;
-  const int32_t margin = config_.move_margin > 0 ? config_.move_margin : INT32_MAX;
   const int32_t k = config_.smooth_trunc;
   const int32_t row = y * w;
   const uint8_t* f = g.labels + row;
@@ -86,7 +83,6 @@ int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1
     const int32_t u = ca[x] - cc[x];
     int32_t limit = sw[x] * k;
     limit = limit < 0xffff ? limit : 0xffff;
-    limit = limit < margin ? limit : margin;
     const int32_t lo = u - v(f[x], alpha) * sw[x];
     hi[x] += lo;
     const bool far = restricted && (near[x - 1] | near[x] | near[x + 1]) == 0;

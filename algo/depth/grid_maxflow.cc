@@ -47,9 +47,10 @@ void GridMaxflow::Truncate(int32_t height) {
   memset(static_cast<void*>(nodes_ + count_), 0, sizeof(Node) * static_cast<size_t>(width_));
 }
 
-void GridMaxflow::Reset(int32_t width, int32_t height) {
-  Start(width, height);
-  memset(static_cast<void*>(storage_), 0, sizeof(Node) * static_cast<size_t>(count_ + 2 * width));
+void GridMaxflowProbe::Reset(GridMaxflow& mf, int32_t width, int32_t height) {
+  mf.Start(width, height);
+  memset(static_cast<void*>(mf.storage_), 0,
+         sizeof(GridMaxflow::Node) * static_cast<size_t>(mf.count_ + 2 * width));
 }
 
 void GridMaxflow::Activate(int32_t p) {

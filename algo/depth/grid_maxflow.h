@@ -1,6 +1,6 @@
 // Boykov-Kolmogorov max-flow on an implicit 4-connected grid: node p = y * width + x, arcs to the
 // right, left, down and up neighbours found by arithmetic, so there are no adjacency lists. All
-// node storage is carved once for the largest grid and reused by every expansion move (Reset).
+// node storage is carved once for the largest grid and reused by every expansion move (Begin).
 // A zeroed row above and below the grid, and arcs across the left and right edges that stay 0
 // (the last node of a row and the first of the next see each other through them), let every
 // visit look at all four neighbours without a boundary test.
@@ -25,16 +25,13 @@ class GridMaxflow {
   // Carves node storage for grids of up to max_width x max_height nodes.
   void Carve(Arena& arena, int32_t max_width, int32_t max_height);
 
-  // Starts a new graph of width x height nodes, all capacities 0.
-  void Reset(int32_t width, int32_t height);
-
   // Starts a new graph of width x height nodes whose every node the caller then sets once with
   // SetNode, row by row, calling RowDone after each row (no clearing pass: the one-arc paths
   // and the initial trees are prepared two rows behind, while the rows are still in cache).
   void Begin(int32_t width, int32_t height);
-  // Sets node p: its terminal balance (as AddTerminalBalance) and its arcs to the right and down
-  // neighbours, which must be 0 in the last column and the last row; the sister arcs from those
-  // neighbours are 0.
+  // Sets node p: its terminal balance (positive: source->p, negative: p->sink) and its arcs to
+  // the right and down neighbours, which must be 0 in the last column and the last row; the sister
+  // arcs from those neighbours are 0.
   void SetNode(int32_t p, int32_t balance, int32_t cap_right, int32_t cap_down) {
     Node& n = nodes_[p];
     n.cap[kRight] = cap_right;
@@ -52,23 +49,7 @@ class GridMaxflow {
   // Ends the graph after its first `height` rows (all RowDone), as if it had been begun so.
   void Truncate(int32_t height);
 
-  // Adds terminal capacities source->p and p->sink (both >= 0).
-  void AddTerminal(int32_t p, int32_t cap_source, int32_t cap_sink) {
-    const int32_t m = cap_source < cap_sink ? cap_source : cap_sink;
-    flow_ += m;
-    nodes_[p].tcap += cap_source - cap_sink;
-  }
-  // Adds a signed terminal balance: positive goes to source->p, negative to p->sink.
-  void AddTerminalBalance(int32_t p, int32_t balance) { nodes_[p].tcap += balance; }
-
-  // Adds capacity to the arc p->q and its sister q->p, q = neighbour of p in direction `dir`
-  // (inside the grid).
-  void AddEdge(int32_t p, Dir dir, int32_t cap_pq, int32_t cap_qp) {
-    nodes_[p].cap[dir] += cap_pq;
-    nodes_[p + offset_[dir]].cap[dir ^ 1] += cap_qp;
-  }
-
-  // Computes the maximum flow (including what AddTerminal routed directly).
+  // Computes the maximum flow.
   int64_t Solve();
 
   // After Solve: true when p is on the source side of the minimum cut.
@@ -78,6 +59,7 @@ class GridMaxflow {
   int32_t height() const { return height_; }
 
  private:
+  friend struct GridMaxflowProbe;
   static constexpr uint8_t kFree = 0, kSourceTree = 1, kSinkTree = 2;
   static constexpr uint8_t kTerminal = 4, kOrphan = 5;  // parent values besides a Dir
   static constexpr int32_t kNotActive = -1;
@@ -119,6 +101,25 @@ class GridMaxflow {
   int32_t orphan_head_ = 0, orphan_count_ = 0;
   int32_t time_ = 0;
   int64_t flow_ = 0;
+};
+
+// Graphs the depth stage never builds, for the solver's tests (tests/algo/depth/maxflow_test.cc):
+// arcs in both directions of a pair and terminal capacities on both sides of a node, set in any
+// order. Reset starts a graph of width x height nodes, all capacities 0; AddTerminal adds
+// source->p and p->sink (both >= 0, their common part routed at once and counted by Solve);
+// AddEdge adds to the arc p->q and its sister q->p, q the neighbour of p in direction `dir`
+// (inside the grid).
+struct GridMaxflowProbe {
+  static void Reset(GridMaxflow& mf, int32_t width, int32_t height);
+  static void AddTerminal(GridMaxflow& mf, int32_t p, int32_t cap_source, int32_t cap_sink) {
+    mf.flow_ += cap_source < cap_sink ? cap_source : cap_sink;
+    mf.nodes_[p].tcap += cap_source - cap_sink;
+  }
+  static void AddEdge(GridMaxflow& mf, int32_t p, GridMaxflow::Dir dir, int32_t cap_pq,
+                      int32_t cap_qp) {
+    mf.nodes_[p].cap[dir] += cap_pq;
+    mf.nodes_[p + mf.offset_[dir]].cap[dir ^ 1] += cap_qp;
+  }
 };
 
 }  // namespace lb

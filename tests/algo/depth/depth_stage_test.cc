@@ -52,22 +52,21 @@ TEST(DepthStageTest, EnergyNeverRisesAcrossExpansionMoves) {
     const synth::Burst b = synth::MakeBurst(24, 16, 4, 1, 1, 3, 6, 17, 3, 12, seed);
     for (int32_t trunc : {1, 2, 8}) {
       DepthConfig c = SmallConfig(b, 8, 128);
-      c.move_margin = trunc == 2 ? 150 : 0;  // restricted moves must not raise it either
-      c.max_cycles = 0;                      // winner-take-all only; the test runs the moves
+      c.max_cycles = 0;  // winner-take-all only; the test runs the moves
       c.smooth_weight = 40;
       c.smooth_trunc = trunc;
       Stage s;
       ASSERT_TRUE(s.Configure(c).ok());
       ASSERT_TRUE(s.Compute(b).ok());
-      int64_t energy = s.depth.energy();
-      ASSERT_EQ(s.depth.Energy(s.depth.labels()), energy);
+      int64_t energy = DepthStageProbe::TrackedEnergy(s.depth);
+      ASSERT_EQ(DepthStageProbe::Energy(s.depth, s.depth.labels()), energy);
       // A full cycle, then cycles of moves restricted to labels near alpha (coarse to fine).
       for (int32_t window : {255, 2, 1}) {
         for (int32_t alpha = 0; alpha < c.labels; ++alpha) {
-          s.depth.ExpandMove(alpha, window);
+          DepthStageProbe::ExpandMove(s.depth, alpha, window);
           // Recomputed from scratch, not the stage's own bookkeeping.
-          const int64_t after = s.depth.Energy(s.depth.labels());
-          ASSERT_EQ(after, s.depth.energy());
+          const int64_t after = DepthStageProbe::Energy(s.depth, s.depth.labels());
+          ASSERT_EQ(after, DepthStageProbe::TrackedEnergy(s.depth));
           ASSERT_LE(after, energy)
               << "alpha " << alpha << " trunc " << trunc << " window " << window;
           energy = after;
@@ -88,18 +87,20 @@ TEST(DepthStageTest, RestrictedMovesLookOnlyNearTheirLabels) {
   Stage s;
   ASSERT_TRUE(s.Configure(c).ok());
   ASSERT_TRUE(s.Compute(b).ok());
-  for (int32_t alpha = 0; alpha < c.labels; ++alpha) s.depth.ExpandMove(alpha);  // settle
+  for (int32_t alpha = 0; alpha < c.labels; ++alpha)
+    DepthStageProbe::ExpandMove(s.depth, alpha);  // settle
   const int32_t w = b.width, h = b.height;
   const int64_t n = int64_t{w} * h;
-  int64_t energy = s.depth.energy();
+  int64_t energy = DepthStageProbe::TrackedEnergy(s.depth);
   int32_t small_moves = 0;
   for (int32_t window : {1, 2, 3}) {
     for (int32_t alpha = 0; alpha < c.labels; ++alpha) {
       const int64_t cut_before = s.depth.stats().cut_pixels;
       const std::vector<uint8_t> before(s.depth.labels(), s.depth.labels() + n);
-      s.depth.ExpandMove(alpha, window);
-      const int64_t after = s.depth.Energy(s.depth.labels());
-      ASSERT_EQ(after, s.depth.energy()) << "alpha " << alpha << " window " << window;
+      DepthStageProbe::ExpandMove(s.depth, alpha, window);
+      const int64_t after = DepthStageProbe::Energy(s.depth, s.depth.labels());
+      ASSERT_EQ(after, DepthStageProbe::TrackedEnergy(s.depth))
+          << "alpha " << alpha << " window " << window;
       ASSERT_LE(after, energy);
       energy = after;
       for (int32_t y = 0; y < h; ++y) {
@@ -140,7 +141,7 @@ TEST(DepthStageTest, CoarseBlocksHaveThePixelsEnergy) {
     EXPECT_EQ(st.coarse_energy, st.handover_energy) << w << "x" << h;
     EXPECT_LE(st.coarse_energy, st.initial_energy);
     EXPECT_LE(st.energy, st.handover_energy);
-    EXPECT_EQ(s.depth.Energy(s.depth.labels()), st.energy);
+    EXPECT_EQ(DepthStageProbe::Energy(s.depth, s.depth.labels()), st.energy);
   }
 }
 
@@ -156,8 +157,8 @@ TEST(DepthStageTest, MoveResultBeatsEverySinglePixelSwitch) {
   for (int32_t i = 0; i < 2 * c.labels; ++i) {
     // A full cycle, then one restricted to labels next to alpha.
     const int32_t alpha = i % c.labels, window = i < c.labels ? 255 : 1;
-    s.depth.ExpandMove(alpha, window);
-    const int64_t energy = s.depth.energy();
+    DepthStageProbe::ExpandMove(s.depth, alpha, window);
+    const int64_t energy = DepthStageProbe::TrackedEnergy(s.depth);
     std::vector<uint8_t> labels(s.depth.labels(), s.depth.labels() + n);
     // The move is optimal over all subsets of the pixels it frees switching to alpha, so over
     // single pixels too.
@@ -165,7 +166,8 @@ TEST(DepthStageTest, MoveResultBeatsEverySinglePixelSwitch) {
       if (labels[p] == alpha || std::abs(labels[p] - alpha) > window) continue;
       const uint8_t keep = labels[p];
       labels[p] = static_cast<uint8_t>(alpha);
-      ASSERT_GE(s.depth.Energy(labels.data()), energy) << "pixel " << p << " alpha " << alpha;
+      ASSERT_GE(DepthStageProbe::Energy(s.depth, labels.data()), energy)
+          << "pixel " << p << " alpha " << alpha;
       labels[p] = keep;
     }
   }

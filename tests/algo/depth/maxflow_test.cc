@@ -104,13 +104,14 @@ int64_t CutCapacity(const Graph& g, const GridMaxflow& mf) {
 }
 
 int64_t Solve(const Graph& g, GridMaxflow& mf) {
-  mf.Reset(g.w, g.h);
+  using Probe = GridMaxflowProbe;
+  Probe::Reset(mf, g.w, g.h);
   for (int32_t y = 0; y < g.h; ++y) {
     for (int32_t x = 0; x < g.w; ++x) {
       const int32_t p = y * g.w + x;
-      mf.AddTerminal(p, g.source[p], g.sink[p]);
-      if (x + 1 < g.w) mf.AddEdge(p, GridMaxflow::kRight, g.right_fwd[p], g.right_bwd[p]);
-      if (y + 1 < g.h) mf.AddEdge(p, GridMaxflow::kDown, g.down_fwd[p], g.down_bwd[p]);
+      Probe::AddTerminal(mf, p, g.source[p], g.sink[p]);
+      if (x + 1 < g.w) Probe::AddEdge(mf, p, GridMaxflow::kRight, g.right_fwd[p], g.right_bwd[p]);
+      if (y + 1 < g.h) Probe::AddEdge(mf, p, GridMaxflow::kDown, g.down_fwd[p], g.down_bwd[p]);
     }
   }
   return mf.Solve();
