@@ -209,26 +209,14 @@ LB_AVX2 void SelectRowAvx2T(const uint16_t* const* rows, int32_t others, int32_t
   }
 }
 
-LB_AVX2 void SelectRowAvx2(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
-                           uint16_t* out) {
-  switch ((others + 1) / 2) {
-    case 1:
-      return SelectRowAvx2T<1>(rows, others, x0, x1, out);
-    case 2:
-      return SelectRowAvx2T<2>(rows, others, x0, x1, out);
-    case 3:
-      return SelectRowAvx2T<3>(rows, others, x0, x1, out);
-    case 4:
-      return SelectRowAvx2T<4>(rows, others, x0, x1, out);
-    case 5:
-      return SelectRowAvx2T<5>(rows, others, x0, x1, out);
-    case 6:
-      return SelectRowAvx2T<6>(rows, others, x0, x1, out);
-    case 7:
-      return SelectRowAvx2T<7>(rows, others, x0, x1, out);
-    default:
-      return SelectRowAvx2T<8>(rows, others, x0, x1, out);
-  }
+// The instance for each kept count (others + 1) / 2 = 1 .. kMaxBest.
+constexpr SelectRowFn kAvx2ByKeep[kMaxBest] = {
+    SelectRowAvx2T<1>, SelectRowAvx2T<2>, SelectRowAvx2T<3>, SelectRowAvx2T<4>,
+    SelectRowAvx2T<5>, SelectRowAvx2T<6>, SelectRowAvx2T<7>, SelectRowAvx2T<8>};
+
+void SelectRowAvx2(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
+                   uint16_t* out) {
+  kAvx2ByKeep[(others + 1) / 2 - 1](rows, others, x0, x1, out);
 }
 
 }  // namespace

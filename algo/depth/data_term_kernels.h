@@ -24,6 +24,10 @@ struct DataTerm::Kernels {
 namespace dtk {
 
 inline constexpr int32_t kMaxBest = 8;  // best half of up to 15 other views
+// A select kernel (the signature of Kernels::select); the SIMD twins keep one instance per
+// kept count, 1 .. kMaxBest, in a table.
+using SelectRowFn = void (*)(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
+                             uint16_t* out);
 
 // Q15 reciprocal of `keep`: the mean of the kept sums, rounded (error < 1 for D <= 2295).
 inline uint32_t RecipQ15(int32_t keep) {

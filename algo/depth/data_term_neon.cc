@@ -140,26 +140,14 @@ void SelectRowNeonT(const uint16_t* const* rows, int32_t others, int32_t x0, int
   }
 }
 
+// The instance for each kept count (others + 1) / 2 = 1 .. kMaxBest.
+constexpr SelectRowFn kNeonByKeep[kMaxBest] = {
+    SelectRowNeonT<1>, SelectRowNeonT<2>, SelectRowNeonT<3>, SelectRowNeonT<4>,
+    SelectRowNeonT<5>, SelectRowNeonT<6>, SelectRowNeonT<7>, SelectRowNeonT<8>};
+
 void SelectRowNeon(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
                    uint16_t* out) {
-  switch ((others + 1) / 2) {
-    case 1:
-      return SelectRowNeonT<1>(rows, others, x0, x1, out);
-    case 2:
-      return SelectRowNeonT<2>(rows, others, x0, x1, out);
-    case 3:
-      return SelectRowNeonT<3>(rows, others, x0, x1, out);
-    case 4:
-      return SelectRowNeonT<4>(rows, others, x0, x1, out);
-    case 5:
-      return SelectRowNeonT<5>(rows, others, x0, x1, out);
-    case 6:
-      return SelectRowNeonT<6>(rows, others, x0, x1, out);
-    case 7:
-      return SelectRowNeonT<7>(rows, others, x0, x1, out);
-    default:
-      return SelectRowNeonT<8>(rows, others, x0, x1, out);
-  }
+  kNeonByKeep[(others + 1) / 2 - 1](rows, others, x0, x1, out);
 }
 
 }  // namespace
