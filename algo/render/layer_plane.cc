@@ -162,11 +162,6 @@ void LayerPlane::BuildPrefixT(int32_t k, int32_t level, int32_t h, int32_t jlo, 
   const int32_t q0 = x0 >> level, q1 = x1 >> level;             // the run's columns at this level
   const int32_t shift = shift_;
   const int32_t tile = 1 << tile_shift_;
-  // Weight (Q8) of layer k in a pixel whose layer entry is e.
-  auto weight = [k](uint16_t e) {
-    const int32_t first = e >> 8, frac = e & 255;
-    return first == k ? 256 - frac : (first + 1 == k ? frac : 0);
-  };
   for (int32_t m = jlo; m < jhi; ++m) {
     uint8_t& active = active_[m - base];
     active = (Tiles(k, m << level, (m + 1) << level) & run) != 0;
@@ -185,24 +180,11 @@ void LayerPlane::BuildPrefixT(int32_t k, int32_t level, int32_t h, int32_t jlo, 
         const int32_t t1 = Min(x1, t0 + tile - 1);
         const uint64_t bit = uint64_t{1} << (t0 >> tile_shift_);
         if (!(any & bit)) {  // the layer is absent from this tile: the prefix stays flat
-          for (int32_t c = 0; c <= C; ++c) {
-            for (int32_t x = t0; x <= t1; ++x) p[c][x + 1] = p[c][x];
-          }
+          layer_rows::FlatPrefixRowC<C>(t0, t1, p);
         } else if (pure & bit) {  // wholly in the layer: weight 256 everywhere
-          for (int32_t c = 0; c < C; ++c) {
-            for (int32_t x = t0; x <= t1; ++x) {
-              p[c][x + 1] = p[c][x] + static_cast<uint32_t>((v[c][x] * 256) >> shift);
-            }
-          }
-          for (int32_t x = t0; x <= t1; ++x) p[C][x + 1] = p[C][x] + 256;
+          layer_rows::PurePrefixRowC<C>(v, shift, t0, t1, p);
         } else {
-          for (int32_t x = t0; x <= t1; ++x) {
-            const int32_t a = weight(layer_of[s[x] + offset]);
-            for (int32_t c = 0; c < C; ++c) {
-              p[c][x + 1] = p[c][x] + static_cast<uint32_t>((v[c][x] * a) >> shift);
-            }
-            p[C][x + 1] = p[C][x] + static_cast<uint32_t>(a);
-          }
+          layer_rows::WeightedPrefixRowC<C>(v, s, layer_of, offset, k, shift, t0, t1, p);
         }
       }
     } else {
@@ -226,34 +208,13 @@ void LayerPlane::BuildPrefixT(int32_t k, int32_t level, int32_t h, int32_t jlo, 
           if (!(any & bit)) continue;
           const int32_t t1 = Min(x1, t0 + tile - 1);
           if ((pure & bit) && shift <= 8) {
-            // Wholly in the layer: weight 256 everywhere, and as v * 256 is a multiple of
-            // 2^shift, the sum of (v * 256) >> shift is (sum of v) << (8 - shift) exactly.
-            for (int32_t c = 0; c < C; ++c) {
-              layer_rows::SumGroupsC(v[c], t0, t1, level, 8 - shift, box[c]);
-            }
-            for (int32_t q = t0 >> level; q <= t1 >> level; ++q) {
-              box[C][q] += 256 * (Min(t1, ((q + 1) << level) - 1) - (q << level) + 1);
-            }
-            continue;
-          }
-          for (int32_t q = t0 >> level; q <= t1 >> level; ++q) {
-            int32_t sum[C + 1] = {};
-            const int32_t xe = Min(t1, ((q + 1) << level) - 1);
-            for (int32_t x = q << level; x <= xe; ++x) {
-              const int32_t a = weight(layer_of[s[x] + offset]);
-              for (int32_t c = 0; c < C; ++c) sum[c] += (v[c][x] * a) >> shift;
-              sum[C] += a;
-            }
-            for (int32_t c = 0; c <= C; ++c) box[c][q] += sum[c];
+            layer_rows::PureBoxRowC<C>(v, shift, level, t0, t1, box);
+          } else {
+            layer_rows::WeightedBoxRowC<C>(v, s, layer_of, offset, k, shift, level, t0, t1, box);
           }
         }
       }
-      const int32_t round = 1 << (2 * level - 1);
-      for (int32_t c = 0; c <= C; ++c) {
-        for (int32_t i = q0; i <= q1; ++i) {
-          p[c][i + 1] = p[c][i] + static_cast<uint32_t>((box[c][i] + round) >> (2 * level));
-        }
-      }
+      for (int32_t c = 0; c <= C; ++c) layer_rows::BoxPrefixRowC(box[c], level, q0, q1, p[c]);
     }
     // Beyond the run the prefix stays flat: the kernel reads up to `h` + 1 columns outside.
     for (int32_t c = 0; c <= C; ++c) {
@@ -340,9 +301,7 @@ void LayerPlane::RenderRun(int32_t k, int32_t y0, int32_t n, const uint16_t* lay
       const int16_t* s = RadiusRow(y);
       int32_t* alpha = layer_ + channels_ * static_cast<ptrdiff_t>(pitch_);
       for (int32_t x = x0; x <= x1; ++x) {
-        const uint16_t e = layer_of[s[x] + offset];
-        const int32_t first = e >> 8, frac = e & 255;
-        alpha[x] = (first == k ? 256 - frac : (first + 1 == k ? frac : 0)) << 8;
+        alpha[x] = layer_rows::LayerWeightQ8(layer_of[s[x] + offset], k) << 8;
       }
       for (int32_t c = 0; c < channels_; ++c) {
         const int16_t* v = ValueRow(y, c);

@@ -99,11 +99,6 @@ void LerpCompositeC(const int32_t* col, ptrdiff_t stride, const uint8_t* frac, i
   }
 }
 
-template void LerpCompositeC<1>(const int32_t*, ptrdiff_t, const uint8_t*, int32_t, int32_t,
-                                int32_t, int32_t*, ptrdiff_t);
-template void LerpCompositeC<2>(const int32_t*, ptrdiff_t, const uint8_t*, int32_t, int32_t,
-                                int32_t, int32_t*, ptrdiff_t);
-
 void SumGroupsC(const int16_t* v, int32_t x0, int32_t x1, int32_t level, int32_t up, int32_t* box) {
   switch (level) {
     case 1:
@@ -116,6 +111,94 @@ void SumGroupsC(const int16_t* v, int32_t x0, int32_t x1, int32_t level, int32_t
       return SumGroupsT<4>(v, x0, x1, up, box);
   }
 }
+
+template <int C>
+void FlatPrefixRowC(int32_t x0, int32_t x1, uint32_t* const* p) {
+  for (int32_t c = 0; c <= C; ++c) {
+    for (int32_t x = x0; x <= x1; ++x) p[c][x + 1] = p[c][x];
+  }
+}
+
+template <int C>
+void PurePrefixRowC(const int16_t* const* v, int32_t shift, int32_t x0, int32_t x1,
+                    uint32_t* const* p) {
+  for (int32_t c = 0; c < C; ++c) {
+    const int16_t* vc = v[c];
+    uint32_t* pc = p[c];
+    for (int32_t x = x0; x <= x1; ++x) {
+      pc[x + 1] = pc[x] + static_cast<uint32_t>((vc[x] * 256) >> shift);
+    }
+  }
+  uint32_t* pa = p[C];
+  for (int32_t x = x0; x <= x1; ++x) pa[x + 1] = pa[x] + 256;
+}
+
+template <int C>
+void WeightedPrefixRowC(const int16_t* const* v, const int16_t* s, const uint16_t* layer_of,
+                        int32_t offset, int32_t k, int32_t shift, int32_t x0, int32_t x1,
+                        uint32_t* const* p) {
+  const int16_t* vc[C];
+  uint32_t* pc[C + 1];
+  for (int32_t c = 0; c < C; ++c) vc[c] = v[c];
+  for (int32_t c = 0; c <= C; ++c) pc[c] = p[c];
+  for (int32_t x = x0; x <= x1; ++x) {
+    const int32_t a = LayerWeightQ8(layer_of[s[x] + offset], k);
+    for (int32_t c = 0; c < C; ++c) {
+      pc[c][x + 1] = pc[c][x] + static_cast<uint32_t>((vc[c][x] * a) >> shift);
+    }
+    pc[C][x + 1] = pc[C][x] + static_cast<uint32_t>(a);
+  }
+}
+
+template <int C>
+void PureBoxRowC(const int16_t* const* v, int32_t shift, int32_t level, int32_t x0, int32_t x1,
+                 int32_t* const* box) {
+  for (int32_t c = 0; c < C; ++c) SumGroupsC(v[c], x0, x1, level, 8 - shift, box[c]);
+  for (int32_t q = x0 >> level; q <= x1 >> level; ++q) {
+    box[C][q] += 256 * (Min(x1, ((q + 1) << level) - 1) - (q << level) + 1);
+  }
+}
+
+template <int C>
+void WeightedBoxRowC(const int16_t* const* v, const int16_t* s, const uint16_t* layer_of,
+                     int32_t offset, int32_t k, int32_t shift, int32_t level, int32_t x0,
+                     int32_t x1, int32_t* const* box) {
+  for (int32_t q = x0 >> level; q <= x1 >> level; ++q) {
+    int32_t sum[C + 1] = {};
+    const int32_t xe = Min(x1, ((q + 1) << level) - 1);
+    for (int32_t x = q << level; x <= xe; ++x) {
+      const int32_t a = LayerWeightQ8(layer_of[s[x] + offset], k);
+      for (int32_t c = 0; c < C; ++c) sum[c] += (v[c][x] * a) >> shift;
+      sum[C] += a;
+    }
+    for (int32_t c = 0; c <= C; ++c) box[c][q] += sum[c];
+  }
+}
+
+void BoxPrefixRowC(const int32_t* box, int32_t level, int32_t q0, int32_t q1, uint32_t* p) {
+  const int32_t round = 1 << (2 * level - 1);
+  for (int32_t i = q0; i <= q1; ++i) {
+    p[i + 1] = p[i] + static_cast<uint32_t>((box[i] + round) >> (2 * level));
+  }
+}
+
+#define LB_LAYER_ROWS_INSTANTIATE(C)                                                           \
+  template void FlatPrefixRowC<C>(int32_t, int32_t, uint32_t* const*);                         \
+  template void PurePrefixRowC<C>(const int16_t* const*, int32_t, int32_t, int32_t,            \
+                                  uint32_t* const*);                                           \
+  template void WeightedPrefixRowC<C>(const int16_t* const*, const int16_t*, const uint16_t*,  \
+                                      int32_t, int32_t, int32_t, int32_t, int32_t,             \
+                                      uint32_t* const*);                                       \
+  template void PureBoxRowC<C>(const int16_t* const*, int32_t, int32_t, int32_t, int32_t,      \
+                               int32_t* const*);                                               \
+  template void WeightedBoxRowC<C>(const int16_t* const*, const int16_t*, const uint16_t*,     \
+                                   int32_t, int32_t, int32_t, int32_t, int32_t, int32_t,       \
+                                   int32_t* const*);                                           \
+  template void LerpCompositeC<C>(const int32_t*, ptrdiff_t, const uint8_t*, int32_t, int32_t, \
+                                  int32_t, int32_t*, ptrdiff_t);
+LB_LAYER_ROWS_INSTANTIATE(1)
+LB_LAYER_ROWS_INSTANTIATE(2)
+#undef LB_LAYER_ROWS_INSTANTIATE
 
 void NormaliseAlphaRowC(const uint32_t* acc, uint64_t rec, int32_t x0, int32_t x1, int32_t* alpha) {
   for (int32_t x = x0; x <= x1; ++x) {

@@ -23,6 +23,50 @@
 
 namespace lb::layer_rows {
 
+// Weight (Q8, 0..256) of layer k in a pixel whose layer entry (RenderStage's layer_of) is e =
+// first layer << 8 | weight of the next layer (Q8): 256 - that weight in the first layer, that
+// weight in the next, 0 elsewhere.
+inline int32_t LayerWeightQ8(uint16_t e, int32_t k) {
+  const int32_t first = e >> 8, frac = e & 255;
+  return first == k ? 256 - frac : (first + 1 == k ? frac : 0);
+}
+
+// ---- Prefix rows of a layer (C colour planes, then its weight), at full resolution. v[c] are
+// the value rows, s the signed radius row (Q4), p[c] the prefix rows, written at x + 1 for x in
+// [x0, x1] from p[c][x0]. Overflow: per pixel |c| <= 2040 x 256 and the weight <= 256; prefix
+// sums wrap in uint32 and only their differences (< 2^31, see above) are read. ----
+
+// A tile where the layer is absent: the prefix stays flat.
+template <int C>
+void FlatPrefixRowC(int32_t x0, int32_t x1, uint32_t* const* p);
+// A tile wholly in the layer (weight 256): c = (v x 256) >> shift.
+template <int C>
+void PurePrefixRowC(const int16_t* const* v, int32_t shift, int32_t x0, int32_t x1,
+                    uint32_t* const* p);
+// Any tile: the weight a of layer k per pixel from layer_of[s[x] + offset], c = (v x a) >> shift.
+template <int C>
+void WeightedPrefixRowC(const int16_t* const* v, const int16_t* s, const uint16_t* layer_of,
+                        int32_t offset, int32_t k, int32_t shift, int32_t x0, int32_t x1,
+                        uint32_t* const* p);
+
+// ---- Box sums of a reduced level (1..4): box[c][x >> level] += sum of c over the columns of
+// [x0, x1] in that box (x0 a multiple of 2^level), one full-resolution row at a time.
+// Overflow: a box of 2^level x 2^level <= 256 pixels of |c| <= 2040 x 256: < 2^27, int32. ----
+
+// A tile wholly in the layer, shift <= 8: (sum of v) << (8 - shift), which equals the sum of
+// (v x 256) >> shift exactly (v x 256 is a multiple of 2^shift); weights 256 per pixel.
+template <int C>
+void PureBoxRowC(const int16_t* const* v, int32_t shift, int32_t level, int32_t x0, int32_t x1,
+                 int32_t* const* box);
+// Any tile: as WeightedPrefixRowC, summed per box.
+template <int C>
+void WeightedBoxRowC(const int16_t* const* v, const int16_t* s, const uint16_t* layer_of,
+                     int32_t offset, int32_t k, int32_t shift, int32_t level, int32_t x0,
+                     int32_t x1, int32_t* const* box);
+// p[q + 1] = p[q] + round(box[q] / 4^level) for q in [q0, q1]: the box means' prefix row.
+// Overflow: box + 2^(2 level - 1) < 2^27 + 2^7, int32.
+void BoxPrefixRowC(const int32_t* box, int32_t level, int32_t q0, int32_t q1, uint32_t* p);
+
 // acc[x] += sum over the kernel row's cells of weight x c, for x in [x0, x1]: the span
 // [left, right] at w and the ends left - 1, right + 1 at wl, wr (Q8, 0..256), read from the
 // prefix row p (p[i] = sum of c over columns < i, valid for i in [x0 + left - 1,

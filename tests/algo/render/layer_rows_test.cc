@@ -331,6 +331,146 @@ TEST(LayerRows, ResolveRowDividesRoundsAndClamps) {
   }
 }
 
+TEST(LayerRows, LayerWeightsOfAPixelSumTo256) {
+  for (int32_t first = 0; first < 79; ++first) {
+    for (int32_t frac = 0; frac < 256; frac += 5) {
+      const uint16_t e = static_cast<uint16_t>(first << 8 | frac);
+      int32_t sum = 0;
+      for (int32_t k = 0; k < 80; ++k) sum += layer_rows::LayerWeightQ8(e, k);
+      ASSERT_EQ(sum, 256) << first << " " << frac;
+      ASSERT_EQ(layer_rows::LayerWeightQ8(e, first), 256 - frac);
+    }
+  }
+}
+
+// A layer's rows: C value rows, a radius row and a layer_of table mapping radius + offset to
+// an entry whose first layer is 0..3.
+template <int C>
+struct LayerInput {
+  static constexpr int32_t kOffset = 64;
+  std::vector<std::vector<int16_t>> v = std::vector<std::vector<int16_t>>(C);
+  std::vector<int16_t> s;
+  std::vector<uint16_t> layer_of = std::vector<uint16_t>(2 * kOffset + 1);
+  const int16_t* rows[C];
+  LayerInput(std::mt19937& rng, int32_t n, bool extreme, bool pure_in = false, int32_t k = 0) {
+    for (uint16_t& e : layer_of) {
+      e = static_cast<uint16_t>(pure_in ? k << 8
+                                        : (rng() % 4) << 8 | (extreme ? 255 : rng() % 256));
+    }
+    const int16_t sign = (rng() & 1) ? 1 : -1;
+    for (int32_t c = 0; c < C; ++c) {
+      for (int32_t x = 0; x < n; ++x) {
+        v[c].push_back(static_cast<int16_t>(
+            extreme ? sign * kMaxV : static_cast<int32_t>(rng() % (2 * kMaxV + 1)) - kMaxV));
+      }
+      rows[c] = v[c].data();
+    }
+    for (int32_t x = 0; x < n; ++x)
+      s.push_back(static_cast<int16_t>(static_cast<int32_t>(rng() % (2 * kOffset + 1)) - kOffset));
+  }
+  int32_t A(int32_t x, int32_t k) const {
+    return layer_rows::LayerWeightQ8(layer_of[s[x] + kOffset], k);
+  }
+};
+
+template <int C>
+void CheckPrefixRows(std::mt19937& rng, int32_t trial) {
+  const int32_t n = 1 + trial % 70, k = trial % 4, shift = trial % 9;
+  const bool extreme = trial % 3 == 0;
+  const LayerInput<C> in(rng, n, extreme);
+  const int32_t x0 = static_cast<int32_t>(rng() % n);
+  for (int32_t kind = 0; kind < 3; ++kind) {
+    std::vector<std::vector<uint32_t>> prefix(C + 1, std::vector<uint32_t>(n + 1));
+    uint32_t* p[C + 1];
+    for (int32_t c = 0; c <= C; ++c) {
+      prefix[c][x0] = rng();  // any start: only differences are read
+      p[c] = prefix[c].data();
+    }
+    if (kind == 0) layer_rows::FlatPrefixRowC<C>(x0, n - 1, p);
+    if (kind == 1) layer_rows::PurePrefixRowC<C>(in.rows, shift, x0, n - 1, p);
+    if (kind == 2) {
+      layer_rows::WeightedPrefixRowC<C>(in.rows, in.s.data(), in.layer_of.data(),
+                                        LayerInput<C>::kOffset, k, shift, x0, n - 1, p);
+    }
+    for (int32_t x = x0; x < n; ++x) {
+      const int32_t a = kind == 0 ? 0 : kind == 1 ? 256 : in.A(x, k);
+      for (int32_t c = 0; c <= C; ++c) {
+        const int32_t want = c == C ? a : (in.v[c][x] * a) >> shift;
+        ASSERT_EQ(static_cast<int32_t>(prefix[c][x + 1] - prefix[c][x]), want)
+            << "kind " << kind << " trial " << trial << " x " << x << " c " << c;
+      }
+    }
+  }
+}
+
+TEST(LayerRows, PrefixRowsAddEachPixelsWeightedValue) {
+  std::mt19937 rng(21);
+  for (int32_t trial = 0; trial < 200; ++trial) {
+    CheckPrefixRows<1>(rng, trial);
+    CheckPrefixRows<2>(rng, trial);
+  }
+}
+
+template <int C>
+void CheckBoxRows(std::mt19937& rng, int32_t trial) {
+  const int32_t level = 1 + trial % 4, n = 1 + trial % 90, k = trial % 4, shift = trial % 9;
+  const bool extreme = trial % 3 == 0;
+  const int32_t x0 = static_cast<int32_t>(rng() % n) & ~((1 << level) - 1);
+  const int32_t x1 = x0 + static_cast<int32_t>(rng() % (n - x0));
+  const int32_t boxes = (n >> level) + 1;
+  // A whole box of rows (the largest sums), weighted; and a pure one both ways.
+  const LayerInput<C> mixed(rng, n, extreme), pure(rng, n, extreme, true, k);
+  std::vector<std::vector<int32_t>> got(C + 1, std::vector<int32_t>(boxes, 0));
+  std::vector<std::vector<int32_t>> want = got, pure_w = got, pure_p = got;
+  int32_t* g[C + 1];
+  int32_t* pw[C + 1];
+  int32_t* pp[C + 1];
+  for (int32_t c = 0; c <= C; ++c)
+    g[c] = got[c].data(), pw[c] = pure_w[c].data(), pp[c] = pure_p[c].data();
+  for (int32_t row = 0; row < (1 << level); ++row) {
+    layer_rows::WeightedBoxRowC<C>(mixed.rows, mixed.s.data(), mixed.layer_of.data(),
+                                   LayerInput<C>::kOffset, k, shift, level, x0, x1, g);
+    for (int32_t x = x0; x <= x1; ++x) {
+      const int32_t a = mixed.A(x, k);
+      for (int32_t c = 0; c < C; ++c) want[c][x >> level] += (mixed.v[c][x] * a) >> shift;
+      want[C][x >> level] += a;
+    }
+    layer_rows::WeightedBoxRowC<C>(pure.rows, pure.s.data(), pure.layer_of.data(),
+                                   LayerInput<C>::kOffset, k, shift, level, x0, x1, pw);
+    layer_rows::PureBoxRowC<C>(pure.rows, shift, level, x0, x1, pp);
+  }
+  ASSERT_EQ(got, want) << "trial " << trial;
+  ASSERT_EQ(pure_p, pure_w) << "trial " << trial;  // the shortcut gives the same sums
+}
+
+TEST(LayerRows, BoxRowsSumEachBoxAndThePureShortcutAgrees) {
+  std::mt19937 rng(22);
+  for (int32_t trial = 0; trial < 300; ++trial) {
+    CheckBoxRows<1>(rng, trial);
+    CheckBoxRows<2>(rng, trial);
+  }
+}
+
+TEST(LayerRows, BoxPrefixRowAddsTheRoundedMeans) {
+  std::mt19937 rng(23);
+  for (int32_t trial = 0; trial < 200; ++trial) {
+    const int32_t level = 1 + trial % 4, n = 1 + trial % 40;
+    const int32_t max_box = (1 << (2 * level)) * kMaxV * 256;  // 2^level x 2^level pixels
+    std::vector<int32_t> box(n);
+    for (int32_t& b : box) {
+      b = trial % 3 == 0 ? ((rng() & 1) ? max_box : -max_box)
+                         : static_cast<int32_t>(rng() % (2 * uint32_t(max_box) + 1)) - max_box;
+    }
+    std::vector<uint32_t> p(n + 1);
+    p[0] = rng();
+    layer_rows::BoxPrefixRowC(box.data(), level, 0, n - 1, p.data());
+    for (int32_t q = 0; q < n; ++q) {
+      const double mean = std::floor(box[q] / static_cast<double>(1 << (2 * level)) + 0.5);
+      ASSERT_EQ(static_cast<int32_t>(p[q + 1] - p[q]), static_cast<int32_t>(mean)) << trial;
+    }
+  }
+}
+
 TEST(LayerRows, BestKernelsAreOneOfTheVariants) {
   const Kernels& best = layer_rows::BestKernels();
   bool found = false;
