@@ -11,7 +11,7 @@
 #include "algo/depth/planes.h"
 #include "tests/algo/depth/handheld.h"
 #include "tests/algo/depth/synthetic_views.h"
-#include "tests/algo/pipeline/alloc_counter.h"
+#include "tests/support/alloc_counter.h"
 
 namespace lb {
 namespace {

@@ -6,8 +6,8 @@
 #include <cstdlib>
 #include <vector>
 
-#include "tests/algo/render/alloc_counter.h"
 #include "tests/algo/render/render_util.h"
+#include "tests/support/alloc_counter.h"
 
 namespace lb {
 namespace {
@@ -280,7 +280,7 @@ TEST(RenderStage, NothingIsAllocatedAfterConfigure) {
   params.aperture = {7, 10.0f, 0.3f};
   params.highlight_gain = 3.0f;
   params.highlight_threshold = 220;
-  const int64_t before = test::AllocationCount();
+  const size_t before = testing::AllocationCount();
   bool ok = stage.Begin(scene.Planar(), scene.WorkingDisp(), params).ok();
   int32_t total = 0;
   for (int32_t rows = 1; ok && rows > 0;) {
@@ -289,10 +289,10 @@ TEST(RenderStage, NothingIsAllocatedAfterConfigure) {
     ok = stage.NextStrip(&strip, &y0, &rows).ok();
     total += rows;
   }
-  const int64_t after = test::AllocationCount();
+  const size_t after = testing::AllocationCount();
   EXPECT_TRUE(ok);
   EXPECT_EQ(total, 64);
-  EXPECT_EQ(after - before, 0);
+  EXPECT_EQ(after - before, 0u);
   EXPECT_LT(RenderStage::RequiredBytes(config), size_t{1} << 20);
 }
 

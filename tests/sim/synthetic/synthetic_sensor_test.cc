@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "tests/sim/synthetic/alloc_counter.h"
+#include "tests/support/alloc_counter.h"
 
 namespace lb {
 namespace {
