@@ -28,25 +28,12 @@ struct Burst {
   void Setup(int32_t width, int32_t height, int32_t frames) {
     SceneParams params;
     params.seed = 7;
-    sensor = std::make_unique<SyntheticSensor>(params);
-    SensorConfig sc;
-    sc.width = width;
-    sc.height = height;
-    sc.frames = frames;
-    ASSERT_TRUE(sensor->Configure(sc, &mode).ok());
-    config.width = mode.width;
-    config.height = mode.height;
-    config.frames = mode.frames;
-    config.reference = sensor->scene().reference();
+    ASSERT_NO_FATAL_FAILURE(Open(params, width, height, frames));
     config.labels = 24;
     config.disp_min_q8 = 0;
     config.disp_max_q8 = sensor->scene().disparity_max_q8(1) + 256;
     config.max_blur_radius = 12;
-    size_t bytes = 0;
-    ASSERT_TRUE(Pipeline::RequiredBytes(config, &bytes).ok());
-    arena = aligned_alloc(Arena::kAlign, Arena::RoundUp(bytes));
-    Status s = pipeline.Configure(config, arena, bytes);
-    ASSERT_TRUE(s.ok()) << s.message();
+    ConfigurePipeline();
   }
 
   // The board's default path (firmware/daemon/config.cc, DaemonJobDefaults): a handheld burst
@@ -57,6 +44,14 @@ struct Burst {
     params.seed = 7;
     params.motion = CameraMotion::kHandheld;
     params.max_translation = max_translation;
+    ASSERT_NO_FATAL_FAILURE(Open(params, width, height, frames));
+    config.labels = 32;
+    config.geometry = Geometry::kAuto;
+    ConfigurePipeline();
+  }
+
+  // The sensor, and the configuration's frame size, count and reference from its mode.
+  void Open(const SceneParams& params, int32_t width, int32_t height, int32_t frames) {
     sensor = std::make_unique<SyntheticSensor>(params);
     SensorConfig sc;
     sc.width = width;
@@ -67,8 +62,10 @@ struct Burst {
     config.height = mode.height;
     config.frames = mode.frames;
     config.reference = sensor->scene().reference();
-    config.labels = 32;
-    config.geometry = Geometry::kAuto;
+  }
+
+  // The pipeline on its own aligned block of the bytes it asks for.
+  void ConfigurePipeline() {
     size_t bytes = 0;
     ASSERT_TRUE(Pipeline::RequiredBytes(config, &bytes).ok());
     arena = aligned_alloc(Arena::kAlign, Arena::RoundUp(bytes));
