@@ -6,12 +6,9 @@
 // and B + C - A >= 0 because truncated linear is a metric, so every move is a graph cut.
 #include "algo/depth/depth_stage.h"
 
+#include "algo/core/int_math.h"
+
 namespace lb {
-namespace {
-
-inline int32_t Abs(int32_t v) { return v < 0 ? -v : v; }
-
-}  // namespace
 
 // Pass 1: pixels whose choice does not depend on their neighbours are fixed before the cut.
 // Flipping p to alpha changes the energy by u_p plus, per neighbour q, C - A (q keeps its label)
