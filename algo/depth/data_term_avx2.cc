@@ -214,16 +214,11 @@ constexpr SelectRowFn kAvx2ByKeep[kMaxBest] = {
     SelectRowAvx2T<1>, SelectRowAvx2T<2>, SelectRowAvx2T<3>, SelectRowAvx2T<4>,
     SelectRowAvx2T<5>, SelectRowAvx2T<6>, SelectRowAvx2T<7>, SelectRowAvx2T<8>};
 
-void SelectRowAvx2(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
-                   uint16_t* out) {
-  kAvx2ByKeep[(others + 1) / 2 - 1](rows, others, x0, x1, out);
-}
-
 }  // namespace
 
 const DataTerm::Kernels* Avx2Kernels() {
   static constexpr DataTerm::Kernels kAvx2 = {CensusRowAvx2, CostRowAvx2, HSumRowAvx2,
-                                              SelectRowAvx2};
+                                              SelectByKeep<kAvx2ByKeep>};
   return __builtin_cpu_supports("avx2") ? &kAvx2 : nullptr;
 }
 

@@ -28,6 +28,12 @@ inline constexpr int32_t kMaxBest = 8;  // best half of up to 15 other views
 // kept count, 1 .. kMaxBest, in a table.
 using SelectRowFn = void (*)(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
                              uint16_t* out);
+// The select kernel that runs the instance of `by_keep` (kMaxBest entries) for the kept count.
+template <const SelectRowFn* by_keep>
+void SelectByKeep(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
+                  uint16_t* out) {
+  by_keep[(others + 1) / 2 - 1](rows, others, x0, x1, out);
+}
 
 // Q15 reciprocal of `keep`: the mean of the kept sums, rounded (error < 1 for D <= 2295).
 inline uint32_t RecipQ15(int32_t keep) {

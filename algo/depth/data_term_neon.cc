@@ -145,16 +145,11 @@ constexpr SelectRowFn kNeonByKeep[kMaxBest] = {
     SelectRowNeonT<1>, SelectRowNeonT<2>, SelectRowNeonT<3>, SelectRowNeonT<4>,
     SelectRowNeonT<5>, SelectRowNeonT<6>, SelectRowNeonT<7>, SelectRowNeonT<8>};
 
-void SelectRowNeon(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
-                   uint16_t* out) {
-  kNeonByKeep[(others + 1) / 2 - 1](rows, others, x0, x1, out);
-}
-
 }  // namespace
 
 const DataTerm::Kernels* NeonKernels() {
   static constexpr DataTerm::Kernels kNeon = {CensusRowNeon, CostRowNeon, HSumRowNeon,
-                                              SelectRowNeon};
+                                              SelectByKeep<kNeonByKeep>};
   return &kNeon;
 }
 
