@@ -10,6 +10,10 @@
 
 namespace lb {
 
+// The largest frame side the product takes: sensors refuse larger modes, the pipeline sizes its
+// arena for at most this.
+inline constexpr int32_t kMaxFrameSide = 8192;
+
 enum class PixelFormat : uint8_t {
   kGray8,   // 1 x 8-bit
   kRgb8,    // 3 x 8-bit, R G B in memory order

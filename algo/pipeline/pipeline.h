@@ -32,8 +32,8 @@ enum class Geometry : uint8_t {
 
 struct PipelineConfig {
   static constexpr int32_t kMaxFrames = DepthConfig::kMaxViews;
-  static constexpr int32_t kMaxWidth = 8192;
-  static constexpr int32_t kMaxHeight = 8192;
+  static constexpr int32_t kMaxWidth = kMaxFrameSide;
+  static constexpr int32_t kMaxHeight = kMaxFrameSide;
 
   int32_t width = 0;  // sensor frames, full resolution
   int32_t height = 0;

@@ -20,9 +20,9 @@
 #include <string>
 #include <vector>
 
+#include "hal/frame_sequence.h"
 #include "hal/libcamera/exposure_hold.h"
 #include "hal/libcamera/libcamera_format.h"
-#include "hal/v4l2/frame_sequence.h"
 
 namespace lb {
 

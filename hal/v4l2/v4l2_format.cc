@@ -2,8 +2,6 @@
 
 #include <cstdio>
 
-#include "algo/pipeline/pipeline.h"
-
 namespace lb {
 
 FourccText FourccName(uint32_t fourcc) {
@@ -88,10 +86,10 @@ Status LayoutFromFormat(const char* device, const v4l2_pix_format& pix, uint32_t
     return Status(Code::kUnsupported, "%s: interlaced field order %u, progressive needed", device,
                   pix.field);
   }
-  if (pix.width == 0 || pix.height == 0 || pix.width > PipelineConfig::kMaxWidth ||
-      pix.height > PipelineConfig::kMaxHeight) {
+  if (pix.width == 0 || pix.height == 0 || pix.width > kMaxFrameSide ||
+      pix.height > kMaxFrameSide) {
     return Status(Code::kUnsupported, "%s: frame size %ux%u outside 1x1..%dx%d", device, pix.width,
-                  pix.height, PipelineConfig::kMaxWidth, PipelineConfig::kMaxHeight);
+                  pix.height, kMaxFrameSide, kMaxFrameSide);
   }
   if (format == PixelFormat::kYuyv && pix.width % 2 != 0) {
     return Status(Code::kUnsupported, "%s: YUYV with odd width %u", device, pix.width);

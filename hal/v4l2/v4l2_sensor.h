@@ -9,8 +9,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "hal/frame_sequence.h"
 #include "hal/sensor.h"
-#include "hal/v4l2/frame_sequence.h"
 #include "hal/v4l2/v4l2_format.h"
 #include "hal/v4l2/v4l2_io.h"
 

@@ -1,4 +1,4 @@
-#include "hal/v4l2/frame_sequence.h"
+#include "hal/frame_sequence.h"
 
 namespace lb {
 
