@@ -273,11 +273,14 @@ TEST(LayerRows, NormaliseRowsScaleByTheReciprocal) {
     layer_rows::NormaliseAlphaRowC(acc_a.data(), rec, 0, n - 1, alpha.data());
     layer_rows::NormaliseColourRowC(acc_c.data(), rec, shift, 0, n - 1, colour.data());
     for (int32_t x = 0; x < n; ++x) {
-      const __int128 a = (static_cast<__int128>(acc_a[x]) * rec) >> 32;
+      // Exact in 64 bits on every target (armhf has no __int128): acc_a <= total x 2^8 and
+      // rec <= 2^40 / total, so acc_a x rec <= 2^48; |acc_c| <= INT32_MAX and rec <= 2^32, so
+      // |acc_c x rec| < 2^63.
+      const uint64_t a = (uint64_t{acc_a[x]} * rec) >> 32;
       ASSERT_EQ(alpha[x], a > 65536 ? 65536 : static_cast<int32_t>(a)) << trial;
       ASSERT_LE(alpha[x], 65536);
-      const __int128 c =
-          (static_cast<__int128>(static_cast<int32_t>(acc_c[x])) * rec) >> (32 - shift);
+      const int64_t c =
+          (int64_t{static_cast<int32_t>(acc_c[x])} * static_cast<int64_t>(rec)) >> (32 - shift);
       ASSERT_EQ(colour[x], static_cast<int32_t>(c)) << trial;
       // Q16 of v: within the value range (plus rounding of the reciprocal).
       ASSERT_LE(std::abs(colour[x]), kMaxV * 65536 + 65536) << trial;
