@@ -12,6 +12,9 @@
 
 namespace lb {
 
+// Most workers a stage carves scratch for.
+inline constexpr int32_t kMaxWorkers = 16;
+
 // One task of a Run: `task` in [0, tasks), `worker` in [0, workers()).
 using TaskFn = void (*)(void* context, int32_t task, int32_t worker);
 

@@ -35,16 +35,25 @@ bool DataTerm::UseSimd(bool on) {
   return simd != nullptr;
 }
 
-void DataTerm::Carve(Arena& arena, int32_t width, int32_t height, int32_t views) {
+void DataTerm::Carve(Arena& arena, int32_t width, int32_t height, int32_t views, int32_t workers) {
   width_ = width;
   height_ = height;
   views_ = views;
+  workers_ = Clamp(workers, 1, kMaxWorkers);
   const size_t n = static_cast<size_t>(width) * height;
   for (int32_t v = 0; v < views; ++v) census_[v] = arena.Allocate<uint8_t>(3 * n);
-  luma_ = arena.Allocate<uint8_t>(static_cast<size_t>(width + 2 * kLumaPad) * kLumaRows);
-  pixel_ = arena.Allocate<uint8_t>(static_cast<size_t>(width) + 2);
-  hsum_ = arena.Allocate<uint16_t>(static_cast<size_t>(width) * 3 * (views - 1));
+  for (int32_t i = 0; i < workers_; ++i) {
+    Scratch& s = scratch_[i];
+    s.luma = arena.Allocate<uint8_t>(static_cast<size_t>(width + 2 * kLumaPad) * kLumaRows);
+    s.pixel = arena.Allocate<uint8_t>(static_cast<size_t>(width) + 2);
+    s.hsum = arena.Allocate<uint16_t>(static_cast<size_t>(width) * 3 * (views - 1));
+  }
+  runner_ = &inline_;
   UseSimd(true);
+}
+
+void DataTerm::SetRunner(TaskRunner* runner) {
+  runner_ = runner != nullptr && runner->workers() <= workers_ ? runner : &inline_;
 }
 
 void DataTerm::SetParams(const DataTermParams& params, int32_t reference) {
@@ -56,18 +65,21 @@ void DataTerm::SetParams(const DataTermParams& params, int32_t reference) {
 
 void DataTerm::Prepare(const ConstImageU8* views) {
   images_ = views;
+  ParallelFor(*runner_, views_,
+              [&](int32_t v, int32_t worker) { CensusOfView(scratch_[worker], v); });
+}
+
+void DataTerm::CensusOfView(const Scratch& s, int32_t v) {
   const int32_t w = width_, h = height_;
   const ptrdiff_t pitch = w + 2 * kLumaPad;
   // Luma row r lives in ring slot r % 5 (the census needs rows y - 2 .. y + 2, clamped).
-  auto slot = [&](int32_t r) { return luma_ + (r % kLumaRows) * pitch + kLumaPad; };
-  for (int32_t v = 0; v < views_; ++v) {
-    for (int32_t r = 0; r < 2 && r < h; ++r) LumaRow(views[v].Row(r), w, slot(r));
-    for (int32_t y = 0; y < h; ++y) {
-      if (y + 2 < h) LumaRow(views[v].Row(y + 2), w, slot(y + 2));
-      const uint8_t* rows[kLumaRows];
-      for (int32_t k = 0; k < kLumaRows; ++k) rows[k] = slot(Clamp(y + k - 2, 0, h - 1));
-      kernels_->census(rows, 0, w, w, census_[v] + static_cast<ptrdiff_t>(y) * 3 * w);
-    }
+  auto slot = [&](int32_t r) { return s.luma + (r % kLumaRows) * pitch + kLumaPad; };
+  for (int32_t r = 0; r < 2 && r < h; ++r) LumaRow(images_[v].Row(r), w, slot(r));
+  for (int32_t y = 0; y < h; ++y) {
+    if (y + 2 < h) LumaRow(images_[v].Row(y + 2), w, slot(y + 2));
+    const uint8_t* rows[kLumaRows];
+    for (int32_t k = 0; k < kLumaRows; ++k) rows[k] = slot(Clamp(y + k - 2, 0, h - 1));
+    kernels_->census(rows, 0, w, w, census_[v] + static_cast<ptrdiff_t>(y) * 3 * w);
   }
 }
 
@@ -97,10 +109,10 @@ void DataTerm::PixelCostRow(int32_t view, int32_t y, int32_t disp_q8, int32_t x0
 
 // Horizontal 3-sum of the pixel costs of row y (borders replicated) for columns x0..x1-1:
 // 0..765.
-void DataTerm::WindowRow(int32_t view, int32_t y, int32_t disp_q8, int32_t x0, int32_t x1,
-                         uint16_t* hsum) {
+void DataTerm::WindowRow(const Scratch& s, int32_t view, int32_t y, int32_t disp_q8, int32_t x0,
+                         int32_t x1, uint16_t* hsum) const {
   const int32_t w = width_;
-  uint8_t* cost = pixel_ + 1;
+  uint8_t* cost = s.pixel + 1;
   const int32_t c0 = x0 > 0 ? x0 - 1 : 0, c1 = x1 < w ? x1 + 1 : w;
   PixelCostRow(view, Clamp(y, 0, height_ - 1), disp_q8, c0, c1, cost);
   if (x0 == 0) cost[-1] = cost[0];
@@ -110,21 +122,41 @@ void DataTerm::WindowRow(int32_t view, int32_t y, int32_t disp_q8, int32_t x0, i
 
 void DataTerm::ComputeRect(int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0, int32_t y1,
                            uint16_t* out, ptrdiff_t stride) {
+  // A band's first two rows of 3-sums are its overhead, and a task costs a wake-up: bands of
+  // at least kMinBandRows rows and kMinBandPixels pixels, a few per worker to even out the load.
+  constexpr int32_t kMinBandRows = 8, kMinBandPixels = 8192, kBandsPerWorker = 4;
+  const int32_t rows = y1 - y0, cols = x1 - x0;
+  int32_t bands = runner_->workers() * kBandsPerWorker;
+  bands = Min(bands, rows / kMinBandRows);
+  bands = Min(bands, static_cast<int32_t>(int64_t{rows} * cols / kMinBandPixels));
+  if (bands <= 1) {
+    ComputeBand(scratch_[0], disp_q8, x0, x1, y0, y1, out, stride);
+    return;
+  }
+  ParallelFor(*runner_, bands, [&](int32_t band, int32_t worker) {
+    const int32_t b0 = y0 + static_cast<int32_t>(int64_t{rows} * band / bands);
+    const int32_t b1 = y0 + static_cast<int32_t>(int64_t{rows} * (band + 1) / bands);
+    ComputeBand(scratch_[worker], disp_q8, x0, x1, b0, b1, out + (b0 - y0) * stride, stride);
+  });
+}
+
+void DataTerm::ComputeBand(const Scratch& s, int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0,
+                           int32_t y1, uint16_t* out, ptrdiff_t stride) const {
   const int32_t w = width_;
   const int32_t others = views_ - 1;
   auto ring = [&](int32_t j, int32_t row) {
-    return hsum_ + (static_cast<size_t>(j) * 3 + static_cast<size_t>((row - y0 + 1) % 3)) * w;
+    return s.hsum + (static_cast<size_t>(j) * 3 + static_cast<size_t>((row - y0 + 1) % 3)) * w;
   };
   auto view = [&](int32_t j) { return j < reference_ ? j : j + 1; };
   for (int32_t j = 0; j < others; ++j) {
-    WindowRow(view(j), y0 - 1, disp_q8, x0, x1, ring(j, y0 - 1));
-    WindowRow(view(j), y0, disp_q8, x0, x1, ring(j, y0));
+    WindowRow(s, view(j), y0 - 1, disp_q8, x0, x1, ring(j, y0 - 1));
+    WindowRow(s, view(j), y0, disp_q8, x0, x1, ring(j, y0));
   }
   const uint16_t* rows[3 * 15];
   const size_t row_bytes = static_cast<size_t>(3) * (x1 - x0);
   for (int32_t y = y0; y < y1; ++y) {
     for (int32_t j = 0; j < others; ++j) {
-      WindowRow(view(j), y + 1, disp_q8, x0, x1, ring(j, y + 1));
+      WindowRow(s, view(j), y + 1, disp_q8, x0, x1, ring(j, y + 1));
       // The views' next rows are far apart (a whole view each), so the hardware prefetcher
       // misses their starts; asking early hides the cache misses behind the other views.
       const int32_t next = Clamp(y + 2, 0, height_ - 1);

@@ -10,6 +10,8 @@
 //
 // Range: pixel cost 0..255, window sum 0..2295, D (a mean of window sums) 0..2295, uint16.
 // No costs are stored: each call computes the rows it is asked for, through a 3-row ring.
+// Threads: a large request is cut into bands of rows, one task each (task_runner.h); a band
+// starts its ring one row above itself, so every row's D is the same whoever computes it.
 //
 // Every kernel has a plain C reference (data_term_ref.cc); SIMD twins give the same bits: AVX2
 // on x86-64 (data_term_avx2.cc, when the CPU has it, else the C cost kernel compiled for SSSE3)
@@ -23,6 +25,7 @@
 
 #include "algo/core/arena.h"
 #include "algo/core/image.h"
+#include "algo/core/task_runner.h"
 #include "algo/motion/plane_homography.h"
 
 namespace lb {
@@ -37,9 +40,12 @@ class DataTerm {
   static constexpr int32_t kMaxCost = 2295;  // 9 * 255
   static constexpr int32_t kCensusBits = 24;
 
-  // Carves the census images and row rings for `views` views of width x height, and picks the
-  // SIMD kernels when the CPU has them.
-  void Carve(Arena& arena, int32_t width, int32_t height, int32_t views);
+  // Carves the census images, and row rings for each of `workers` workers, for `views` views of
+  // width x height, and picks the SIMD kernels when the CPU has them.
+  void Carve(Arena& arena, int32_t width, int32_t height, int32_t views, int32_t workers = 1);
+  // Where Prepare and ComputeRect run their tasks (borrowed; nullptr: on the caller). At most
+  // the carved number of workers.
+  void SetRunner(TaskRunner* runner);
   // The SIMD kernels (when `on` and the CPU has them) or the C reference; returns which is used.
   bool UseSimd(bool on);
   void SetParams(const DataTermParams& params, int32_t reference);
@@ -69,10 +75,20 @@ class DataTerm {
   struct Kernels;
 
  private:
+  // One worker's rings.
+  struct Scratch {
+    uint8_t* luma = nullptr;   // 5 rows of one view's luma (+/-128), 2 replicated pixels a side
+    uint8_t* pixel = nullptr;  // one row of pixel costs, 1 replicated pixel a side
+    uint16_t* hsum = nullptr;  // per other view, 3 rows of horizontal 3-sums
+  };
   // Pixel costs of columns x0..x1-1 of row y (out indexed by x).
   void PixelCostRow(int32_t view, int32_t y, int32_t disp_q8, int32_t x0, int32_t x1,
                     uint8_t* out) const;
-  void WindowRow(int32_t view, int32_t y, int32_t disp_q8, int32_t x0, int32_t x1, uint16_t* hsum);
+  void WindowRow(const Scratch& s, int32_t view, int32_t y, int32_t disp_q8, int32_t x0, int32_t x1,
+                 uint16_t* hsum) const;
+  void CensusOfView(const Scratch& s, int32_t view);
+  void ComputeBand(const Scratch& s, int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0,
+                   int32_t y1, uint16_t* out, ptrdiff_t stride) const;
 
   int32_t width_ = 0, height_ = 0, views_ = 0, reference_ = 0;
   DataTermParams params_;
@@ -81,9 +97,10 @@ class DataTerm {
   const Kernels* kernels_ = nullptr;
   const PlaneHomography* planes_ = nullptr;
   uint8_t* census_[16] = {};
-  uint8_t* luma_ = nullptr;   // 5 rows of one view's luma (+/-128), 2 replicated pixels a side
-  uint8_t* pixel_ = nullptr;  // one row of pixel costs, 1 replicated pixel a side
-  uint16_t* hsum_ = nullptr;  // per other view, 3 rows of horizontal 3-sums
+  Scratch scratch_[kMaxWorkers];
+  int32_t workers_ = 1;
+  InlineRunner inline_;
+  TaskRunner* runner_ = &inline_;
 };
 
 }  // namespace lb

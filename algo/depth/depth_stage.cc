@@ -27,6 +27,10 @@ Status DepthStage::Validate(const DepthConfig& c) {
     return Status(Code::kInvalidArgument, "depth: reference %d outside 0..%d", c.reference,
                   c.views - 1);
   }
+  if (c.workers < 1 || c.workers > kMaxWorkers) {
+    return Status(Code::kInvalidArgument, "depth: %d workers (needs 1 to %d)", c.workers,
+                  kMaxWorkers);
+  }
   if (c.labels < 2 || c.labels > DepthConfig::kMaxLabels) {
     return Status(Code::kInvalidArgument, "depth: %d labels (needs 2 to %d)", c.labels,
                   DepthConfig::kMaxLabels);
@@ -85,7 +89,7 @@ Status DepthStage::Carve(Arena& arena) {
   const size_t start = arena.used();
   const int32_t w = config_.width, h = config_.height;
   const size_t n = static_cast<size_t>(w) * h;
-  data_.Carve(arena, w, h, config_.views);
+  data_.Carve(arena, w, h, config_.views, config_.workers);
   maxflow_.Carve(arena, w, h);
   CarveGrid(arena, fine_, w, h, true);
   move_rows_ = arena.Allocate<int32_t>(11 * static_cast<size_t>(w));

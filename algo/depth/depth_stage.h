@@ -68,6 +68,8 @@ struct DepthConfig {
   // within fine_window, which moves the block edges onto the image's.
   bool coarse_blocks = true;
   bool subpixel = true;  // parabola fit between labels for the output
+  // Workers the data term carves rings for (task_runner.h), 1..kMaxWorkers.
+  int32_t workers = 1;
 };
 
 struct DepthStats {
@@ -92,6 +94,9 @@ class DepthStage {
   static size_t RequiredBytes(const DepthConfig& config);
 
   Status Configure(const DepthConfig& config, Arena& arena);
+  // Where the data term runs its tasks (borrowed; nullptr: on the caller), with at most
+  // config.workers workers. The output does not depend on it.
+  void SetRunner(TaskRunner* runner) { data_.SetRunner(runner); }
 
   // kPlanes only, after Configure and before each Compute (a Compute consumes them, so a new
   // burst cannot run on the last one's poses): homographies[v * labels + l] is label l's plane

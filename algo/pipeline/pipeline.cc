@@ -39,6 +39,7 @@ static DepthConfig MakeDepthConfig(const PipelineConfig& c, int32_t w, int32_t h
   d.labels = c.labels;
   d.disp_min_q8 = c.disp_min_q8;
   d.disp_max_q8 = c.disp_max_q8;
+  d.workers = c.workers;
   if (c.geometry == Geometry::kAuto) {
     d.geometry = DepthGeometry::kPlanes;
     // Placeholder range for sizing; every burst sets its own (auto_geometry.h).
@@ -92,6 +93,10 @@ Status Pipeline::RequiredBytes(const PipelineConfig& c, size_t* bytes) {
   if (c.max_working_width < 8 || c.max_working_height < 8) {
     return Status(Code::kInvalidArgument, "working size bound %dx%d is below 8x8",
                   c.max_working_width, c.max_working_height);
+  }
+  if (c.workers < 1 || c.workers > kMaxWorkers) {
+    return Status(Code::kInvalidArgument, "%d worker threads: 1 to %d are supported", c.workers,
+                  kMaxWorkers);
   }
   const Layout l = Plan(c);
   if (HasDepth(l.work_w, l.work_h)) {
@@ -154,6 +159,8 @@ Status Pipeline::Carve(Arena& arena) {
   }
   return Status::Ok();
 }
+
+void Pipeline::SetRunner(TaskRunner* runner) { depth_.SetRunner(runner); }
 
 Status Pipeline::Configure(const PipelineConfig& config, void* arena, size_t bytes) {
   size_t needed = 0;

@@ -18,6 +18,7 @@
 #include "algo/core/frame.h"
 #include "algo/core/image.h"
 #include "algo/core/status.h"
+#include "algo/core/task_runner.h"
 #include "algo/depth/depth_stage.h"
 #include "algo/motion/motion_stage.h"
 #include "algo/render/render_stage.h"
@@ -52,6 +53,8 @@ struct PipelineConfig {
   // Focal length in full-resolution px (kAuto); 0 assumes DefaultIntrinsics' field of view.
   double focal_px = 0;
   int32_t max_blur_radius = 32;  // full-resolution px
+  // Workers the stages carve scratch for (task_runner.h): the most SetRunner may hand in.
+  int32_t workers = 1;
 };
 
 class Pipeline : public FrameSink {
@@ -64,6 +67,10 @@ class Pipeline : public FrameSink {
 
   // Carves `arena` (at least RequiredBytes, 64-byte aligned). Resets any previous burst.
   Status Configure(const PipelineConfig& config, void* arena, size_t bytes);
+
+  // Where the stages run their tasks (borrowed; nullptr: on the caller), with at most
+  // config.workers workers. The output bits do not depend on it.
+  void SetRunner(TaskRunner* runner);
 
   // FrameSink: frames 0..frames-1 in any order, each exactly once, each covering every row.
   Status BeginFrame(const FrameInfo& info) override;

@@ -8,6 +8,7 @@
 #include "firmware/app/focus.h"
 #include "firmware/app/refocusable.h"
 #include "firmware/jpeg/jpeg_writer.h"
+#include "firmware/platform/worker_pool.h"
 #include "firmware/storage/atomic_file.h"
 #include "firmware/storage/output_target.h"
 
@@ -31,7 +32,7 @@ void FormatExifTime(char* out, size_t size) {
 
 void Job::FreeDeleter::operator()(void* p) const { free(p); }
 
-Job::Job() : pipeline_(std::make_unique<Pipeline>()) {}
+Job::Job() : pipeline_(std::make_unique<Pipeline>()), pool_(std::make_unique<WorkerPool>()) {}
 Job::~Job() = default;
 
 Status Job::Configure(Sensor* sensor, const JobOptions& options) {
@@ -53,6 +54,8 @@ Status Job::Configure(Sensor* sensor, const JobOptions& options) {
   }
   if (pc.reference < 0) pc.reference = pc.frames / 2;
   LB_RETURN_IF_ERROR(CheckFocusRegion(options_.render.focus, mode_.width, mode_.height));
+  const int32_t cores = WorkerPool::AvailableCores();
+  pc.workers = options.threads > 0 ? options.threads : (cores < kMaxWorkers ? cores : kMaxWorkers);
   size_t bytes = 0;
   LB_RETURN_IF_ERROR(Pipeline::RequiredBytes(pc, &bytes));
   if (bytes != arena_bytes_) {
@@ -60,7 +63,10 @@ Status Job::Configure(Sensor* sensor, const JobOptions& options) {
     if (!arena_) return Status(Code::kOutOfMemory, "cannot allocate the %zu-byte arena", bytes);
     arena_bytes_ = bytes;
   }
-  return pipeline_->Configure(pc, arena_.get(), arena_bytes_);
+  LB_RETURN_IF_ERROR(pipeline_->Configure(pc, arena_.get(), arena_bytes_));
+  if (pool_->workers() != pc.workers) LB_RETURN_IF_ERROR(pool_->Start(pc.workers));
+  pipeline_->SetRunner(pool_.get());
+  return Status::Ok();
 }
 
 Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer) {

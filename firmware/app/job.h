@@ -13,11 +13,15 @@
 
 namespace lb {
 
+class WorkerPool;
+
 struct JobOptions {
   SensorConfig sensor;      // requested size and burst length
   PipelineConfig pipeline;  // width/height/frames are taken from the sensor's mode
   RenderParams render;
   int quality = 92;
+  // Worker threads for the pipeline, 1..kMaxWorkers; 0: one per core this process may use.
+  int32_t threads = 0;
   // The lens as a 35 mm equivalent focal length, mm, when the sensor does not report one
   // (0 = unknown: the pipeline assumes a typical field of view).
   int32_t focal_35mm = 0;
@@ -69,6 +73,7 @@ class Job {
   JobOptions options_;
   SensorMode mode_;
   std::unique_ptr<Pipeline> pipeline_;
+  std::unique_ptr<WorkerPool> pool_;
   std::unique_ptr<uint8_t, FreeDeleter> arena_;
   size_t arena_bytes_ = 0;
 };

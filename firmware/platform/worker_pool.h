@@ -18,8 +18,6 @@ namespace lb {
 
 class WorkerPool final : public TaskRunner {
  public:
-  static constexpr int32_t kMaxWorkers = 16;
-
   WorkerPool() = default;
   WorkerPool(const WorkerPool&) = delete;
   WorkerPool& operator=(const WorkerPool&) = delete;

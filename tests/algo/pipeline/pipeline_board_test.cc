@@ -20,5 +20,9 @@ TEST(Pipeline, TheBoardsDefaultPathAt12MegapixelsAllocatesNothingAfterConfigure)
   ExpectBoardPathAllocatesNothing(4056, 3040);
 }
 
+TEST(Pipeline, TheBoardsDefaultPathAt12MegapixelsAllocatesNothingWithFourThreads) {
+  ExpectBoardPathAllocatesNothing(4056, 3040, 640, 480, 0.01, 4);
+}
+
 }  // namespace
 }  // namespace lb

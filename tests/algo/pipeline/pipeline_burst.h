@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "algo/pipeline/pipeline.h"
+#include "firmware/platform/worker_pool.h"
 #include "sim/synthetic/synthetic_sensor.h"
 #include "tests/support/alloc_counter.h"
 
@@ -21,6 +22,7 @@ struct Burst {
   PipelineConfig config;
   void* arena = nullptr;
   Pipeline pipeline;
+  WorkerPool pool;  // started by ConfigurePipeline when config.workers > 1
 
   ~Burst() { free(arena); }
 
@@ -71,6 +73,8 @@ struct Burst {
     arena = aligned_alloc(Arena::kAlign, Arena::RoundUp(bytes));
     Status s = pipeline.Configure(config, arena, bytes);
     ASSERT_TRUE(s.ok()) << s.message();
+    ASSERT_TRUE(pool.Start(config.workers).ok());
+    pipeline.SetRunner(&pool);
   }
 };
 
@@ -115,12 +119,13 @@ inline uint64_t RenderChecksum(Pipeline& p, const RenderParams& params, int32_t*
 }
 
 // Capture, depth (the motion stage included) and every rendered strip of the board's default
-// path allocate nothing once the pipeline is configured.
+// path allocate nothing once the pipeline is configured, with `threads` workers running.
 inline void ExpectBoardPathAllocatesNothing(int32_t width, int32_t height,
                                             int32_t max_working_width = 640,
                                             int32_t max_working_height = 480,
-                                            double max_translation = 0.01) {
+                                            double max_translation = 0.01, int32_t threads = 1) {
   Burst b;
+  b.config.workers = threads;
   b.config.max_working_width = max_working_width;
   b.config.max_working_height = max_working_height;
   b.SetupBoard(width, height, 5, max_translation);

@@ -120,7 +120,7 @@ TEST(WorkerPool, StartsTheThreadsItIsAskedForAndStopsThem) {
 
 TEST(WorkerPool, ACountOutsideTheRangeIsRefused) {
   WorkerPool pool;
-  for (int32_t bad : {0, -1, WorkerPool::kMaxWorkers + 1}) {
+  for (int32_t bad : {0, -1, kMaxWorkers + 1}) {
     const Status s = pool.Start(bad);
     EXPECT_EQ(s.code(), Code::kInvalidArgument) << bad;
     EXPECT_NE(strstr(s.message(), "threads"), nullptr) << s.message();
