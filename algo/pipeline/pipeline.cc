@@ -72,6 +72,7 @@ static RenderConfig MakeRenderConfig(const PipelineConfig& c, int32_t s, int32_t
   r.working_width = w;
   r.working_height = h;
   r.max_radius = c.max_blur_radius;
+  r.workers = c.workers;
   return r;
 }
 
@@ -160,7 +161,10 @@ Status Pipeline::Carve(Arena& arena) {
   return Status::Ok();
 }
 
-void Pipeline::SetRunner(TaskRunner* runner) { depth_.SetRunner(runner); }
+void Pipeline::SetRunner(TaskRunner* runner) {
+  depth_.SetRunner(runner);
+  render_.SetRunner(runner);
+}
 
 Status Pipeline::Configure(const PipelineConfig& config, void* arena, size_t bytes) {
   size_t needed = 0;

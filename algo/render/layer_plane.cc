@@ -37,7 +37,7 @@ int32_t LayerPlane::Reach(int32_t sub, const int32_t* radii_q4, int32_t radii) {
 
 Status LayerPlane::Carve(Arena& arena, int32_t width, int32_t height, int32_t channels,
                          int32_t strip_rows, int32_t sub, const int32_t* radii_q4, int32_t radii,
-                         int32_t layers, int32_t extra_rows) {
+                         int32_t layers, int32_t extra_rows, int32_t workers) {
   // radius_, level_, half_ and reciprocal_ hold kMaxKernels entries.
   if (radii < 1 || radii > kMaxKernels) {
     return Status(Code::kInvalidArgument, "layer plane: %d blur radii outside 1..%d", radii,
@@ -47,11 +47,15 @@ Status LayerPlane::Carve(Arena& arena, int32_t width, int32_t height, int32_t ch
     return Status(Code::kInvalidArgument, "layer plane: %d depth layers outside 1..%d", layers,
                   2 * kMaxKernels - 1);
   }
+  if (workers < 1 || workers > kMaxWorkers) {
+    return Status(Code::kInvalidArgument, "layer plane: %d workers outside 1..%d", workers,
+                  kMaxWorkers);
+  }
   if (channels < 1 || channels > 2) {
     return Status(Code::kInvalidArgument, "layer plane: %d channels (1 or 2)", channels);
   }
   rows_ = &layer_rows::BestKernels();
-  width_ = width, height_ = height, channels_ = channels;
+  width_ = width, height_ = height, channels_ = channels, workers_ = workers;
   layers_ = layers, radii_ = radii;
   int32_t max_half = 0;
   window_rows_ = 1, low_rows_ = 1, reach_ = 0;
@@ -65,8 +69,8 @@ Status LayerPlane::Carve(Arena& arena, int32_t width, int32_t height, int32_t ch
     if (k.level > 0) low_rows_ = Max(low_rows_, rows);
   }
   kernel_rows_ = 2 * max_half + 1;
-  // Rows [y0 - reach, y0 + strip + reach) plus the caller's look-ahead and slack.
-  ring_rows_ = strip_rows + 2 * reach_ + extra_rows + 4;
+  // Rows [y0 - reach, y0 + workers strips + reach) plus the caller's look-ahead and slack.
+  ring_rows_ = workers * strip_rows + 2 * reach_ + extra_rows + 4;
   pitch_ = static_cast<int32_t>(Arena::RoundUp((width + 2 * max_half + 8) * sizeof(uint32_t)) /
                                 sizeof(uint32_t));
   const size_t ring = static_cast<size_t>(ring_rows_) * width;
@@ -78,12 +82,15 @@ Status LayerPlane::Carve(Arena& arena, int32_t width, int32_t height, int32_t ch
   tiles_ = arena.Allocate<uint64_t>(static_cast<size_t>(ring_rows_) * layers);
   ring_tag_ = arena.Allocate<int32_t>(static_cast<size_t>(ring_rows_));
   pure_ = arena.Allocate<uint64_t>(static_cast<size_t>(ring_rows_) * layers);
-  prefix_ = arena.Allocate<uint32_t>(static_cast<size_t>(window_rows_) * planes * pitch_);
-  active_ = arena.Allocate<uint8_t>(static_cast<size_t>(window_rows_));
-  box_ = arena.Allocate<int32_t>(planes * pitch_);
-  acc_ = arena.Allocate<uint32_t>(planes * pitch_);
-  layer_ = arena.Allocate<int32_t>(static_cast<size_t>(low_rows_) * planes * pitch_);
-  out_ = arena.Allocate<int32_t>(static_cast<size_t>(strip_rows) * planes * width);
+  for (int32_t i = 0; i < workers; ++i) {
+    Scratch& s = scratch_[i];
+    s.prefix = arena.Allocate<uint32_t>(static_cast<size_t>(window_rows_) * planes * pitch_);
+    s.active = arena.Allocate<uint8_t>(static_cast<size_t>(window_rows_));
+    s.box = arena.Allocate<int32_t>(planes * pitch_);
+    s.acc = arena.Allocate<uint32_t>(planes * pitch_);
+    s.layer = arena.Allocate<int32_t>(static_cast<size_t>(low_rows_) * planes * pitch_);
+    s.out = arena.Allocate<int32_t>(static_cast<size_t>(strip_rows) * planes * width);
+  }
   kernels_ = arena.Allocate<KernelRow>(static_cast<size_t>(radii) * kernel_rows_);
   // Column l of a reduced level samples the low-res row at (2x + 1 - f) / 2f, Q8.
   int32_t max_level = 0;
@@ -107,11 +114,17 @@ void LayerPlane::Begin(const ApertureShape& shape, int32_t shift) {
   }
   shift_ = shift;
   next_row_ = 0;
-  stale_ = false;
+  for (int32_t i = 0; i < workers_; ++i) scratch_[i].stale = false;
   for (int32_t i = 0; i < ring_rows_; ++i) ring_tag_[i] = -1;
 }
 
 bool LayerPlane::Holds(int32_t y) const { return ring_tag_[Slot(y)] == y; }
+
+bool LayerPlane::stale() const {
+  bool any = false;
+  for (int32_t i = 0; i < workers_; ++i) any = any || scratch_[i].stale;
+  return any;
+}
 
 void LayerPlane::CommitRow(int32_t y, const uint16_t* layer_of, int32_t offset) {
   ring_tag_[Slot(y)] = y;
@@ -135,40 +148,40 @@ void LayerPlane::CommitRow(int32_t y, const uint16_t* layer_of, int32_t offset) 
   next_row_ = y + 1;
 }
 
-uint64_t LayerPlane::Tiles(int32_t k, int32_t y0, int32_t y1) {
+uint64_t LayerPlane::Tiles(Scratch& s, int32_t k, int32_t y0, int32_t y1) const {
   uint64_t t = 0;
   for (int32_t j = Max(0, y0); j < Min(height_, y1); ++j) {
     t |= tiles_[Slot(j) * layers_ + k];
-    stale_ = stale_ || ring_tag_[Slot(j)] != j;
+    s.stale = s.stale || ring_tag_[Slot(j)] != j;
   }
   return t;
 }
 
-void LayerPlane::BuildPrefix(int32_t k, int32_t level, int32_t h, int32_t jlo, int32_t jhi,
-                             int32_t x0, int32_t x1, uint64_t run, int32_t base,
-                             const uint16_t* layer_of, int32_t offset) {
+void LayerPlane::BuildPrefix(Scratch& s, int32_t k, int32_t level, int32_t h, int32_t jlo,
+                             int32_t jhi, int32_t x0, int32_t x1, uint64_t run, int32_t base,
+                             const uint16_t* layer_of, int32_t offset) const {
   if (channels_ == 1) {
-    BuildPrefixT<1>(k, level, h, jlo, jhi, x0, x1, run, base, layer_of, offset);
+    BuildPrefixT<1>(s, k, level, h, jlo, jhi, x0, x1, run, base, layer_of, offset);
   } else {
-    BuildPrefixT<2>(k, level, h, jlo, jhi, x0, x1, run, base, layer_of, offset);
+    BuildPrefixT<2>(s, k, level, h, jlo, jhi, x0, x1, run, base, layer_of, offset);
   }
 }
 
 template <int C>
-void LayerPlane::BuildPrefixT(int32_t k, int32_t level, int32_t h, int32_t jlo, int32_t jhi,
-                              int32_t x0, int32_t x1, uint64_t run, int32_t base,
-                              const uint16_t* layer_of, int32_t offset) {
+void LayerPlane::BuildPrefixT(Scratch& sc, int32_t k, int32_t level, int32_t h, int32_t jlo,
+                              int32_t jhi, int32_t x0, int32_t x1, uint64_t run, int32_t base,
+                              const uint16_t* layer_of, int32_t offset) const {
   const int32_t pad = pitch_ - width_ - (pitch_ - width_) / 2;  // room for indices below 0
   const int32_t q0 = x0 >> level, q1 = x1 >> level;             // the run's columns at this level
   const int32_t shift = shift_;
   const int32_t tile = 1 << tile_shift_;
   for (int32_t m = jlo; m < jhi; ++m) {
-    uint8_t& active = active_[m - base];
-    active = (Tiles(k, m << level, (m + 1) << level) & run) != 0;
+    uint8_t& active = sc.active[m - base];
+    active = (Tiles(sc, k, m << level, (m + 1) << level) & run) != 0;
     if (!active) continue;
     uint32_t* p[C + 1];
     for (int32_t c = 0; c <= C; ++c) {
-      p[c] = prefix_ + ((m - base) * (C + 1) + c) * static_cast<ptrdiff_t>(pitch_) + pad;
+      p[c] = sc.prefix + ((m - base) * (C + 1) + c) * static_cast<ptrdiff_t>(pitch_) + pad;
       for (int32_t x = q0 - h; x <= q0; ++x) p[c][x] = 0;
     }
     if (level == 0) {
@@ -192,7 +205,7 @@ void LayerPlane::BuildPrefixT(int32_t k, int32_t level, int32_t h, int32_t jlo, 
       // row is summed in registers and added once.
       int32_t* box[C + 1];
       for (int32_t c = 0; c <= C; ++c) {
-        box[c] = box_ + c * static_cast<ptrdiff_t>(pitch_);
+        box[c] = sc.box + c * static_cast<ptrdiff_t>(pitch_);
         for (int32_t i = q0; i <= q1; ++i) box[c][i] = 0;
       }
       const int32_t end = Min(height_, (m + 1) << level);
@@ -223,50 +236,51 @@ void LayerPlane::BuildPrefixT(int32_t k, int32_t level, int32_t h, int32_t jlo, 
   }
 }
 
-void LayerPlane::GatherNormalise(int32_t kernel, int32_t m, int32_t jlo, int32_t jhi, int32_t base,
-                                 int32_t x0, int32_t x1, int32_t* layer, ptrdiff_t stride) {
+void LayerPlane::GatherNormalise(Scratch& s, int32_t kernel, int32_t m, int32_t jlo, int32_t jhi,
+                                 int32_t base, int32_t x0, int32_t x1, int32_t* layer,
+                                 ptrdiff_t stride) const {
   const int32_t planes = channels_ + 1;
   const int32_t pad = pitch_ - width_ - (pitch_ - width_) / 2;
   const int32_t h = half_[kernel];
   const KernelRow* rows = kernels_ + kernel * kernel_rows_;
   for (int32_t c = 0; c < planes; ++c) {
-    uint32_t* acc = acc_ + c * static_cast<ptrdiff_t>(pitch_);
+    uint32_t* acc = s.acc + c * static_cast<ptrdiff_t>(pitch_);
     for (int32_t x = x0; x <= x1; ++x) acc[x] = 0;
   }
   for (int32_t dy = -h; dy <= h; ++dy) {
     const int32_t j = m + dy;
-    if (j < jlo || j >= jhi || !active_[j - base]) continue;
+    if (j < jlo || j >= jhi || !s.active[j - base]) continue;
     const KernelRow& kr = rows[dy + h];
     if (kr.w == 0 && kr.wl == 0 && kr.wr == 0) continue;
     for (int32_t c = 0; c < planes; ++c) {
       const uint32_t* p =
-          prefix_ + ((j - base) * planes + c) * static_cast<ptrdiff_t>(pitch_) + pad;
-      rows_->gather(p, kr, acc_ + c * static_cast<ptrdiff_t>(pitch_), x0, x1);
+          s.prefix + ((j - base) * planes + c) * static_cast<ptrdiff_t>(pitch_) + pad;
+      rows_->gather(p, kr, s.acc + c * static_cast<ptrdiff_t>(pitch_), x0, x1);
     }
   }
   // alpha = acc / (total * 256) in Q16 (rec = 2^40 / total); colour likewise, undoing the shift.
   const uint64_t rec = reciprocal_[kernel];
-  layer_rows::NormaliseAlphaRowC(acc_ + channels_ * static_cast<ptrdiff_t>(pitch_), rec, x0, x1,
+  layer_rows::NormaliseAlphaRowC(s.acc + channels_ * static_cast<ptrdiff_t>(pitch_), rec, x0, x1,
                                  layer + channels_ * stride);
   for (int32_t c = 0; c < channels_; ++c) {
-    layer_rows::NormaliseColourRowC(acc_ + c * static_cast<ptrdiff_t>(pitch_), rec, shift_, x0, x1,
+    layer_rows::NormaliseColourRowC(s.acc + c * static_cast<ptrdiff_t>(pitch_), rec, shift_, x0, x1,
                                     layer + c * stride);
   }
 }
 
 void LayerPlane::Composite(const int32_t* layer, ptrdiff_t stride, int32_t x0, int32_t x1,
-                           int32_t* out) {
+                           int32_t* out) const {
   const int32_t* alpha = layer + channels_ * stride;
   for (int32_t c = 0; c <= channels_; ++c) {
     rows_->composite(out + c * static_cast<ptrdiff_t>(width_), layer + c * stride, alpha, x0, x1);
   }
 }
 
-void LayerPlane::RenderLayer(int32_t k, int32_t y0, int32_t n, const uint16_t* layer_of,
-                             int32_t offset, int32_t i) {
+void LayerPlane::RenderLayer(Scratch& s, int32_t k, int32_t y0, int32_t n, const uint16_t* layer_of,
+                             int32_t offset, int32_t i) const {
   const int32_t level = level_[i];
   const int32_t reach = level == 0 ? half_[i] : (half_[i] + 2) << level;
-  uint64_t tiles = Tiles(k, y0 - reach, y0 + n + reach);
+  uint64_t tiles = Tiles(s, k, y0 - reach, y0 + n + reach);
   if (!tiles) return;  // no pixel of this layer reaches the strip
   // Grow by the reach: a run of grown tiles holds every source pixel its outputs depend on.
   const int32_t count = (width_ + (1 << tile_shift_) - 1) >> tile_shift_;
@@ -283,14 +297,14 @@ void LayerPlane::RenderLayer(int32_t k, int32_t y0, int32_t n, const uint16_t* l
     int32_t e = t;
     while (e + 1 < count && ((tiles >> (e + 1)) & 1)) ++e;
     const uint64_t run = (e - t + 1 == 64) ? ~uint64_t{0} : ((uint64_t{1} << (e - t + 1)) - 1) << t;
-    RenderRun(k, y0, n, layer_of, offset, i, t << tile_shift_,
+    RenderRun(s, k, y0, n, layer_of, offset, i, t << tile_shift_,
               Min(width_, (e + 1) << tile_shift_) - 1, run);
     t = e + 1;
   }
 }
 
-void LayerPlane::RenderRun(int32_t k, int32_t y0, int32_t n, const uint16_t* layer_of,
-                           int32_t offset, int32_t i, int32_t x0, int32_t x1, uint64_t run) {
+void LayerPlane::RenderRun(Scratch& sc, int32_t k, int32_t y0, int32_t n, const uint16_t* layer_of,
+                           int32_t offset, int32_t i, int32_t x0, int32_t x1, uint64_t run) const {
   const int32_t level = level_[i], h = half_[i];
   const int32_t planes = channels_ + 1;
   const ptrdiff_t row_stride = planes * static_cast<ptrdiff_t>(width_);
@@ -299,28 +313,28 @@ void LayerPlane::RenderRun(int32_t k, int32_t y0, int32_t n, const uint16_t* lay
     // the same numbers the general path gives for a kernel of one cell of weight 256.
     for (int32_t y = y0; y < y0 + n; ++y) {
       const int16_t* s = RadiusRow(y);
-      int32_t* alpha = layer_ + channels_ * static_cast<ptrdiff_t>(pitch_);
+      int32_t* alpha = sc.layer + channels_ * static_cast<ptrdiff_t>(pitch_);
       for (int32_t x = x0; x <= x1; ++x) {
         alpha[x] = layer_rows::LayerWeightQ8(layer_of[s[x] + offset], k) << 8;
       }
       for (int32_t c = 0; c < channels_; ++c) {
         const int16_t* v = ValueRow(y, c);
-        int32_t* colour = layer_ + c * static_cast<ptrdiff_t>(pitch_);
+        int32_t* colour = sc.layer + c * static_cast<ptrdiff_t>(pitch_);
         for (int32_t x = x0; x <= x1; ++x) {
           colour[x] = ((v[x] * (alpha[x] >> 8)) >> shift_) * (1 << (8 + shift_));
         }
       }
-      Composite(layer_, pitch_, x0, x1, out_ + (y - y0) * row_stride);
+      Composite(sc.layer, pitch_, x0, x1, sc.out + (y - y0) * row_stride);
     }
     return;
   }
   if (level == 0) {
     const int32_t jlo = Max(0, y0 - h), jhi = Min(height_, y0 + n + h);
     const int32_t base = y0 - h;
-    BuildPrefix(k, 0, h, jlo, jhi, x0, x1, run, base, layer_of, offset);
+    BuildPrefix(sc, k, 0, h, jlo, jhi, x0, x1, run, base, layer_of, offset);
     for (int32_t y = y0; y < y0 + n; ++y) {
-      GatherNormalise(i, y, jlo, jhi, base, x0, x1, layer_, pitch_);
-      Composite(layer_, pitch_, x0, x1, out_ + (y - y0) * row_stride);
+      GatherNormalise(sc, i, y, jlo, jhi, base, x0, x1, sc.layer, pitch_);
+      Composite(sc.layer, pitch_, x0, x1, sc.out + (y - y0) * row_stride);
     }
     return;
   }
@@ -334,42 +348,45 @@ void LayerPlane::RenderRun(int32_t k, int32_t y0, int32_t n, const uint16_t* lay
   const int32_t jlo = Max(0, m_first - h), jhi = Min(low_h, m_last + 1 + h);
   const int32_t base = m_first - h;
   const int32_t q_lo = x0 >> level, q_hi = x1 >> level;
-  BuildPrefix(k, level, h, jlo, jhi, x0, x1, run, base, layer_of, offset);
+  BuildPrefix(sc, k, level, h, jlo, jhi, x0, x1, run, base, layer_of, offset);
   const ptrdiff_t low_stride = planes * static_cast<ptrdiff_t>(pitch_);
   for (int32_t m = m_first; m <= m_last; ++m) {
-    GatherNormalise(i, m, jlo, jhi, base, q_lo, q_hi, layer_ + (m - m_first) * low_stride, pitch_);
+    GatherNormalise(sc, i, m, jlo, jhi, base, q_lo, q_hi, sc.layer + (m - m_first) * low_stride,
+                    pitch_);
   }
   for (int32_t y = y0; y < y0 + n; ++y) {
     const int32_t uy = coord_q8(y);
     const int32_t ma = Clamp(uy >> 8, m_first, m_last), mb = Clamp((uy >> 8) + 1, m_first, m_last);
     const int64_t fy = uy & 255;
-    const int32_t* ra = layer_ + (ma - m_first) * low_stride;
-    const int32_t* rb = layer_ + (mb - m_first) * low_stride;
-    // Separable: blend the two low-res rows (into box_, edges replicated), then interpolate
+    const int32_t* ra = sc.layer + (ma - m_first) * low_stride;
+    const int32_t* rb = sc.layer + (mb - m_first) * low_stride;
+    // Separable: blend the two low-res rows (into the box row, edges replicated), then interpolate
     // each output column between its two taps.
     for (int32_t c = 0; c < planes; ++c) {
       const int32_t* a = ra + c * static_cast<ptrdiff_t>(pitch_);
       const int32_t* b = rb + c * static_cast<ptrdiff_t>(pitch_);
-      layer_rows::BlendRowsC(a, b, fy, q_lo, q_hi, box_ + c * static_cast<ptrdiff_t>(pitch_) + 1);
+      layer_rows::BlendRowsC(a, b, fy, q_lo, q_hi, sc.box + c * static_cast<ptrdiff_t>(pitch_) + 1);
     }
-    int32_t* out = out_ + (y - y0) * row_stride;
+    int32_t* out = sc.out + (y - y0) * row_stride;
     if (channels_ == 1) {
-      layer_rows::LerpCompositeC<1>(box_ + 1, pitch_, frac_[level], level, x0, x1, out, width_);
+      layer_rows::LerpCompositeC<1>(sc.box + 1, pitch_, frac_[level], level, x0, x1, out, width_);
     } else {
-      layer_rows::LerpCompositeC<2>(box_ + 1, pitch_, frac_[level], level, x0, x1, out, width_);
+      layer_rows::LerpCompositeC<2>(sc.box + 1, pitch_, frac_[level], level, x0, x1, out, width_);
     }
   }
 }
 
-void LayerPlane::RenderStrip(int32_t y0, int32_t n, const uint16_t* layer_of, int32_t offset,
-                             const int32_t* radius_of_layer, int32_t bias, ImageU8* dst) {
+void LayerPlane::RenderStrip(int32_t worker, int32_t y0, int32_t n, const uint16_t* layer_of,
+                             int32_t offset, const int32_t* radius_of_layer, int32_t bias,
+                             ImageU8* dst) {
+  Scratch& s = scratch_[worker];
   const int32_t planes = channels_ + 1;
-  for (size_t i = 0; i < static_cast<size_t>(n) * planes * width_; ++i) out_[i] = 0;
+  for (size_t i = 0; i < static_cast<size_t>(n) * planes * width_; ++i) s.out[i] = 0;
   for (int32_t k = 0; k < layers_; ++k) {
-    RenderLayer(k, y0, n, layer_of, offset, radius_of_layer[k]);
+    RenderLayer(s, k, y0, n, layer_of, offset, radius_of_layer[k]);
   }
   for (int32_t y = y0; y < y0 + n; ++y) {
-    const int32_t* out = out_ + (y - y0) * planes * static_cast<ptrdiff_t>(width_);
+    const int32_t* out = s.out + (y - y0) * planes * static_cast<ptrdiff_t>(width_);
     const int32_t* out_a = out + channels_ * static_cast<ptrdiff_t>(width_);
     for (int32_t c = 0; c < channels_; ++c) {
       // A pixel always covers itself, so alpha is positive (ResolveRowC keeps a fallback).

@@ -47,6 +47,10 @@ Status RenderStage::Validate(const RenderConfig& c) {
     return Status(Code::kInvalidArgument, "render: working size %dx%d x%d does not fit %dx%d",
                   c.working_width, c.working_height, c.working_scale, c.width, c.height);
   }
+  if (c.workers < 1 || c.workers > kMaxWorkers) {
+    return Status(Code::kInvalidArgument, "render: %d workers outside 1..%d", c.workers,
+                  kMaxWorkers);
+  }
   if (c.max_radius < 0 || c.max_radius > 128) {
     return Status(Code::kInvalidArgument, "render: largest blur radius %d outside 0..128",
                   c.max_radius);
@@ -90,10 +94,13 @@ size_t RenderStage::RequiredBytes(const RenderConfig& config) {
 Status RenderStage::Carve(Arena& arena) {
   const RenderConfig& c = config_;
   const int32_t cw = (c.width + 1) / 2, ch = (c.height + 1) / 2;
-  strip_.count = 3;
-  strip_.planes[0] = arena.AllocateImage<uint8_t>(c.width, RenderConfig::kStripRows);
-  strip_.planes[1] = arena.AllocateImage<uint8_t>(cw, RenderConfig::kStripRows / 2);
-  strip_.planes[2] = arena.AllocateImage<uint8_t>(cw, RenderConfig::kStripRows / 2);
+  for (int32_t i = 0; i < c.workers; ++i) {
+    PlanarU8& strip = strips_[i];
+    strip.count = 3;
+    strip.planes[0] = arena.AllocateImage<uint8_t>(c.width, RenderConfig::kStripRows);
+    strip.planes[1] = arena.AllocateImage<uint8_t>(cw, RenderConfig::kStripRows / 2);
+    strip.planes[2] = arena.AllocateImage<uint8_t>(cw, RenderConfig::kStripRows / 2);
+  }
   int32_t radii_q4[kMaxRadii];
   radii_ = LayerRadiiQ4(c.max_radius, radii_q4);
   layers_ = 2 * radii_ - 1;
@@ -109,9 +116,9 @@ Status RenderStage::Carve(Arena& arena) {
   // The luma ring also serves the chroma rows that the next chroma strip reads ahead.
   const int32_t look_ahead = Max(0, 2 * chroma_reach_ - luma_reach_) + 2;
   LB_RETURN_IF_ERROR(luma_.Carve(arena, c.width, c.height, 1, RenderConfig::kStripRows, 1, radii_q4,
-                                 radii_, layers_, look_ahead));
+                                 radii_, layers_, look_ahead, c.workers));
   LB_RETURN_IF_ERROR(chroma_.Carve(arena, cw, ch, 2, RenderConfig::kStripRows / 2, 2, radii_q4,
-                                   radii_, layers_, 0));
+                                   radii_, layers_, 0, c.workers));
   if (arena.overflowed()) {
     return Status(Code::kOutOfMemory, "render: arena of %zu bytes is too small (%zu needed)",
                   arena.size(), arena.used());
@@ -145,7 +152,12 @@ Status RenderStage::Configure(const RenderConfig& config, Arena& arena) {
   LB_RETURN_IF_ERROR(Validate(config));
   config_ = config;
   begun_ = false;
+  runner_ = &inline_;
   return Carve(arena);
+}
+
+void RenderStage::SetRunner(TaskRunner* runner) {
+  runner_ = runner != nullptr && runner->workers() <= config_.workers ? runner : &inline_;
 }
 
 Status RenderStage::Begin(const ConstPlanarU8& ref, ConstImageU16 disp_q8,
@@ -169,6 +181,7 @@ Status RenderStage::Begin(const ConstPlanarU8& ref, ConstImageU16 disp_q8,
   disp_ = disp_q8;
   params_ = params;
   next_row_ = 0;
+  batch_y0_ = batch_count_ = batch_next_ = 0;
 
   const FocusRegion& r = params.focus;
   const int32_t focus =
@@ -237,26 +250,50 @@ void RenderStage::FillChromaRow(int32_t cy) {
 
 Status RenderStage::NextStrip(ConstPlanarU8* strip, int32_t* y0, int32_t* rows) {
   if (!begun_) return Status(Code::kInvalidArgument, "render: NextStrip before Begin");
-  const int32_t h = config_.height, ch = (h + 1) / 2;
-  *y0 = next_row_;
-  *rows = Min(RenderConfig::kStripRows, h - next_row_);
-  if (*rows <= 0) {
+  if (batch_next_ == batch_count_) LB_RETURN_IF_ERROR(RenderBatch());
+  if (batch_count_ == 0) {
+    *y0 = next_row_;
     *rows = 0;
     return Status::Ok();
   }
-  const int32_t cy0 = *y0 / 2, cn = (*rows + 1) / 2;
-  const int32_t chroma_end = Min(ch, cy0 + cn + chroma_reach_);
-  const int32_t luma_end = Min(h, Max(*y0 + *rows + luma_reach_, 2 * chroma_end));
+  const int32_t i = batch_next_++;
+  *y0 = batch_y0_ + i * RenderConfig::kStripRows;
+  *rows = Min(RenderConfig::kStripRows, config_.height - *y0);
+  next_row_ = *y0 + *rows;
+  *strip = strips_[i].AsConst();
+  return Status::Ok();
+}
+
+// The next config.workers strips (fewer at the bottom): the ring rows they read are filled in
+// order, then each strip renders from them on a worker of its own.
+Status RenderStage::RenderBatch() {
+  constexpr int32_t kStrip = RenderConfig::kStripRows;
+  const int32_t h = config_.height, ch = (h + 1) / 2;
+  batch_y0_ = next_row_;
+  batch_count_ = Min(config_.workers, (h - next_row_ + kStrip - 1) / kStrip);
+  batch_next_ = 0;
+  if (batch_count_ <= 0) {
+    batch_count_ = 0;
+    return Status::Ok();
+  }
+  const int32_t last_y0 = batch_y0_ + (batch_count_ - 1) * kStrip;
+  const int32_t last_rows = Min(kStrip, h - last_y0);
+  const int32_t chroma_end = Min(ch, last_y0 / 2 + (last_rows + 1) / 2 + chroma_reach_);
+  const int32_t luma_end = Min(h, Max(last_y0 + last_rows + luma_reach_, 2 * chroma_end));
   while (luma_.next_row() < luma_end) FillLumaRow(luma_.next_row());
   while (chroma_.next_row() < chroma_end) FillChromaRow(chroma_.next_row());
   const int32_t offset = config_.max_radius * 16;
-  luma_.RenderStrip(*y0, *rows, layer_of_, offset, radius_of_layer_, 0, &strip_.planes[0]);
-  chroma_.RenderStrip(cy0, cn, layer_of_, offset, radius_of_layer_, 128, &strip_.planes[1]);
+  ParallelFor(*runner_, batch_count_, [&](int32_t i, int32_t worker) {
+    const int32_t y0 = batch_y0_ + i * kStrip, rows = Min(kStrip, h - y0);
+    luma_.RenderStrip(worker, y0, rows, layer_of_, offset, radius_of_layer_, 0,
+                      &strips_[i].planes[0]);
+    chroma_.RenderStrip(worker, y0 / 2, (rows + 1) / 2, layer_of_, offset, radius_of_layer_, 128,
+                        &strips_[i].planes[1]);
+  });
   if (luma_stale_ || luma_.stale() || chroma_.stale()) {
-    return Status(Code::kInternal, "render: strip at row %d read a recycled ring row", *y0);
+    return Status(Code::kInternal, "render: a strip at rows %d..%d read a recycled ring row",
+                  batch_y0_, last_y0 + last_rows - 1);
   }
-  next_row_ += *rows;
-  *strip = strip_.AsConst();
   return Status::Ok();
 }
 

@@ -22,6 +22,7 @@
 #include "algo/core/arena.h"
 #include "algo/core/image.h"
 #include "algo/core/status.h"
+#include "algo/core/task_runner.h"
 #include "algo/render/depth_upsample.h"
 #include "algo/render/layer_plane.h"
 #include "algo/render/lens_model.h"
@@ -60,6 +61,9 @@ struct RenderConfig {
   int32_t working_width = 0;
   int32_t working_height = 0;
   int32_t max_radius = 32;  // largest blur radius in full-resolution pixels
+  // Strips rendered at once, one per worker (task_runner.h), 1..kMaxWorkers: each worker's
+  // accumulators and output strip, and ring rows for that many strips, come from the arena.
+  int32_t workers = 1;
 };
 
 class RenderStage {
@@ -67,6 +71,9 @@ class RenderStage {
   static Status Validate(const RenderConfig& config);
   static size_t RequiredBytes(const RenderConfig& config);
   Status Configure(const RenderConfig& config, Arena& arena);
+  // Where the strips of a batch render (borrowed; nullptr: on the caller), with at most
+  // config.workers workers. The output does not depend on it.
+  void SetRunner(TaskRunner* runner);
 
   // Starts a render. `ref` is Y, Cb, Cr (chroma at half size); `disp_q8` the working-resolution
   // disparity (see depth_stage.h). Both must stay valid until the last strip.
@@ -74,7 +81,8 @@ class RenderStage {
 
   // Renders the next strip into an arena buffer and points `strip` at it: strip->planes[0] has
   // `*rows` luma rows starting at `*y0`, planes 1 and 2 the matching (rows+1)/2 chroma rows.
-  // `*rows` is 0 once the image is complete.
+  // `*rows` is 0 once the image is complete. The strips come in batches of config.workers,
+  // rendered at once; a strip stays valid until the call after the batch's last.
   Status NextStrip(ConstPlanarU8* strip, int32_t* y0, int32_t* rows);
 
   // What the lens model computed in Begin (for GFocus metadata and re-rendering):
@@ -98,6 +106,7 @@ class RenderStage {
 
  private:
   Status Carve(Arena& arena);
+  Status RenderBatch();
   void FillLumaRow(int32_t y);
   void FillChromaRow(int32_t y);
 
@@ -105,7 +114,10 @@ class RenderStage {
   ConstPlanarU8 ref_;
   ConstImageU16 disp_;
   RenderParams params_;
-  PlanarU8 strip_;
+  PlanarU8 strips_[kMaxWorkers];
+  int32_t batch_y0_ = 0, batch_count_ = 0, batch_next_ = 0;  // the batch being handed out
+  InlineRunner inline_;
+  TaskRunner* runner_ = &inline_;
   int32_t next_row_ = 0;
   bool begun_ = false;
   bool luma_stale_ = false;  // a chroma row was made from a recycled luma row (a bug)
