@@ -64,10 +64,7 @@ enum Opt {
   kDisparity
 };
 
-int Usage(const char* problem) {
-  fprintf(stderr, "refocus depth: %s ('refocus depth --help' lists the options)\n", problem);
-  return 2;
-}
+int Usage(const std::string& problem) { return UsageError("depth", problem); }
 
 int Help() {
   const DepthConfig defaults;
@@ -170,7 +167,7 @@ int DepthCommand(int argc, char** argv) {
     if (o != kPositional) in_views = o == kViews;
     switch (o) {
       case 0:
-        return Usage(options.error().c_str());
+        return Usage(options.error());
       case kPositional:
         ok = view(arg);
         break;
@@ -200,11 +197,11 @@ int DepthCommand(int argc, char** argv) {
         range_given = ok;
         break;
     }
-    if (!ok) return Usage(error.c_str());
+    if (!ok) return Usage(error);
   }
   // After "--" every argument is a file, even one that starts with a dash.
   for (int i = options.rest(); i < argc; ++i) {
-    if (!view(argv[i])) return Usage(error.c_str());
+    if (!view(argv[i])) return Usage(error);
   }
   const Geometry geometry = settings.pipeline.geometry;
   const int32_t focal_35mm = settings.focal_35mm;

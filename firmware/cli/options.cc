@@ -100,4 +100,10 @@ int Fail(const char* message) {
   return 1;
 }
 
+int UsageError(const char* command, const std::string& problem) {
+  fprintf(stderr, "refocus %s: %s ('refocus %s --help' lists the options)\n", command,
+          problem.c_str(), command);
+  return 2;
+}
+
 }  // namespace lb::cli

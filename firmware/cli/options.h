@@ -68,5 +68,8 @@ class OptionReader {
 
 // Prints "refocus: <message>" on stderr and returns exit code 1.
 int Fail(const char* message);
+// Prints "refocus COMMAND: <problem> ('refocus COMMAND --help' lists the options)" on stderr
+// and returns exit code 2.
+int UsageError(const char* command, const std::string& problem);
 
 }  // namespace lb::cli

@@ -21,11 +21,7 @@ const char kUsage[] =
 
 enum Opt { kOut = 256, kHelp };
 
-int Usage(const std::string& error) {
-  fprintf(stderr, "refocus rerender: %s ('refocus rerender --help' lists the options)\n",
-          error.c_str());
-  return 2;
-}
+int Usage(const std::string& problem) { return UsageError("rerender", problem); }
 
 }  // namespace
 

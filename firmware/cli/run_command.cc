@@ -46,10 +46,7 @@ int Help() {
   return 0;
 }
 
-int Usage(const std::string& error) {
-  fprintf(stderr, "refocus run: %s ('refocus run --help' lists the options)\n", error.c_str());
-  return 2;
-}
+int Usage(const std::string& problem) { return UsageError("run", problem); }
 
 }  // namespace
 
