@@ -46,7 +46,8 @@ class OptionReader {
   // unknown or a setting's value wrong.
   int Next(JobOptions* job);
   const char* arg() const { return arg_; }
-  // The option as the user spelled it, without the dashes ("size", not "resolution").
+  // The option's long name as the user chose it, without the dashes: an alias stays an alias
+  // ("size", not "resolution").
   const char* name() const { return name_; }
   const std::string& error() const { return error_; }
   int rest() const { return optind; }
