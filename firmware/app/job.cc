@@ -30,6 +30,18 @@ void FormatExifTime(char* out, size_t size) {
 
 }  // namespace
 
+Status WriteStrips(RenderStage* render, StripObserver* observer, JpegWriter* writer) {
+  for (;;) {
+    ConstPlanarU8 strip;
+    int32_t y0 = 0, rows = 0;
+    LB_RETURN_IF_ERROR(render->NextStrip(&strip, &y0, &rows));
+    if (rows == 0) break;
+    if (observer) observer->OnStrip(strip, y0, rows);
+    LB_RETURN_IF_ERROR(writer->WriteStrip(strip, rows));
+  }
+  return writer->Finish();
+}
+
 void Job::FreeDeleter::operator()(void* p) const { free(p); }
 
 Job::Job() : pipeline_(std::make_unique<Pipeline>()), pool_(std::make_unique<WorkerPool>()) {}
@@ -121,15 +133,7 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
   LB_RETURN_IF_ERROR(file.Open(out_path));
   JpegWriter writer;
   LB_RETURN_IF_ERROR(writer.Begin(&file, mode_.width, mode_.height, options_.quality, meta));
-  for (;;) {
-    ConstPlanarU8 strip;
-    int32_t y0 = 0, rows = 0;
-    LB_RETURN_IF_ERROR(p.NextStrip(&strip, &y0, &rows));
-    if (rows == 0) break;
-    if (observer) observer->OnStrip(strip, y0, rows);
-    LB_RETURN_IF_ERROR(writer.WriteStrip(strip, rows));
-  }
-  LB_RETURN_IF_ERROR(writer.Finish());
+  LB_RETURN_IF_ERROR(WriteStrips(&p.render(), observer, &writer));
   LB_RETURN_IF_ERROR(file.Commit());
   r.render_s = Now() - t2;
   if (report) *report = r;

@@ -50,6 +50,12 @@ class StripObserver {
   virtual void OnStrip(const ConstPlanarU8& strip, int32_t y0, int32_t rows) = 0;
 };
 
+class JpegWriter;
+
+// Encodes every strip `render` gives, showing each to `observer` (may be nullptr) first, then
+// finishes the image: a burst's photo and a re-render are written the same way.
+Status WriteStrips(RenderStage* render, StripObserver* observer, JpegWriter* writer);
+
 class Job {
  public:
   Job();

@@ -117,15 +117,7 @@ Status Rerenderer::Render(const RerenderOptions& options, const char* out_path,
                                               width_, &meta.extra_segments));
   JpegWriter writer;
   LB_RETURN_IF_ERROR(writer.Begin(&file, width_, height_, options.quality, meta));
-  for (;;) {
-    ConstPlanarU8 strip;
-    int32_t y0 = 0, rows = 0;
-    LB_RETURN_IF_ERROR(render.NextStrip(&strip, &y0, &rows));
-    if (rows == 0) break;
-    if (observer) observer->OnStrip(strip, y0, rows);
-    LB_RETURN_IF_ERROR(writer.WriteStrip(strip, rows));
-  }
-  LB_RETURN_IF_ERROR(writer.Finish());
+  LB_RETURN_IF_ERROR(WriteStrips(&render, observer, &writer));
   return file.Commit();
 }
 

@@ -10,9 +10,7 @@
 #include "firmware/app/focus.h"
 
 namespace lb {
-namespace {
 
-bool Why(std::string* why, const char* format, ...) __attribute__((format(printf, 2, 3)));
 bool Why(std::string* why, const char* format, ...) {
   char text[256];
   va_list args;
@@ -22,6 +20,8 @@ bool Why(std::string* why, const char* format, ...) {
   *why = text;
   return false;
 }
+
+namespace {
 
 // One run of 1-9 decimal digits (no sign, no spaces) within [lo, hi]; `text` moves past it.
 bool Digits(const char** text, int32_t lo, int32_t hi, int32_t* out) {

@@ -37,6 +37,10 @@ const Setting* FindSetting(const char* name);
 // "--f-number N  aperture as on a lens ..." lines for the settings of `group`.
 std::string SettingsHelp(SettingGroup group);
 
+// Sets `why` to the printf-style message (at most 255 characters) and returns false: how every
+// value parser, the table's and refocusd.conf's own keys', says what is wrong.
+bool Why(std::string* why, const char* format, ...) __attribute__((format(printf, 2, 3)));
+
 // The value parsers the table uses, for options of one command only.
 bool ParseWholeNumber(const char* text, int32_t lo, int32_t hi, int32_t* out, std::string* why);
 bool ParseRealNumber(const char* text, float lo, float hi, float* out, std::string* why);

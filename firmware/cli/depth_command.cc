@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "algo/core/color.h"
@@ -51,10 +52,19 @@ const char kUsage[] =
 // burst of them within 0.5 GB.
 constexpr int64_t kMaxDepthPixels = int64_t{2} << 20;
 
-int Usage(const char* problem) {
-  fprintf(stderr, "refocus depth: %s ('refocus depth --help' lists the options)\n", problem);
-  return 2;
-}
+enum Opt {
+  kViews = 256,
+  kSubpixel,
+  kHelp,
+  kDisparityOut,
+  kPreview,
+  kRef,
+  kSmoothness,
+  kCycles,
+  kDisparity
+};
+
+int Usage(const std::string& problem) { return UsageError("depth", problem); }
 
 int Help() {
   const DepthConfig defaults;
@@ -127,42 +137,71 @@ int DepthCommand(int argc, char** argv) {
   JobOptions settings;  // --geometry, --focal-35mm and --labels, as run takes them
   settings.pipeline.geometry = Geometry::kAuto;
   std::string error;
-  for (int i = 1; i < argc; ++i) {  // argv[0] is the subcommand's name
-    const char* a = argv[i];
-    const char* value = i + 1 < argc ? argv[i + 1] : nullptr;
-    auto need = [&]() {
-      if (!value) error = std::string(a) + " needs a value";
-      return value != nullptr;
-    };
-    bool ok = true;
-    if (!strcmp(a, "--views")) {
-      while (i + 1 < argc && strncmp(argv[i + 1], "--", 2) != 0) files.push_back(argv[++i]);
-      continue;
-    } else if (!strcmp(a, "--subpixel")) {
-      c.subpixel = true;
-      continue;
-    } else if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-      return Help();
-    } else if (!strcmp(a, "--disparity-out")) {
-      ok = need() && (pfm = argv[++i]);
-    } else if (!strcmp(a, "--preview")) {
-      ok = need() && (preview = argv[++i]);
-    } else if (!strcmp(a, "--geometry") || !strcmp(a, "--focal-35mm") || !strcmp(a, "--labels")) {
-      ok = need() && ParseSettingNamed(a + 2, argv[++i], &settings, &error);
-    } else if (!strcmp(a, "--ref")) {
-      ok = need() && ParseWholeNumber(argv[++i], 0, DepthConfig::kMaxViews - 1, &ref, &error);
-    } else if (!strcmp(a, "--smoothness")) {
-      ok = need() && ParseWholeNumber(argv[++i], 0, 4096, &c.smooth_weight, &error);
-    } else if (!strcmp(a, "--cycles")) {
-      ok = need() && ParseWholeNumber(argv[++i], 0, 32, &c.max_cycles, &error);
-    } else if (!strcmp(a, "--disparity")) {
-      ok = need() && ParseDisparityRange(argv[++i], &c.disp_min_q8, &c.disp_max_q8, &error);
-      range_given = ok;
+  std::vector<option> table = WithSettings(
+      {
+          {"views", no_argument, nullptr, kViews},
+          {"subpixel", no_argument, nullptr, kSubpixel},
+          {"help", no_argument, nullptr, kHelp},
+          {"disparity-out", required_argument, nullptr, kDisparityOut},
+          {"preview", required_argument, nullptr, kPreview},
+          {"ref", required_argument, nullptr, kRef},
+          {"smoothness", required_argument, nullptr, kSmoothness},
+          {"cycles", required_argument, nullptr, kCycles},
+          {"disparity", required_argument, nullptr, kDisparity},
+      },
+      {"geometry", "focal-35mm", "labels"});
+  // "-": the arguments that are no option come back in place, to be taken as views.
+  OptionReader options(argc, argv, std::move(table), "-:h");
+  bool in_views = false;  // from --views up to the next option
+  auto view = [&](const char* file) {
+    if (in_views) {
+      files.push_back(file);
     } else {
-      error = std::string("unknown option \"") + a + "\"";
-      ok = false;
+      error = std::string("unknown option '") + file + "'";
     }
-    if (!ok) return Usage(error.c_str());
+    return in_views;
+  };
+  for (int o; (o = options.Next(&settings)) != -1;) {
+    const char* arg = options.arg();
+    bool ok = true;
+    if (o != kPositional) in_views = o == kViews;
+    switch (o) {
+      case 0:
+        return Usage(options.error());
+      case kPositional:
+        ok = view(arg);
+        break;
+      case kSubpixel:
+        c.subpixel = true;
+        break;
+      case kHelp:
+      case 'h':
+        return Help();
+      case kDisparityOut:
+        pfm = arg;
+        break;
+      case kPreview:
+        preview = arg;
+        break;
+      case kRef:
+        ok = ParseWholeNumber(arg, 0, DepthConfig::kMaxViews - 1, &ref, &error);
+        break;
+      case kSmoothness:
+        ok = ParseWholeNumber(arg, 0, 4096, &c.smooth_weight, &error);
+        break;
+      case kCycles:
+        ok = ParseWholeNumber(arg, 0, 32, &c.max_cycles, &error);
+        break;
+      case kDisparity:
+        ok = ParseDisparityRange(arg, &c.disp_min_q8, &c.disp_max_q8, &error);
+        range_given = ok;
+        break;
+    }
+    if (!ok) return Usage(error);
+  }
+  // After "--" every argument is a file, even one that starts with a dash.
+  for (int i = options.rest(); i < argc; ++i) {
+    if (!view(argv[i])) return Usage(error);
   }
   const Geometry geometry = settings.pipeline.geometry;
   const int32_t focal_35mm = settings.focal_35mm;

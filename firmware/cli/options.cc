@@ -1,6 +1,8 @@
 #include "firmware/cli/options.h"
 
 #include <cstdio>
+#include <cstring>
+#include <utility>
 
 namespace lb::cli {
 
@@ -18,13 +20,14 @@ bool ParseDisparityRange(const char* text, int32_t* lo_q8, int32_t* hi_q8, std::
   return true;
 }
 
-std::vector<option> WithSettings(std::initializer_list<option> own,
-                                 std::initializer_list<SettingGroup> groups) {
+namespace {
+
+// `own`, the settings `wanted(setting)` picks under their names and aliases, the zero entry.
+template <typename Wanted>
+std::vector<option> Collect(std::initializer_list<option> own, Wanted wanted) {
   std::vector<option> all(own);
   for (int i = 0; const Setting* s = SettingAt(i); ++i) {
-    bool wanted = false;
-    for (SettingGroup g : groups) wanted |= s->group == g;
-    if (!wanted) continue;
+    if (!wanted(*s)) continue;
     all.push_back({s->name, required_argument, nullptr, kFirstSettingOption + i});
     if (s->alias) all.push_back({s->alias, required_argument, nullptr, kFirstSettingOption + i});
   }
@@ -32,42 +35,75 @@ std::vector<option> WithSettings(std::initializer_list<option> own,
   return all;
 }
 
+}  // namespace
+
+std::vector<option> WithSettings(std::initializer_list<option> own,
+                                 std::initializer_list<SettingGroup> groups) {
+  return Collect(own, [groups](const Setting& s) {
+    for (SettingGroup g : groups) {
+      if (s.group == g) return true;
+    }
+    return false;
+  });
+}
+
+std::vector<option> WithSettings(std::initializer_list<option> own,
+                                 std::initializer_list<const char*> names) {
+  return Collect(own, [names](const Setting& s) {
+    for (const char* name : names) {
+      if (strcmp(s.name, name) == 0) return true;
+    }
+    return false;
+  });
+}
+
 const Setting* SettingOfOption(int id) {
   return id >= kFirstSettingOption ? SettingAt(id - kFirstSettingOption) : nullptr;
 }
 
-namespace {
-
-bool Parse(const Setting* s, const char* arg, JobOptions* job, std::string* error) {
-  std::string why;
-  if (s->parse(arg, job, &why)) return true;
-  *error = std::string("--") + s->name + ": " + why;
-  return false;
+OptionReader::OptionReader(int argc, char** argv, std::vector<option> options, const char* letters)
+    : argc_(argc), argv_(argv), options_(std::move(options)), letters_(letters) {
+  optind = 0;  // not 1: glibc reads a new optstring's "-" only when it starts over
+  opterr = 0;  // Next says it in one line
 }
 
-}  // namespace
-
-bool ParseSettingOption(int id, const char* arg, JobOptions* job, std::string* error) {
-  const Setting* s = SettingOfOption(id);
-  if (s == nullptr) {
-    *error = "unknown option";
-    return false;
+int OptionReader::Next(JobOptions* job) {
+  int index = -1;
+  const int c = getopt_long(argc_, argv_, letters_, options_.data(), &index);
+  arg_ = optarg;
+  name_ = index >= 0 ? options_[static_cast<size_t>(index)].name : nullptr;
+  if (c == ':') return Problem(std::string(argv_[optind - 1]) + " needs a value");
+  if (c == '?') return Problem(std::string("unknown option '") + argv_[optind - 1] + "'");
+  if (const Setting* s = SettingOfOption(c)) {
+    std::string why;
+    if (!s->parse(arg_, job, &why)) return Problem(std::string("--") + name_ + ": " + why);
   }
-  return Parse(s, arg, job, error);
+  return c;
 }
 
-bool ParseSettingNamed(const char* name, const char* arg, JobOptions* job, std::string* error) {
-  const Setting* s = FindSetting(name);
-  if (s == nullptr) {
-    *error = std::string("unknown option '--") + name + "'";
+bool OptionReader::Once(std::string* value, std::string* error) const {
+  if (!value->empty()) {
+    *error = std::string("--") + name_ + " given twice";
     return false;
   }
-  return Parse(s, arg, job, error);
+  *value = arg_;
+  return true;
+}
+
+int OptionReader::Problem(std::string message) {
+  error_ = std::move(message);
+  return 0;
 }
 
 int Fail(const char* message) {
   fprintf(stderr, "refocus: %s\n", message);
   return 1;
+}
+
+int UsageError(const char* command, const std::string& problem) {
+  fprintf(stderr, "refocus %s: %s ('refocus %s --help' lists the options)\n", command,
+          problem.c_str(), command);
+  return 2;
 }
 
 }  // namespace lb::cli

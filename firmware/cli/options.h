@@ -23,14 +23,54 @@ inline constexpr int kFirstSettingOption = 1000;
 // its alias, then the zero entry.
 std::vector<option> WithSettings(std::initializer_list<option> own,
                                  std::initializer_list<SettingGroup> groups);
+// The same with the settings named, for a command that takes only a few of a group.
+std::vector<option> WithSettings(std::initializer_list<option> own,
+                                 std::initializer_list<const char*> names);
 // The setting behind option `id`, or nullptr for a command's own option.
 const Setting* SettingOfOption(int id);
-// Parses setting option `id` into `job`; false with `error` naming the option.
-bool ParseSettingOption(int id, const char* arg, JobOptions* job, std::string* error);
-// The same by the setting's name, for commands that walk argv themselves.
-bool ParseSettingNamed(const char* name, const char* arg, JobOptions* job, std::string* error);
+
+// What OptionReader::Next returns for an argument that is no option, when `letters` asks for
+// arguments in place.
+inline constexpr int kPositional = 1;
+
+// getopt_long over one command's arguments (argv[0] is the command's name): its own options come
+// back one at a time, the settings are parsed on the way, and every usage problem is one line.
+class OptionReader {
+ public:
+  // `options` from WithSettings; `letters` is getopt's optstring: ":" for long options only, a
+  // leading "-" keeps the other arguments in place (refocus depth: the files after --views).
+  OptionReader(int argc, char** argv, std::vector<option> options, const char* letters = ":");
+
+  // The next option's id, a setting's once parsed into `job`; kPositional; or -1 after the last
+  // (rest() then indexes what is left). 0 with error() set when a value is missing, an option
+  // unknown or a setting's value wrong.
+  int Next(JobOptions* job);
+  const char* arg() const { return arg_; }
+  // The option's long name as the user chose it, without the dashes: an alias stays an alias
+  // ("size", not "resolution").
+  const char* name() const { return name_; }
+  const std::string& error() const { return error_; }
+  int rest() const { return optind; }
+
+  // Takes arg() into `value` for an option given at most once; false with `error` otherwise.
+  bool Once(std::string* value, std::string* error) const;
+
+ private:
+  int Problem(std::string message);
+
+  int argc_;
+  char** argv_;
+  std::vector<option> options_;
+  const char* letters_;
+  const char* arg_ = nullptr;
+  const char* name_ = nullptr;
+  std::string error_;
+};
 
 // Prints "refocus: <message>" on stderr and returns exit code 1.
 int Fail(const char* message);
+// Prints "refocus COMMAND: <problem> ('refocus COMMAND --help' lists the options)" on stderr
+// and returns exit code 2.
+int UsageError(const char* command, const std::string& problem);
 
 }  // namespace lb::cli

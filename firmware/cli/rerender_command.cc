@@ -1,8 +1,7 @@
 // refocus rerender: a refocusable JPEG -> the same photo with a new focus or aperture.
-#include <getopt.h>
-
 #include <cstdio>
 #include <string>
+#include <utility>
 
 #include "firmware/app/rerender.h"
 #include "firmware/cli/commands.h"
@@ -22,52 +21,35 @@ const char kUsage[] =
 
 enum Opt { kOut = 256, kHelp };
 
-int Usage(const std::string& error) {
-  fprintf(stderr, "refocus rerender: %s ('refocus rerender --help' lists the options)\n",
-          error.c_str());
-  return 2;
-}
+int Usage(const std::string& problem) { return UsageError("rerender", problem); }
 
 }  // namespace
 
 int RerenderCommand(int argc, char** argv) {
-  const std::vector<option> options = WithSettings(
+  std::vector<option> table = WithSettings(
       {
           {"out", required_argument, nullptr, kOut},
           {"help", no_argument, nullptr, kHelp},
       },
       {SettingGroup::kLens});
+  OptionReader options(argc, argv, std::move(table));
   JobOptions lens;
   std::string out_path, error;
-  optind = 1;
-  opterr = 0;  // the messages below say it in one line
-  for (int c; (c = getopt_long(argc, argv, ":", options.data(), nullptr)) != -1;) {
-    bool ok = true;
-    switch (c) {
-      case kOut:
-        ok = out_path.empty();
-        if (!ok) error = "--out given twice";
-        out_path = optarg;
-        break;
-      case kHelp:
-        printf("%s%s", kUsage, SettingsHelp(SettingGroup::kLens).c_str());
-        return 0;
-      case ':':
-        return Usage(std::string(argv[optind - 1]) + " needs a value");
-      case '?':
-        return Usage(std::string("unknown option '") + argv[optind - 1] + "'");
-      default:
-        ok = ParseSettingOption(c, optarg, &lens, &error);
+  for (int c; (c = options.Next(&lens)) != -1;) {
+    if (c == 0) return Usage(options.error());
+    if (c == kOut && !options.Once(&out_path, &error)) return Usage(error);
+    if (c == kHelp) {
+      printf("%s%s", kUsage, SettingsHelp(SettingGroup::kLens).c_str());
+      return 0;
     }
-    if (!ok) return Usage(error);
   }
   RerenderOptions o;
   o.render = lens.render;
   o.max_blur_radius = lens.pipeline.max_blur_radius;
   o.quality = lens.quality;
-  if (optind != argc - 1) return Usage("give exactly one input file");
+  if (options.rest() != argc - 1) return Usage("give exactly one input file");
   if (out_path.empty()) return Usage("--out OUT.jpg is required");
-  const char* input = argv[optind];
+  const char* input = argv[options.rest()];
   Status s = CheckOutputTarget(out_path.c_str(), &input, 1);
   if (!s.ok()) return Fail(s.message());
   Rerenderer r;

@@ -1,10 +1,9 @@
 // refocus run: a burst (image files, a folder, or the synthetic scene) -> a refocused JPEG.
-#include <getopt.h>
-
 #include <cstdio>
 #include <cstring>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "firmware/app/job.h"
@@ -47,10 +46,7 @@ int Help() {
   return 0;
 }
 
-int Usage(const std::string& error) {
-  fprintf(stderr, "refocus run: %s ('refocus run --help' lists the options)\n", error.c_str());
-  return 2;
-}
+int Usage(const std::string& problem) { return UsageError("run", problem); }
 
 }  // namespace
 
@@ -67,7 +63,7 @@ int RunCommand(int argc, char** argv) {
   SceneParams scene;
   int32_t seed = 1;
 
-  const std::vector<option> options = WithSettings(
+  std::vector<option> table = WithSettings(
       {
           {"synthetic", no_argument, nullptr, kSynthetic},
           {"input", required_argument, nullptr, kInput},
@@ -79,57 +75,46 @@ int RunCommand(int argc, char** argv) {
           {"help", no_argument, nullptr, kHelp},
       },
       {SettingGroup::kBurst, SettingGroup::kDepth, SettingGroup::kLens});
-  optind = 1;
-  opterr = 0;  // the messages below say it in one line
-  int index = -1;
-  for (int c; (index = -1, c = getopt_long(argc, argv, ":", options.data(), &index)) != -1;) {
+  OptionReader options(argc, argv, std::move(table));
+  for (int c; (c = options.Next(&job)) != -1;) {
+    const char* arg = options.arg();
     bool ok = true;
     switch (c) {
+      case 0:
+        return Usage(options.error());
       case kSynthetic:
         synthetic = true;
         break;
       case kInput:
-        ok = input_dir.empty();
-        if (!ok) error = "--input given twice";
-        input_dir = optarg;
+        ok = options.Once(&input_dir, &error);
         break;
       case kSeed:
-        ok = ParseWholeNumber(optarg, 0, INT32_MAX, &seed, &error);
+        ok = ParseWholeNumber(arg, 0, INT32_MAX, &seed, &error);
         break;
       case kMotion:
-        motion = optarg;
-        ok = !strcmp(optarg, "handheld") || !strcmp(optarg, "rectified");
-        if (!ok) error = std::string("motion '") + optarg + "' is neither handheld nor rectified";
+        motion = arg;
+        ok = !strcmp(arg, "handheld") || !strcmp(arg, "rectified");
+        if (!ok) error = std::string("motion '") + arg + "' is neither handheld nor rectified";
         break;
       case kRef:
-        ok = ParseWholeNumber(optarg, 0, PipelineConfig::kMaxFrames - 1, &job.pipeline.reference,
+        ok = ParseWholeNumber(arg, 0, PipelineConfig::kMaxFrames - 1, &job.pipeline.reference,
                               &error);
         break;
       case kDisparity:
-        ok = ParseDisparityRange(optarg, &job.pipeline.disp_min_q8, &job.pipeline.disp_max_q8,
-                                 &error);
+        ok = ParseDisparityRange(arg, &job.pipeline.disp_min_q8, &job.pipeline.disp_max_q8, &error);
         range_given = true;
         break;
       case kOut:
-        ok = out_path.empty();
-        if (!ok) error = "--out given twice";
-        out_path = optarg;
+        ok = options.Once(&out_path, &error);
         break;
       case kHelp:
         return Help();
-      case ':':
-        return Usage(std::string(argv[optind - 1]) + " needs a value");
-      case '?':
-        return Usage(std::string("unknown option '") + argv[optind - 1] + "'");
-      default:
-        ok = ParseSettingOption(c, optarg, &job, &error);
-        if (ok && SettingOfOption(c)->group == SettingGroup::kBurst) {
-          synthetic_only = options[static_cast<size_t>(index)].name;  // as the user spelled it
-        }
+      default:  // a setting, already taken into `job`
+        if (SettingOfOption(c)->group == SettingGroup::kBurst) synthetic_only = options.name();
     }
     if (!ok) return Usage(error);
   }
-  std::vector<std::string> files(argv + optind, argv + argc);
+  std::vector<std::string> files(argv + options.rest(), argv + argc);
   if (out_path.empty()) return Usage("--out OUT.jpg is required");
   if (synthetic + !input_dir.empty() + !files.empty() > 1) {
     return Usage("give one input: --synthetic, --input DIR or FILE...");

@@ -1,7 +1,6 @@
 #include "firmware/daemon/config.h"
 
 #include <cerrno>
-#include <cstdarg>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -16,94 +15,85 @@ namespace {
 constexpr size_t kMaxFileBytes = 64 * 1024;
 constexpr size_t kMaxText = 63;  // make, model
 
-using Why = std::string;
-
-bool Fail(Why* why, const char* format, ...) __attribute__((format(printf, 2, 3)));
-bool Fail(Why* why, const char* format, ...) {
-  char text[200];
-  va_list args;
-  va_start(args, format);
-  vsnprintf(text, sizeof(text), format, args);
-  va_end(args);
-  *why = text;
-  return false;
-}
-
-bool Int32(const char* v, int32_t lo, int32_t hi, int32_t* out, Why* why) {
-  return ParseWholeNumber(v, lo, hi, out, why);
-}
-
-bool Text(const char* v, std::string* out, Why* why) {
-  if (strlen(v) > kMaxText) return Fail(why, "longer than %zu characters", kMaxText);
+bool Text(const char* v, std::string* out, std::string* why) {
+  if (strlen(v) > kMaxText) return Why(why, "longer than %zu characters", kMaxText);
   *out = v;
   return true;
 }
 
 struct Key {
   const char* name;
-  bool (*parse)(const char* v, DaemonConfig* c, Why* why);
+  bool (*parse)(const char* v, DaemonConfig* c, std::string* why);
 };
 
 const Key kKeys[] = {
     {"backend",
-     [](const char* v, DaemonConfig* c, Why* why) {
+     [](const char* v, DaemonConfig* c, std::string* why) {
        for (Backend b : {Backend::kV4l2, Backend::kLibcamera, Backend::kSynthetic}) {
          if (strcmp(v, BackendName(b)) == 0) {
            c->backend = b;
            return true;
          }
        }
-       return Fail(why, "'%s' is none of: v4l2, libcamera, synthetic", v);
+       return Why(why, "'%s' is none of: v4l2, libcamera, synthetic", v);
      }},
     {"device",
-     [](const char* v, DaemonConfig* c, Why*) {
+     [](const char* v, DaemonConfig* c, std::string*) {
        c->device = strcmp(v, "auto") == 0 ? "" : v;
        return true;
      }},
-    {"fps",
-     [](const char* v, DaemonConfig* c, Why* why) { return Int32(v, 0, 240, &c->fps, why); }},
-    {"frame_timeout_ms", [](const char* v, DaemonConfig* c,
-                            Why* why) { return Int32(v, 100, 60000, &c->frame_timeout_ms, why); }},
+    {"fps", [](const char* v, DaemonConfig* c,
+               std::string* why) { return ParseWholeNumber(v, 0, 240, &c->fps, why); }},
+    {"frame_timeout_ms",
+     [](const char* v, DaemonConfig* c, std::string* why) {
+       return ParseWholeNumber(v, 100, 60000, &c->frame_timeout_ms, why);
+     }},
     {"seed",
-     [](const char* v, DaemonConfig* c, Why* why) {
+     [](const char* v, DaemonConfig* c, std::string* why) {
        int32_t x = 0;
-       if (!Int32(v, 0, INT32_MAX, &x, why)) return false;
+       if (!ParseWholeNumber(v, 0, INT32_MAX, &x, why)) return false;
        c->seed = static_cast<uint64_t>(x);
        return true;
      }},
     {"button",
-     [](const char* v, DaemonConfig* c, Why*) {
+     [](const char* v, DaemonConfig* c, std::string*) {
        c->button = v;
        return true;
      }},
-    {"debounce_ms", [](const char* v, DaemonConfig* c,
-                       Why* why) { return Int32(v, 0, 500, &c->debounce_ms, why); }},
+    {"debounce_ms",
+     [](const char* v, DaemonConfig* c, std::string* why) {
+       return ParseWholeNumber(v, 0, 500, &c->debounce_ms, why);
+     }},
     {"busy_press",
-     [](const char* v, DaemonConfig* c, Why* why) {
+     [](const char* v, DaemonConfig* c, std::string* why) {
        if (strcmp(v, "queue") == 0) {
          c->busy = BusyPolicy::kQueue;
        } else if (strcmp(v, "refuse") == 0) {
          c->busy = BusyPolicy::kRefuse;
        } else {
-         return Fail(why, "'%s' is neither queue nor refuse", v);
+         return Why(why, "'%s' is neither queue nor refuse", v);
        }
        return true;
      }},
-    {"capture_retries", [](const char* v, DaemonConfig* c,
-                           Why* why) { return Int32(v, 0, 5, &c->capture_retries, why); }},
+    {"capture_retries",
+     [](const char* v, DaemonConfig* c, std::string* why) {
+       return ParseWholeNumber(v, 0, 5, &c->capture_retries, why);
+     }},
     {"output_dir",
-     [](const char* v, DaemonConfig* c, Why* why) {
+     [](const char* v, DaemonConfig* c, std::string* why) {
        // Room for "/IMG_YYYYMMDD_HHMMSS_NNNN.jpg" and the temporary's suffix within a path.
-       if (strlen(v) > 900) return Fail(why, "longer than 900 characters");
+       if (strlen(v) > 900) return Why(why, "longer than 900 characters");
        c->output_dir = v;
        return true;
      }},
-    {"make", [](const char* v, DaemonConfig* c, Why* why) { return Text(v, &c->make, why); }},
-    {"model", [](const char* v, DaemonConfig* c, Why* why) { return Text(v, &c->model, why); }},
+    {"make",
+     [](const char* v, DaemonConfig* c, std::string* why) { return Text(v, &c->make, why); }},
+    {"model",
+     [](const char* v, DaemonConfig* c, std::string* why) { return Text(v, &c->model, why); }},
     {"log_level",
-     [](const char* v, DaemonConfig* c, Why* why) {
+     [](const char* v, DaemonConfig* c, std::string* why) {
        if (ParseLogLevel(v, &c->log_level)) return true;
-       return Fail(why, "'%s' is none of: debug, info, warning, error", v);
+       return Why(why, "'%s' is none of: debug, info, warning, error", v);
      }},
 };
 constexpr int kKeyCount = sizeof(kKeys) / sizeof(kKeys[0]);
@@ -200,7 +190,7 @@ Status ParseConfig(const char* name, const char* text, DaemonConfig* config) {
     if (value.empty()) {
       return Status(Code::kInvalidArgument, "%s:%d: %s has no value", name, line_no, known);
     }
-    Why why;
+    std::string why;
     const bool ok = k < kKeyCount
                         ? kKeys[k].parse(value.c_str(), config, &why)
                         : SettingAt(k - kKeyCount)->parse(value.c_str(), &config->job, &why);

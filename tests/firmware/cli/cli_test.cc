@@ -390,6 +390,8 @@ TEST_F(Cli, NothingIsSilentlyChangedOrIgnored) {
            {{"run", "--out", out, "--out", out + "2"}, false, 2, "--out given twice"},
            {{"run", "--synthetic", "--out"}, false, 2, "--out needs a value"},
            {{"run", "--bogus", "--out", out}, false, 2, "unknown option '--bogus'"},
+           {{"run", "--size", "320y240", "--out", out}, false, 2, "--size: '320y240'"},
+           {{"rerender", out, "--rotation", "400", "--out", out}, false, 2, "--rotation: '400'"},
            {{"run", "--size", "320x240", "--focus", "5000,5000", "--out", out},
             false,
             1,
@@ -487,6 +489,44 @@ TEST_F(Cli, SizeRefusalsNameTheFile) {
   r = Run({"depth", "--geometry", "rectified", "--disparity-out", out_dir_ + "/d.pfm", "--views",
            tinier[0], tinier[1]});
   ExpectCleanFailure(r, tinier[0], "4x4");
+}
+
+// refocus depth reads its options as run does: the same settings and messages, and the files
+// after --views up to the next option.
+TEST_F(Cli, DepthTakesItsOptionsAsRunDoes) {
+  const std::vector<std::string> f = PpmBurst(3, 64, 48);
+  const std::string pfm = out_dir_ + "/d.pfm";
+  struct Case {
+    std::vector<std::string> args;
+    std::string says;
+  };
+  for (const Case& c : std::vector<Case>{
+           {{"depth", "--labels", "1", "--disparity-out", pfm, "--views", f[0], f[1]},
+            "--labels: '1' is not a whole number from 2 to 256"},
+           {{"depth", "--working-size", "64x48", "--views", f[0], f[1]},
+            "unknown option '--working-size'"},
+           {{"depth", "--views", f[0], f[1], "--ref"}, "--ref needs a value"},
+           {{"depth", f[0], "--views", f[1], f[2], "--disparity-out", pfm},
+            "unknown option '" + f[0] + "'"},
+           {{"depth", "--views", f[0], "--subpixel", f[1], "--disparity-out", pfm},
+            "unknown option '" + f[1] + "'"},
+           {{"depth", "--views", f[0], "--disparity-out", pfm}, "--views needs at least two files"},
+       }) {
+    const Result r = Run(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.says << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << r.err;
+  }
+  EXPECT_TRUE(OutDirEmpty());
+  // --views may be given more than once; "--" ends the options.
+  const Result r = Run({"depth", "--geometry", "rectified", "--labels", "8", "--views", f[0],
+                        "--disparity-out", pfm, "--views", f[1], "--", f[2]});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("3 views (reference 1)"), std::string::npos) << r.out;
+  const Result help = Run({"depth", "-h"});
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_EQ(help.out, Run({"depth", "--help"}).out);
+  EXPECT_NE(help.out.find("usage: refocus depth"), std::string::npos);
 }
 
 TEST_F(Cli, UsageErrorsExitWithTwo) {
