@@ -196,6 +196,11 @@ const Setting kSettings[] = {
      return ParseWholeNumber(t, 2, 256, &j->pipeline.labels, w); }},
   {"working-size", nullptr, SettingGroup::kDepth, "WxH",
    "largest working resolution for depth, 16x16 .. 8192x8192 (default 640x480)", WorkingSize},
+  {"threads", nullptr, SettingGroup::kDepth, "N",
+   "worker threads for depth and render, 1..16, or 0: one per core (default 0); the photo is "
+   "the same whatever the number",
+   [](const char* t, JobOptions* j, std::string* w) {
+     return ParseWholeNumber(t, 0, kMaxWorkers, &j->threads, w); }},
 };
 // clang-format on
 constexpr int kCount = sizeof(kSettings) / sizeof(kSettings[0]);

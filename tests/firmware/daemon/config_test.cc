@@ -188,6 +188,7 @@ TEST(ConfigTest, EverySharedSettingMeansWhatTheCommandLineMeans) {
       {"focal-35mm", "28"},
       {"labels", "48"},
       {"working-size", "320x240"},
+      {"threads", "3"},
   };
   int covered = 0;
   for (const auto& [name, value] : value_of) {
@@ -219,6 +220,7 @@ TEST(ConfigTest, EverySharedSettingMeansWhatTheCommandLineMeans) {
     EXPECT_EQ(conf.focal_35mm, cli.focal_35mm);
     EXPECT_EQ(conf.pipeline.labels, cli.pipeline.labels);
     EXPECT_EQ(conf.pipeline.max_working_width, cli.pipeline.max_working_width);
+    EXPECT_EQ(conf.threads, cli.threads);
     ++covered;
   }
   int settings = 0;
