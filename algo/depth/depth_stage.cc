@@ -300,6 +300,9 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
     planes_set_ = false;
   }
   const int32_t w = c.width, h = c.height;
+  // Units: the costs' preparation and the first labeling, then one per move of every cycle.
+  const int32_t total = 1 + c.max_cycles * c.labels;
+  if (progress_ != nullptr) progress_->Report(0, total);
   data_.Prepare(views);
   EdgeWeights(views[c.reference]);
   prev_label_ = -1;
@@ -325,6 +328,7 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
     }
   }
   if (coarse) window_ = c.fine_window;
+  if (progress_ != nullptr) progress_->Report(1, total);
   for (int32_t cycle = 0; cycle < c.max_cycles; ++cycle) {
     bool lowered = false;
     for (int32_t alpha = 0; alpha < c.labels; ++alpha) {
@@ -332,12 +336,14 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
         lowered = true;
         ++stats_.moves;
       }
+      if (progress_ != nullptr) progress_->Report(2 + cycle * c.labels + alpha, total);
     }
     ++stats_.cycles;
     if (!lowered) break;
   }
   stats_.energy = energy_;
   Refine(disp_q8);
+  if (progress_ != nullptr) progress_->Report(total, total);
   return Status::Ok();
 }
 

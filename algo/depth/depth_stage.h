@@ -17,6 +17,7 @@
 
 #include "algo/core/arena.h"
 #include "algo/core/image.h"
+#include "algo/core/progress.h"
 #include "algo/core/status.h"
 #include "algo/depth/data_term.h"
 #include "algo/depth/grid_maxflow.h"
@@ -97,6 +98,8 @@ class DepthStage {
   // Where the data term runs its tasks (borrowed; nullptr: on the caller), with at most
   // config.workers workers. The output does not depend on it.
   void SetRunner(TaskRunner* runner) { data_.SetRunner(runner); }
+  // Told after each expansion move of Compute (borrowed; nullptr: nobody).
+  void SetProgress(ProgressSink* progress) { progress_ = progress; }
 
   // kPlanes only, after Configure and before each Compute (a Compute consumes them, so a new
   // burst cannot run on the last one's poses): homographies[v * labels + l] is label l's plane
@@ -186,6 +189,7 @@ class DepthStage {
   void Refine(ImageU16 disp_q8);
 
   DepthConfig config_;
+  ProgressSink* progress_ = nullptr;
   DepthStats stats_;
   DataTerm data_;
   GridMaxflow maxflow_;

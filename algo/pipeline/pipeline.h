@@ -71,6 +71,8 @@ class Pipeline : public FrameSink {
   // Where the stages run their tasks (borrowed; nullptr: on the caller), with at most
   // config.workers workers. The output bits do not depend on it.
   void SetRunner(TaskRunner* runner);
+  // Told how far ComputeDepth's labeling is (borrowed; nullptr: nobody).
+  void SetProgress(ProgressSink* progress) { depth_.SetProgress(progress); }
 
   // FrameSink: frames 0..frames-1 in any order, each exactly once, each covering every row.
   Status BeginFrame(const FrameInfo& info) override;

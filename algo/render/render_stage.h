@@ -71,6 +71,7 @@ class RenderStage {
   static Status Validate(const RenderConfig& config);
   static size_t RequiredBytes(const RenderConfig& config);
   Status Configure(const RenderConfig& config, Arena& arena);
+  const RenderConfig& config() const { return config_; }
   // Where the strips of a batch render (borrowed; nullptr: on the caller), with at most
   // config.workers workers. The output does not depend on it.
   void SetRunner(TaskRunner* runner);

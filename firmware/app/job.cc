@@ -30,7 +30,8 @@ void FormatExifTime(char* out, size_t size) {
 
 }  // namespace
 
-Status WriteStrips(RenderStage* render, StripObserver* observer, JpegWriter* writer) {
+Status WriteStrips(RenderStage* render, StripObserver* observer, JpegWriter* writer,
+                   Progress* progress) {
   for (;;) {
     ConstPlanarU8 strip;
     int32_t y0 = 0, rows = 0;
@@ -38,9 +39,49 @@ Status WriteStrips(RenderStage* render, StripObserver* observer, JpegWriter* wri
     if (rows == 0) break;
     if (observer) observer->OnStrip(strip, y0, rows);
     LB_RETURN_IF_ERROR(writer->WriteStrip(strip, rows));
+    if (progress) {
+      const int64_t height = render->config().height;
+      progress->Update("render", static_cast<int32_t>(100 * (y0 + rows) / height));
+    }
   }
   return writer->Finish();
 }
+
+namespace {
+
+// Counts the frames a sensor delivers into the pipeline, for the progress line.
+class CountingSink final : public FrameSink {
+ public:
+  CountingSink(FrameSink* next, int32_t frames, Progress* progress)
+      : next_(next), frames_(frames), progress_(progress) {}
+  Status BeginFrame(const FrameInfo& info) override { return next_->BeginFrame(info); }
+  Status Rows(const FrameRows& rows) override { return next_->Rows(rows); }
+  Status EndFrame() override {
+    LB_RETURN_IF_ERROR(next_->EndFrame());
+    ++done_;
+    progress_->Update("capture", 100 * done_ / (frames_ > 0 ? frames_ : 1));
+    return Status::Ok();
+  }
+
+ private:
+  FrameSink* next_;
+  int32_t frames_, done_ = 0;
+  Progress* progress_;
+};
+
+// The labeling's moves as the progress line's percentage.
+class DepthProgress final : public ProgressSink {
+ public:
+  explicit DepthProgress(Progress* progress) : progress_(progress) {}
+  void Report(int32_t done, int32_t total) override {
+    progress_->Update("depth", static_cast<int32_t>(100 * int64_t{done} / (total > 0 ? total : 1)));
+  }
+
+ private:
+  Progress* progress_;
+};
+
+}  // namespace
 
 void Job::FreeDeleter::operator()(void* p) const { free(p); }
 
@@ -95,10 +136,25 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
   // written, and any later failure removes it, so nothing is left on storage.
   LB_RETURN_IF_ERROR(CheckOutputTarget(out_path, nullptr, 0));
   double t0 = Now();
-  LB_RETURN_IF_ERROR(sensor_->CaptureBurst(p));
+  if (progress_ != nullptr) {
+    progress_->Update("capture", 0);
+    CountingSink counting(&p, mode_.frames, progress_);
+    LB_RETURN_IF_ERROR(sensor_->CaptureBurst(counting));
+  } else {
+    LB_RETURN_IF_ERROR(sensor_->CaptureBurst(p));
+  }
   double t1 = Now();
   r.capture_s = t1 - t0;
-  LB_RETURN_IF_ERROR(p.ComputeDepth());
+  DepthProgress depth_progress(progress_);
+  if (progress_ != nullptr) {
+    progress_->Update("depth", 0);
+    p.SetProgress(&depth_progress);
+  }
+  const Status depth = p.ComputeDepth();
+  p.SetProgress(nullptr);
+  LB_RETURN_IF_ERROR(depth);
+  // A burst without depth skips the labeling: its stage is over all the same.
+  if (progress_ != nullptr) progress_->Update("depth", 100);
   double t2 = Now();
   r.depth_s = t2 - t1;
   r.warning = p.depth_warning();
@@ -133,7 +189,8 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
   LB_RETURN_IF_ERROR(file.Open(out_path));
   JpegWriter writer;
   LB_RETURN_IF_ERROR(writer.Begin(&file, mode_.width, mode_.height, options_.quality, meta));
-  LB_RETURN_IF_ERROR(WriteStrips(&p.render(), observer, &writer));
+  LB_RETURN_IF_ERROR(WriteStrips(&p.render(), observer, &writer, progress_));
+  if (progress_ != nullptr) progress_->Update("write", 100);
   LB_RETURN_IF_ERROR(file.Commit());
   r.render_s = Now() - t2;
   if (report) *report = r;

@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "algo/pipeline/pipeline.h"
+#include "firmware/app/progress.h"
 #include "hal/sensor.h"
 
 namespace lb {
@@ -52,9 +53,11 @@ class StripObserver {
 
 class JpegWriter;
 
-// Encodes every strip `render` gives, showing each to `observer` (may be nullptr) first, then
-// finishes the image: a burst's photo and a re-render are written the same way.
-Status WriteStrips(RenderStage* render, StripObserver* observer, JpegWriter* writer);
+// Encodes every strip `render` gives, showing each to `observer` (may be nullptr) first and
+// telling `progress` (may be nullptr) the rows done, then finishes the image: a burst's photo and
+// a re-render are written the same way.
+Status WriteStrips(RenderStage* render, StripObserver* observer, JpegWriter* writer,
+                   Progress* progress = nullptr);
 
 class Job {
  public:
@@ -68,6 +71,9 @@ class Job {
   // One burst -> `out_path`. On failure nothing is left under `out_path`.
   Status Run(const char* out_path, JobReport* report, StripObserver* observer = nullptr);
 
+  // Told each stage's progress during Run (borrowed; nullptr: nobody).
+  void set_progress(Progress* progress) { progress_ = progress; }
+
   Pipeline& pipeline() { return *pipeline_; }
   const SensorMode& mode() const { return mode_; }
 
@@ -80,6 +86,7 @@ class Job {
   SensorMode mode_;
   std::unique_ptr<Pipeline> pipeline_;
   std::unique_ptr<WorkerPool> pool_;
+  Progress* progress_ = nullptr;
   std::unique_ptr<uint8_t, FreeDeleter> arena_;
   size_t arena_bytes_ = 0;
 };

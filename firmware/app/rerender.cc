@@ -7,6 +7,7 @@
 #include "firmware/app/refocusable.h"
 #include "firmware/jpeg/jpeg_writer.h"
 #include "firmware/jpeg/refocusable_reader.h"
+#include "firmware/platform/worker_pool.h"
 #include "firmware/storage/atomic_file.h"
 #include "sim/files/exif_focal.h"
 #include "sim/files/image_file.h"
@@ -94,6 +95,8 @@ Status Rerenderer::Render(const RerenderOptions& options, const char* out_path,
   rc.working_width = depth_w_;
   rc.working_height = depth_h_;
   rc.max_radius = options.max_blur_radius;
+  const int32_t cores = WorkerPool::AvailableCores();
+  rc.workers = options.threads > 0 ? options.threads : (cores < kMaxWorkers ? cores : kMaxWorkers);
   LB_RETURN_IF_ERROR(RenderStage::Validate(rc));
   const size_t bytes = RenderStage::RequiredBytes(rc);
   std::unique_ptr<void, decltype(&free)> block(aligned_alloc(Arena::kAlign, Arena::RoundUp(bytes)),
@@ -102,6 +105,9 @@ Status Rerenderer::Render(const RerenderOptions& options, const char* out_path,
   Arena arena(block.get(), Arena::RoundUp(bytes));
   RenderStage render;
   LB_RETURN_IF_ERROR(render.Configure(rc, arena));
+  WorkerPool pool;
+  LB_RETURN_IF_ERROR(pool.Start(rc.workers));
+  render.SetRunner(&pool);
   LB_RETURN_IF_ERROR(render.Begin(reference(), disparity_q8(), options.render));
 
   AtomicFile file;
@@ -117,7 +123,7 @@ Status Rerenderer::Render(const RerenderOptions& options, const char* out_path,
                                               width_, &meta.extra_segments));
   JpegWriter writer;
   LB_RETURN_IF_ERROR(writer.Begin(&file, width_, height_, options.quality, meta));
-  LB_RETURN_IF_ERROR(WriteStrips(&render, observer, &writer));
+  LB_RETURN_IF_ERROR(WriteStrips(&render, observer, &writer, options.progress));
   return file.Commit();
 }
 

@@ -9,6 +9,7 @@
 #include "algo/core/image.h"
 #include "algo/render/render_stage.h"
 #include "firmware/app/job.h"
+#include "firmware/app/progress.h"
 #include "firmware/jpeg/depth_encoding.h"
 
 namespace lb {
@@ -17,6 +18,8 @@ struct RerenderOptions {
   RenderParams render;
   int32_t max_blur_radius = 32;
   int quality = 92;
+  int32_t threads = 0;           // as JobOptions::threads
+  Progress* progress = nullptr;  // told how far the render is (borrowed)
 };
 
 class Rerenderer {

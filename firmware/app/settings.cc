@@ -196,7 +196,7 @@ const Setting kSettings[] = {
      return ParseWholeNumber(t, 2, 256, &j->pipeline.labels, w); }},
   {"working-size", nullptr, SettingGroup::kDepth, "WxH",
    "largest working resolution for depth, 16x16 .. 8192x8192 (default 640x480)", WorkingSize},
-  {"threads", nullptr, SettingGroup::kDepth, "N",
+  {"threads", nullptr, SettingGroup::kWork, "N",
    "worker threads for depth and render, 1..16, or 0: one per core (default 0); the photo is "
    "the same whatever the number",
    [](const char* t, JobOptions* j, std::string* w) {

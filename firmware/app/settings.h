@@ -16,6 +16,7 @@ enum class SettingGroup : uint8_t {
   kLens,   // focus, aperture, blur, JPEG quality: run, rerender, refocusd
   kBurst,  // what the sensor is asked for: run (the synthetic scene), refocusd
   kDepth,  // how depth is found: run, refocusd (depth takes a few)
+  kWork,   // how the work is spread over the board: run, rerender, refocusd
 };
 
 struct Setting {

@@ -31,7 +31,7 @@ int RerenderCommand(int argc, char** argv) {
           {"out", required_argument, nullptr, kOut},
           {"help", no_argument, nullptr, kHelp},
       },
-      {SettingGroup::kLens});
+      {SettingGroup::kLens, SettingGroup::kWork});
   OptionReader options(argc, argv, std::move(table));
   JobOptions lens;
   std::string out_path, error;
@@ -39,7 +39,8 @@ int RerenderCommand(int argc, char** argv) {
     if (c == 0) return Usage(options.error());
     if (c == kOut && !options.Once(&out_path, &error)) return Usage(error);
     if (c == kHelp) {
-      printf("%s%s", kUsage, SettingsHelp(SettingGroup::kLens).c_str());
+      printf("%s%sWork:\n%s", kUsage, SettingsHelp(SettingGroup::kLens).c_str(),
+             SettingsHelp(SettingGroup::kWork).c_str());
       return 0;
     }
   }
@@ -47,6 +48,9 @@ int RerenderCommand(int argc, char** argv) {
   o.render = lens.render;
   o.max_blur_radius = lens.pipeline.max_blur_radius;
   o.quality = lens.quality;
+  o.threads = lens.threads;
+  TerminalProgress progress(stderr);
+  o.progress = &progress;
   if (options.rest() != argc - 1) return Usage("give exactly one input file");
   if (out_path.empty()) return Usage("--out OUT.jpg is required");
   const char* input = argv[options.rest()];
@@ -55,6 +59,7 @@ int RerenderCommand(int argc, char** argv) {
   Rerenderer r;
   s = r.Load(input);
   if (s.ok()) s = r.Render(o, out_path.c_str());
+  progress.Clear();
   if (!s.ok()) return Fail(s.message());
   printf("wrote %s: %dx%d re-rendered at f/%.1f\n", out_path.c_str(), r.width(), r.height(),
          static_cast<double>(o.render.f_number));

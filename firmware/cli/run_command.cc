@@ -40,9 +40,9 @@ const char kOutputUsage[] =
 enum Opt { kSynthetic = 256, kInput, kSeed, kMotion, kRef, kDisparity, kOut, kHelp };
 
 int Help() {
-  printf("%s%sDepth:\n%s%s%s%s", kUsage, SettingsHelp(SettingGroup::kBurst).c_str(),
+  printf("%s%sDepth:\n%s%s%s%sWork:\n%s", kUsage, SettingsHelp(SettingGroup::kBurst).c_str(),
          SettingsHelp(SettingGroup::kDepth).c_str(), kDepthUsage, kOutputUsage,
-         SettingsHelp(SettingGroup::kLens).c_str());
+         SettingsHelp(SettingGroup::kLens).c_str(), SettingsHelp(SettingGroup::kWork).c_str());
   return 0;
 }
 
@@ -74,7 +74,7 @@ int RunCommand(int argc, char** argv) {
           {"out", required_argument, nullptr, kOut},
           {"help", no_argument, nullptr, kHelp},
       },
-      {SettingGroup::kBurst, SettingGroup::kDepth, SettingGroup::kLens});
+      {SettingGroup::kBurst, SettingGroup::kDepth, SettingGroup::kLens, SettingGroup::kWork});
   OptionReader options(argc, argv, std::move(table));
   for (int c; (c = options.Next(&job)) != -1;) {
     const char* arg = options.arg();
@@ -184,7 +184,10 @@ int RunCommand(int argc, char** argv) {
   s = CheckOutputTarget(out_path.c_str(), inputs.data(), static_cast<int32_t>(inputs.size()));
   if (!s.ok()) return Fail(s.message());
   JobReport report;
+  TerminalProgress progress(stderr);
+  runner.set_progress(&progress);
   s = runner.Run(out_path.c_str(), &report);
+  progress.Clear();
   if (!s.ok()) return Fail(s.message());
   if (!report.warning.ok()) {
     fprintf(stderr, "refocus: warning: no depth from this burst, the photo is not blurred: %s\n",
@@ -192,10 +195,11 @@ int RunCommand(int argc, char** argv) {
   }
   printf(
       "wrote %s: %dx%d, %d frames, focus disparity %.2f px; capture %.2f s, depth %.2f s, "
-      "render+encode %.2f s, arena %.1f MiB\n",
+      "render+encode %.2f s, arena %.1f MiB, %d thread%s\n",
       out_path.c_str(), report.width, report.height, runner.mode().frames,
       report.focus_disp_q8 / 256.0, report.capture_s, report.depth_s, report.render_s,
-      static_cast<double>(report.arena_bytes) / (1024.0 * 1024.0));
+      static_cast<double>(report.arena_bytes) / (1024.0 * 1024.0),
+      runner.pipeline().config().workers, runner.pipeline().config().workers == 1 ? "" : "s");
   const Pipeline& p = runner.pipeline();
   if (job.pipeline.geometry == Geometry::kAuto && report.warning.ok()) {
     printf(
