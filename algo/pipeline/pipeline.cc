@@ -137,28 +137,29 @@ Status Pipeline::Carve(Arena& arena) {
     planes_ = arena.Allocate<PlaneHomography>(static_cast<size_t>(c.frames) * c.labels);
     order_scratch_ = arena.Allocate<uint8_t>(DepthOrderScratchBytes(work_w_, work_h_));
   }
-  const bool depth = HasDepth(work_w_, work_h_);
-  if (arena.planning()) {
-    if (depth) {
-      (void)arena.AllocateBytes(DepthStage::RequiredBytes(MakeDepthConfig(c, work_w_, work_h_)));
-    }
-    (void)arena.AllocateBytes(
-        RenderStage::RequiredBytes(MakeRenderConfig(c, scale_, work_w_, work_h_)));
-    if (UsesMotion(c, work_w_, work_h_)) {
-      (void)arena.AllocateBytes(MotionStage::RequiredBytes(MakeMotionConfig(c, work_w_, work_h_)));
-    }
-    return Status::Ok();
-  }
-  if (depth) LB_RETURN_IF_ERROR(depth_.Configure(MakeDepthConfig(c, work_w_, work_h_), arena));
-  LB_RETURN_IF_ERROR(render_.Configure(MakeRenderConfig(c, scale_, work_w_, work_h_), arena));
-  if (UsesMotion(c, work_w_, work_h_)) {
-    LB_RETURN_IF_ERROR(motion_.Configure(MakeMotionConfig(c, work_w_, work_h_), arena));
-  }
+  // Motion and depth are done with before the render starts, and the render keeps nothing
+  // between renders that it does not rebuild at Begin, so they share one region: its size is the
+  // larger of the two, not their sum.
+  const bool depth = HasDepth(work_w_, work_h_), motion = UsesMotion(c, work_w_, work_h_);
+  const DepthConfig dc = MakeDepthConfig(c, work_w_, work_h_);
+  const MotionConfig mc = MakeMotionConfig(c, work_w_, work_h_);
+  const RenderConfig rc = MakeRenderConfig(c, scale_, work_w_, work_h_);
+  // Each stage starts on a fresh alignment boundary: kAlign of slack per stage.
+  const size_t analysis = (depth ? DepthStage::RequiredBytes(dc) + Arena::kAlign : 0) +
+                          (motion ? MotionStage::RequiredBytes(mc) + Arena::kAlign : 0);
+  const size_t render = RenderStage::RequiredBytes(rc) + Arena::kAlign;
+  const size_t shared = analysis > render ? analysis : render;
+  uint8_t* region = arena.Allocate<uint8_t>(shared);
+  if (arena.planning()) return Status::Ok();
   if (arena.overflowed()) {
     return Status(Code::kOutOfMemory, "pipeline arena of %zu bytes is too small (needs %zu)",
                   arena.size(), arena.used());
   }
-  return Status::Ok();
+  Arena analysis_arena(region, shared);
+  if (depth) LB_RETURN_IF_ERROR(depth_.Configure(dc, analysis_arena));
+  if (motion) LB_RETURN_IF_ERROR(motion_.Configure(mc, analysis_arena));
+  Arena render_arena(region, shared);
+  return render_.Configure(rc, render_arena);
 }
 
 void Pipeline::SetRunner(TaskRunner* runner) {

@@ -1,6 +1,7 @@
 // The lens-blur pipeline: configure once, ingest a burst frame by frame, compute depth, render
 // strip by strip. All memory is one arena sized by RequiredBytes() from the configuration; after
-// Configure nothing is allocated.
+// Configure nothing is allocated. The motion and depth stages and the render take turns in one
+// region of it.
 //
 //   size_t bytes = 0;
 //   Status s = Pipeline::RequiredBytes(config, &bytes);   // validates too
@@ -91,6 +92,8 @@ class Pipeline : public FrameSink {
   // kRectified), in the map's units: a signed range is lifted to start at 0 (depth_stage.h).
   int32_t disp_min_q8() const { return disp_min_q8_; }
   int32_t disp_max_q8() const { return disp_max_q8_; }
+  // The motion stage's result; its point arrays (point_xy, inv_depth) and the depth stage's
+  // labels() live in memory the render reuses: valid until BeginRender.
   const MotionResult& motion() const { return motion_result_; }
   Status BeginRender(const RenderParams& params);
   Status NextStrip(ConstPlanarU8* strip, int32_t* y0, int32_t* rows);

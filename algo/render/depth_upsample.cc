@@ -13,7 +13,15 @@ void DepthUpsampler::Carve(Arena& arena, int32_t width, int32_t height, int32_t 
   uniform_ = arena.Allocate<uint8_t>(static_cast<size_t>(ww_));
   spatial_q8_ = arena.Allocate<uint16_t>(static_cast<size_t>(3) * scale_);
   range_q8_ = arena.Allocate<uint16_t>(766);
-  if (arena.planning() || arena.overflowed()) return;
+}
+
+// The tables are filled here, not at Carve: the pipeline lends the render's memory to the depth
+// stages between renders.
+void DepthUpsampler::Begin(const ConstPlanarU8& ref, ConstImageU16 disp_q8) {
+  ref_ = ref;
+  disp_ = disp_q8;
+  for (Guide& g : guide_) g.tag = -1;
+  uniform_tag_ = -1;
   // Spatial term (1 - (d / 1.75)^2)^2 of the distance d in working px between a sub-position and
   // a neighbour's centre: every neighbour of the 3x3 keeps some weight, the near ones most.
   for (int32_t f = 0; f < scale_; ++f) {
@@ -30,13 +38,6 @@ void DepthUpsampler::Carve(Arena& arena, int32_t width, int32_t height, int32_t 
     const int64_t den = (s2 + d * d) * (s2 + d * d);
     range_q8_[d] = static_cast<uint16_t>((256 * s2 * s2 + den / 2) / den);
   }
-}
-
-void DepthUpsampler::Begin(const ConstPlanarU8& ref, ConstImageU16 disp_q8) {
-  ref_ = ref;
-  disp_ = disp_q8;
-  for (Guide& g : guide_) g.tag = -1;
-  uniform_tag_ = -1;
 }
 
 const uint8_t* DepthUpsampler::GuideRow(int32_t wy) {

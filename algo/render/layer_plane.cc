@@ -92,21 +92,25 @@ Status LayerPlane::Carve(Arena& arena, int32_t width, int32_t height, int32_t ch
     s.out = arena.Allocate<int32_t>(static_cast<size_t>(strip_rows) * planes * width);
   }
   kernels_ = arena.Allocate<KernelRow>(static_cast<size_t>(radii) * kernel_rows_);
-  // Column l of a reduced level samples the low-res row at (2x + 1 - f) / 2f, Q8.
   int32_t max_level = 0;
   for (int32_t i = 0; i < radii; ++i) max_level = Max(max_level, level_[i]);
-  for (int32_t l = 1; l <= max_level; ++l) {
-    frac_[l] = arena.Allocate<uint8_t>(static_cast<size_t>(width));
-    if (arena.planning() || arena.overflowed()) continue;
-    for (int32_t x = 0; x < width; ++x) {
-      const int32_t u = ((2 * x + 1 - (1 << l)) * 128) >> l;
-      frac_[l][x] = static_cast<uint8_t>(u & 255);
-    }
+  for (int32_t l = 0; l <= kMaxLevel; ++l) {
+    frac_[l] =
+        l >= 1 && l <= max_level ? arena.Allocate<uint8_t>(static_cast<size_t>(width)) : nullptr;
   }
   return Status::Ok();
 }
 
 void LayerPlane::Begin(const ApertureShape& shape, int32_t shift) {
+  // Column l of a reduced level samples the low-res row at (2x + 1 - f) / 2f, Q8. Filled here,
+  // not at Carve: the pipeline lends the render's memory to the depth stages between renders.
+  for (int32_t l = 1; l <= kMaxLevel; ++l) {
+    if (frac_[l] == nullptr) continue;
+    for (int32_t x = 0; x < width_; ++x) {
+      const int32_t u = ((2 * x + 1 - (1 << l)) * 128) >> l;
+      frac_[l][x] = static_cast<uint8_t>(u & 255);
+    }
+  }
   for (int32_t i = 0; i < radii_; ++i) {
     const float r = radius_[i] / static_cast<float>(1 << level_[i]);
     const uint32_t total = BuildKernel(shape, r, half_[i], kernels_ + i * kernel_rows_);

@@ -123,8 +123,13 @@ Status RenderStage::Carve(Arena& arena) {
     return Status(Code::kOutOfMemory, "render: arena of %zu bytes is too small (%zu needed)",
                   arena.size(), arena.used());
   }
-  if (arena.planning()) return Status::Ok();
+  return Status::Ok();
+}
 
+// The layers' tables, filled at each Begin rather than at Carve: the pipeline lends the render's
+// memory to the depth stages between renders.
+void RenderStage::FillTables() {
+  const RenderConfig& c = config_;
   // Layers far to near: signed radii -r[n-1] .. -r[1], 0, r[1] .. r[n-1].
   LayerRadiiQ4(c.max_radius, radii_q4_);
   for (int32_t k = 0; k < layers_; ++k)
@@ -145,7 +150,6 @@ Status RenderStage::Carve(Arena& arena) {
     }
     layer_of_[s + offset] = static_cast<uint16_t>(k << 8 | frac);
   }
-  return Status::Ok();
 }
 
 Status RenderStage::Configure(const RenderConfig& config, Arena& arena) {
@@ -177,6 +181,7 @@ Status RenderStage::Begin(const ConstPlanarU8& ref, ConstImageU16 disp_q8,
                   disp_q8.width, disp_q8.height, config_.working_width, config_.working_height);
   }
   LB_RETURN_IF_ERROR(ValidateParams(params));
+  FillTables();
   ref_ = ref;
   disp_ = disp_q8;
   params_ = params;

@@ -108,6 +108,7 @@ class RenderStage {
  private:
   Status Carve(Arena& arena);
   Status RenderBatch();
+  void FillTables();
   void FillLumaRow(int32_t y);
   void FillChromaRow(int32_t y);
 
