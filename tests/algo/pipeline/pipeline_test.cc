@@ -52,6 +52,30 @@ TEST(Pipeline, TheBoardsDefaultPathAllocatesNothingWithThreeThreads) {
   ExpectBoardPathAllocatesNothing(640, 480, 320, 240, 0.02, 3);
 }
 
+// The motion and depth stages and the render share memory (pipeline.h): a second burst through
+// the same pipeline, after a render, gives the first one's depth and photo again.
+TEST(Pipeline, ASecondBurstAfterARenderGivesTheSameResult) {
+  Burst b;
+  b.config.max_working_width = 320;
+  b.config.max_working_height = 240;
+  b.SetupBoard(640, 480, 5, 0.02);
+  RenderParams params;
+  params.f_number = 2.0f;
+  uint64_t disparity[2] = {}, photo[2] = {};
+  for (int32_t run = 0; run < 2; ++run) {
+    b.pipeline.ResetBurst();
+    ASSERT_TRUE(b.sensor->CaptureBurst(b.pipeline).ok());
+    ASSERT_TRUE(b.pipeline.ComputeDepth().ok());
+    ASSERT_TRUE(b.pipeline.depth_warning().ok()) << b.pipeline.depth_warning().message();
+    disparity[run] = ImageChecksum(b.pipeline.disparity_q8());
+    int32_t rows = 0;
+    photo[run] = RenderChecksum(b.pipeline, params, &rows);
+    ASSERT_EQ(rows, 480);
+  }
+  EXPECT_EQ(disparity[1], disparity[0]);
+  EXPECT_EQ(photo[1], photo[0]);
+}
+
 // The board's path gives the same depth and photo, bit for bit, whatever the number of threads:
 // every task writes its own rows, and scratch is per worker.
 TEST(Pipeline, TheOutputDoesNotDependOnTheNumberOfThreads) {
