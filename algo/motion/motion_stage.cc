@@ -86,7 +86,7 @@ Status MotionStage::Carve(Arena& arena) {
   LB_RETURN_IF_ERROR(ref_.Carve(c.width, c.height, c.pyramid_levels, arena));
   LB_RETURN_IF_ERROR(view_.Carve(c.width, c.height, c.pyramid_levels, arena));
   LB_RETURN_IF_ERROR(corners_.Carve(c.width, c.height, Cell(c), arena));
-  LB_RETURN_IF_ERROR(tracker_.Carve(c.tracker, arena));
+  LB_RETURN_IF_ERROR(tracker_.Carve(c.tracker, arena, c.workers));
   max_points_ = corners_.max_corners();
   LB_RETURN_IF_ERROR(bundle_.Carve(c.views, max_points_, arena));
   const size_t n = static_cast<size_t>(max_points_);
@@ -183,7 +183,7 @@ Status MotionStage::Track(const ConstImageU8* views, int32_t reference, MotionRe
         dy[i] = guess ? static_cast<int32_t>(int64_t{uy[i]} * d / (d - 1)) : 0;
       }
       tracker_.Track(ref_, view_, pos_q16_, pos_q16_ + max_points_, n, dx, dy,
-                     obs_ok_ + static_cast<size_t>(v) * n);
+                     obs_ok_ + static_cast<size_t>(v) * n, runner_);
     }
   }
   return Status::Ok();

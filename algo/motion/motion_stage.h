@@ -73,6 +73,7 @@ struct MotionConfig {
   double outlier_px = 0.8;
   double min_parallax_px = 1.0;  // depth-dependent motion the best view must show
   int32_t blur_percent = 55;     // a frame whose sharpness is below this % of the median: blurred
+  int32_t workers = 1;           // the tracker's window buffers (task_runner.h), 1..kMaxWorkers
 };
 
 enum class MotionDiagnosis : uint8_t {
@@ -125,6 +126,9 @@ class MotionStage {
   static Status Validate(const MotionConfig& config);
   static size_t RequiredBytes(const MotionConfig& config);
   Status Configure(const MotionConfig& config, Arena& arena);
+  // Where the tracker runs its points (borrowed; nullptr: on the caller), with at most
+  // config.workers workers. The result does not depend on it.
+  void SetRunner(TaskRunner* runner) { runner_ = runner; }
 
   // `views` (config.views of them) are RGB8 or grey images of the working resolution. Fills
   // `result` and returns Ok, or a kDegenerate status whose message says what to do (the
@@ -152,6 +156,7 @@ class MotionStage {
   GreyPyramid ref_, view_;
   CornerDetector corners_;
   Tracker tracker_;
+  TaskRunner* runner_ = nullptr;
   Bundle bundle_;
   Corner* corner_ = nullptr;     // max_points_
   int32_t* pos_q16_ = nullptr;   // corner x (max_points_), then y (max_points_)

@@ -28,36 +28,57 @@ inline int32_t RoundQ16(double v) {
 
 }  // namespace
 
-Status Tracker::Carve(const TrackerParams& params, Arena& arena) {
+Status Tracker::Carve(const TrackerParams& params, Arena& arena, int32_t workers) {
   if (params.radius < 1 || params.radius > 8 || params.max_iterations < 1 ||
       params.max_iterations > 50 || params.max_error_q4 < 1) {
     return Status(Code::kInvalidArgument, "tracker: radius %d (1..8), iterations %d (1..50)",
                   params.radius, params.max_iterations);
   }
+  if (workers < 1 || workers > kMaxWorkers) {
+    return Status(Code::kInvalidArgument, "tracker: %d workers (1..%d)", workers, kMaxWorkers);
+  }
   params_ = params;
+  workers_ = workers;
   const size_t t = 2 * static_cast<size_t>(params.radius) + 3;
   const size_t w = 2 * static_cast<size_t>(params.radius) + 1;
-  tmpl_ = arena.Allocate<int32_t>(t * t);
-  gx_ = arena.Allocate<int32_t>(w * w);
-  gy_ = arena.Allocate<int32_t>(w * w);
+  for (int32_t i = 0; i < workers; ++i) {
+    windows_[i].tmpl = arena.Allocate<int32_t>(t * t);
+    windows_[i].gx = arena.Allocate<int32_t>(w * w);
+    windows_[i].gy = arena.Allocate<int32_t>(w * w);
+  }
   return Status::Ok();
 }
 
 void Tracker::Track(const GreyPyramid& ref, const GreyPyramid& view, const int32_t* x_q16,
-                    const int32_t* y_q16, int32_t n, int32_t* dx_q16, int32_t* dy_q16,
-                    uint8_t* ok) const {
-  for (int32_t i = 0; i < n; ++i) {
+                    const int32_t* y_q16, int32_t n, int32_t* dx_q16, int32_t* dy_q16, uint8_t* ok,
+                    TaskRunner* runner) const {
+  // Runs of points a task: enough to outweigh a wake-up, small enough to even out the load.
+  constexpr int32_t kRun = 64;
+  if (runner == nullptr || runner->workers() > workers_ || n <= kRun) {
+    TrackRange(windows_[0], ref, view, x_q16, y_q16, 0, n, dx_q16, dy_q16, ok);
+    return;
+  }
+  ParallelFor(*runner, (n + kRun - 1) / kRun, [&](int32_t task, int32_t worker) {
+    const int32_t begin = task * kRun, end = begin + kRun < n ? begin + kRun : n;
+    TrackRange(windows_[worker], ref, view, x_q16, y_q16, begin, end, dx_q16, dy_q16, ok);
+  });
+}
+
+void Tracker::TrackRange(const Window& w, const GreyPyramid& ref, const GreyPyramid& view,
+                         const int32_t* x_q16, const int32_t* y_q16, int32_t begin, int32_t end,
+                         int32_t* dx_q16, int32_t* dy_q16, uint8_t* ok) const {
+  for (int32_t i = begin; i < end; ++i) {
     const bool guessed = dx_q16[i] != 0 || dy_q16[i] != 0;
     int32_t error = 0;
     // From a guess only the two finest levels run: the coarse ones alias a fine repetitive
     // texture and would drag the start off to a wrong period.
     const int32_t top = guessed && ref.levels() > 2 ? 1 : ref.levels() - 1;
-    bool found = TrackOne(ref, view, x_q16[i], y_q16[i], top, &dx_q16[i], &dy_q16[i], &error);
+    bool found = TrackOne(w, ref, view, x_q16[i], y_q16[i], top, &dx_q16[i], &dy_q16[i], &error);
     if (guessed) {
       int32_t dx0 = 0, dy0 = 0, error0 = 0;
       // The guess wins unless no motion matches clearly better (half the error): on a
       // repetitive texture both starts match about as well, and only the guess is right.
-      if (TrackOne(ref, view, x_q16[i], y_q16[i], ref.levels() - 1, &dx0, &dy0, &error0) &&
+      if (TrackOne(w, ref, view, x_q16[i], y_q16[i], ref.levels() - 1, &dx0, &dy0, &error0) &&
           (!found || 2 * error0 < error)) {
         found = true;
         dx_q16[i] = dx0;
@@ -68,8 +89,8 @@ void Tracker::Track(const GreyPyramid& ref, const GreyPyramid& view, const int32
   }
 }
 
-bool Tracker::TrackOne(const GreyPyramid& ref, const GreyPyramid& view, int32_t x_q16,
-                       int32_t y_q16, int32_t top, int32_t* dx_q16, int32_t* dy_q16,
+bool Tracker::TrackOne(const Window& w, const GreyPyramid& ref, const GreyPyramid& view,
+                       int32_t x_q16, int32_t y_q16, int32_t top, int32_t* dx_q16, int32_t* dy_q16,
                        int32_t* error_q4) const {
   const int32_t r = params_.radius;
   const int32_t tw = 2 * r + 3, ww = 2 * r + 1;
@@ -101,17 +122,17 @@ bool Tracker::TrackOne(const GreyPyramid& ref, const GreyPyramid& view, int32_t 
     }
     for (int32_t j = 0; j < tw; ++j) {
       for (int32_t i = 0; i < tw; ++i) {
-        tmpl_[j * tw + i] = SampleQ4(ti, px + ((i - r - 1) << 16), py + ((j - r - 1) << 16));
+        w.tmpl[j * tw + i] = SampleQ4(ti, px + ((i - r - 1) << 16), py + ((j - r - 1) << 16));
       }
     }
     int64_t gxx = 0, gyy = 0, gxy = 0;
     for (int32_t j = 0; j < ww; ++j) {
       for (int32_t i = 0; i < ww; ++i) {
-        const int32_t* t = tmpl_ + (j + 1) * tw + (i + 1);
+        const int32_t* t = w.tmpl + (j + 1) * tw + (i + 1);
         const int32_t gx = t[1] - t[-1];
         const int32_t gy = t[tw] - t[-tw];
-        gx_[j * ww + i] = gx;
-        gy_[j * ww + i] = gy;
+        w.gx[j * ww + i] = gx;
+        w.gy[j * ww + i] = gy;
         gxx += int64_t{gx} * gx;
         gyy += int64_t{gy} * gy;
         gxy += int64_t{gx} * gy;
@@ -133,9 +154,9 @@ bool Tracker::TrackOne(const GreyPyramid& ref, const GreyPyramid& view, int32_t 
       for (int32_t j = 0; j < ww; ++j) {
         for (int32_t i = 0; i < ww; ++i) {
           const int32_t e = SampleQ4(vi, qx + ((i - r) << 16), qy + ((j - r) << 16)) -
-                            tmpl_[(j + 1) * tw + (i + 1)];
-          bx += int64_t{gx_[j * ww + i]} * e;
-          by += int64_t{gy_[j * ww + i]} * e;
+                            w.tmpl[(j + 1) * tw + (i + 1)];
+          bx += int64_t{w.gx[j * ww + i]} * e;
+          by += int64_t{w.gy[j * ww + i]} * e;
           abs_err += e < 0 ? -e : e;
         }
       }

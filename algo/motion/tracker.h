@@ -14,6 +14,7 @@
 
 #include "algo/core/arena.h"
 #include "algo/core/status.h"
+#include "algo/core/task_runner.h"
 #include "algo/motion/pyramid.h"
 
 namespace lb {
@@ -26,7 +27,8 @@ struct TrackerParams {
 
 class Tracker {
  public:
-  Status Carve(const TrackerParams& params, Arena& arena);
+  // Window buffers for each of `workers` workers (1..kMaxWorkers).
+  Status Carve(const TrackerParams& params, Arena& arena, int32_t workers = 1);
 
   // Tracks `n` points from `ref` into `view` (same sizes and levels). Start guesses are the
   // displacements in `dx_q16`/`dy_q16` (0 for none); on return they hold the tracked
@@ -35,19 +37,31 @@ class Tracker {
   // matches twice as badly: a repetitive texture (bricks, tiles) locks onto a wrong period from
   // a start too far off, and a wrong guess (a frame that went back) must not cost the point
   // either.
+  // Points are independent: `runner` (nullptr: the caller) tracks runs of them on its workers,
+  // at most the carved number, with the same result.
   void Track(const GreyPyramid& ref, const GreyPyramid& view, const int32_t* x_q16,
-             const int32_t* y_q16, int32_t n, int32_t* dx_q16, int32_t* dy_q16, uint8_t* ok) const;
+             const int32_t* y_q16, int32_t n, int32_t* dx_q16, int32_t* dy_q16, uint8_t* ok,
+             TaskRunner* runner = nullptr) const;
 
  private:
+  // One worker's window.
+  struct Window {
+    int32_t* tmpl = nullptr;  // (2r+3)^2 reference samples, Q4
+    int32_t* gx = nullptr;    // (2r+1)^2
+    int32_t* gy = nullptr;
+  };
+  void TrackRange(const Window& w, const GreyPyramid& ref, const GreyPyramid& view,
+                  const int32_t* x_q16, const int32_t* y_q16, int32_t begin, int32_t end,
+                  int32_t* dx_q16, int32_t* dy_q16, uint8_t* ok) const;
   // Coarse to fine from level `top`; `error_q4` receives the final mean |view - reference|
   // over the window.
-  bool TrackOne(const GreyPyramid& ref, const GreyPyramid& view, int32_t x_q16, int32_t y_q16,
-                int32_t top, int32_t* dx_q16, int32_t* dy_q16, int32_t* error_q4) const;
+  bool TrackOne(const Window& w, const GreyPyramid& ref, const GreyPyramid& view, int32_t x_q16,
+                int32_t y_q16, int32_t top, int32_t* dx_q16, int32_t* dy_q16,
+                int32_t* error_q4) const;
 
   TrackerParams params_;
-  int32_t* tmpl_ = nullptr;  // (2r+3)^2 reference samples, Q4
-  int32_t* gx_ = nullptr;    // (2r+1)^2
-  int32_t* gy_ = nullptr;
+  Window windows_[kMaxWorkers];
+  int32_t workers_ = 1;
 };
 
 }  // namespace lb

@@ -61,6 +61,7 @@ static MotionConfig MakeMotionConfig(const PipelineConfig& c, int32_t w, int32_t
   m.height = h;
   m.views = c.frames;
   m.estimate_focal = !(c.focal_px > 0);  // nobody told the lens: the frames may
+  m.workers = c.workers;
   return m;
 }
 
@@ -164,6 +165,7 @@ Status Pipeline::Carve(Arena& arena) {
 
 void Pipeline::SetRunner(TaskRunner* runner) {
   depth_.SetRunner(runner);
+  motion_.SetRunner(runner);
   render_.SetRunner(runner);
 }
 
