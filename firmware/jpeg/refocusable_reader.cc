@@ -10,6 +10,7 @@
 #include <cstring>
 #include <string_view>
 
+#include "firmware/codecs/exif.h"
 #include "firmware/jpeg/base64.h"
 
 namespace lb {
@@ -360,7 +361,10 @@ Status ReadRefocusable(const uint8_t* data, size_t size, const char* name, Refoc
   }
   LB_RETURN_IF_ERROR(ReadDepth(name, fields, out));
   LB_RETURN_IF_ERROR(ReadImage(name, fields, out));
-  return ReadFocus(fields, out);
+  LB_RETURN_IF_ERROR(ReadFocus(fields, out));
+  // From the bytes in hand: a re-render must not open the file a second time.
+  out->orientation = ExifOrientation(data, size);
+  return Status::Ok();
 }
 
 Status ReadRefocusableFile(const char* path, RefocusableImage* out) {

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "algo/core/status.h"
-#include "firmware/jpeg/png_memory.h"
+#include "firmware/codecs/png_reader.h"
 #include "firmware/jpeg/xmp_writer.h"
 
 namespace lb {
@@ -19,6 +19,7 @@ struct RefocusableImage {
   int32_t height = 0;
   RefocusableXmp xmp;  // depth.data holds the PNG bytes, image the original JPEG (may be empty)
   GrayPng depth;       // the decoded depth image
+  int32_t orientation = 0;  // the photo's EXIF Orientation 1..8, 0 when it records none
 };
 
 Status ReadRefocusable(const uint8_t* data, size_t size, const char* name, RefocusableImage* out);

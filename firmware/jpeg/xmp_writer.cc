@@ -4,8 +4,8 @@
 #include <cstdio>
 #include <cstring>
 
+#include "firmware/codecs/png_writer.h"
 #include "firmware/jpeg/base64.h"
-#include "firmware/jpeg/png_memory.h"
 
 namespace lb {
 namespace {

@@ -11,8 +11,8 @@
 
 #include "algo/core/image.h"
 #include "algo/core/status.h"
+#include "firmware/codecs/jpeg_writer.h"
 #include "firmware/jpeg/depth_encoding.h"
-#include "firmware/jpeg/jpeg_writer.h"
 
 namespace lb {
 

@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <cstdio>
 
-#include "sim/files/exif_focal.h"
+#include "firmware/codecs/exif.h"
 #include "tests/fuzz/decode_check.h"
 
 namespace {

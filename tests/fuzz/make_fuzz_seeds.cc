@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "algo/core/image.h"
-#include "firmware/jpeg/jpeg_writer.h"
+#include "firmware/codecs/jpeg_writer.h"
 #include "firmware/jpeg/refocusable_reader.h"
 #include "firmware/jpeg/xmp_writer.h"
 #include "tests/sim/files/test_images.h"

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "firmware/app/refocusable.h"
-#include "firmware/jpeg/jpeg_writer.h"
+#include "firmware/codecs/jpeg_writer.h"
 #include "tests/firmware/cli/cli_fixture.h"
 #include "tests/sim/files/test_images.h"
 

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "firmware/jpeg/jpeg_writer.h"
+#include "firmware/codecs/jpeg_writer.h"
 #include "tests/firmware/jpeg/jpeg_test_util.h"
 
 namespace lb {

@@ -1,4 +1,4 @@
-#include "firmware/jpeg/jpeg_writer.h"
+#include "firmware/codecs/jpeg_writer.h"
 
 #include <gtest/gtest.h>
 #include <libexif/exif-data.h>

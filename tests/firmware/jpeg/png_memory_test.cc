@@ -1,4 +1,5 @@
-#include "firmware/jpeg/png_memory.h"
+#include "firmware/codecs/png_reader.h"
+#include "firmware/codecs/png_writer.h"
 
 #include <gtest/gtest.h>
 

@@ -3,7 +3,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/files/image_file.h"
+#include "firmware/codecs/image_file.h"
 #include "tests/sim/files/recording_sink.h"
 #include "tests/sim/files/test_images.h"
 

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "algo/core/frame.h"
-#include "sim/files/image_file.h"
+#include "firmware/codecs/image_file.h"
 
 namespace lb::test {
 

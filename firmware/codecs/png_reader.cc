@@ -1,14 +1,17 @@
 // PNG through libpng. libpng reports errors by longjmp: everything that must survive one (the
 // png structs, the row buffers) lives in PngReader, so nothing with a destructor is skipped.
+#include "firmware/codecs/png_reader.h"
+
 #include <png.h>
 
 #include <cinttypes>
 #include <csetjmp>
 #include <cstring>
 
-#include "sim/files/decoder.h"
+#include "firmware/codecs/decoder.h"
 
-namespace lb::files {
+namespace lb {
+namespace codecs {
 namespace {
 
 class PngReader {
@@ -36,6 +39,7 @@ class PngReader {
   }
 
   Status Decode();
+  Status CheckPlainGray(png_uint_32 width, png_uint_32 height, int color, int interlace) const;
   Status Deliver(const uint8_t* rows, int32_t y0, int32_t count);
 
   ByteSource& src_;
@@ -80,7 +84,8 @@ Status PngReader::Decode() {
   png_uint_32 width = 0, height = 0;
   int depth = 0, color = 0, interlace = 0;
   png_get_IHDR(png_, info_, &width, &height, &depth, &color, &interlace, nullptr, nullptr);
-  LB_RETURN_IF_ERROR(CheckImageSize(name, width, height));
+  LB_RETURN_IF_ERROR(CheckImageSize(name, width, height, request_.max_side));
+  if (request_.plain_gray) LB_RETURN_IF_ERROR(CheckPlainGray(width, height, color, interlace));
   const bool gray = (color & PNG_COLOR_MASK_COLOR) == 0;
   const bool wide = depth == 16;
   const PixelFormat format = gray ? (wide ? PixelFormat::kGray16 : PixelFormat::kGray8)
@@ -140,6 +145,23 @@ Status PngReader::Decode() {
   return request_.sink->EndFrame();
 }
 
+Status PngReader::CheckPlainGray(png_uint_32 width, png_uint_32 height, int color,
+                                 int interlace) const {
+  const char* name = request_.name;
+  if (color != PNG_COLOR_TYPE_GRAY) {
+    return Status(Code::kCorruptData, "%s: PNG: not a greyscale image without alpha", name);
+  }
+  if (interlace != PNG_INTERLACE_NONE)
+    return Status(Code::kCorruptData, "%s: PNG: interlaced", name);
+  if ((request_.width > 0 && width != static_cast<png_uint_32>(request_.width)) ||
+      (request_.height > 0 && height != static_cast<png_uint_32>(request_.height))) {
+    return Status(Code::kCorruptData, "%s: PNG: image is %ux%u, expected %dx%d", name,
+                  static_cast<unsigned>(width), static_cast<unsigned>(height), request_.width,
+                  request_.height);
+  }
+  return Status::Ok();
+}
+
 Status PngReader::Deliver(const uint8_t* rows, int32_t y0, int32_t count) {
   FrameRows strip;
   strip.y0 = y0;
@@ -149,6 +171,34 @@ Status PngReader::Deliver(const uint8_t* rows, int32_t y0, int32_t count) {
   return request_.sink->Rows(strip);
 }
 
+// Gathers grey rows (8 or 16 bits, native-endian) as 16-bit values, growing with the rows
+// actually decoded so a header that lies about its size costs nothing.
+class GrayValues final : public FrameSink {
+ public:
+  explicit GrayValues(GrayPng* out) : out_(out) {}
+  Status BeginFrame(const FrameInfo& info) override {
+    out_->width = info.width;
+    out_->height = info.height;
+    out_->bits = info.format == PixelFormat::kGray16 ? 16 : 8;
+    return Status::Ok();
+  }
+  Status Rows(const FrameRows& rows) override {
+    for (int32_t y = 0; y < rows.height; ++y) {
+      const uint8_t* row = rows.planes[0] + y * rows.strides[0];
+      for (int32_t x = 0; x < out_->width; ++x) {
+        uint16_t v = row[x];
+        if (out_->bits == 16) memcpy(&v, row + 2 * x, 2);
+        out_->values.push_back(v);
+      }
+    }
+    return Status::Ok();
+  }
+  Status EndFrame() override { return Status::Ok(); }
+
+ private:
+  GrayPng* out_;
+};
+
 }  // namespace
 
 Status DecodePng(ByteSource& src, const DecodeRequest& request) {
@@ -156,4 +206,28 @@ Status DecodePng(ByteSource& src, const DecodeRequest& request) {
   return reader.Run();
 }
 
-}  // namespace lb::files
+}  // namespace codecs
+
+Status DecodeGrayPng(const uint8_t* data, size_t size, const char* name, int32_t max_side,
+                     int32_t width, int32_t height, GrayPng* out) {
+  *out = GrayPng();
+  if (size < 8 || png_sig_cmp(data, 0, 8) != 0) {
+    return Status(Code::kCorruptData, "%s: not a PNG", name);
+  }
+  codecs::MemorySource src(data, size);
+  ImageFileInfo info;
+  codecs::GrayValues values(out);
+  codecs::DecodeRequest request;
+  request.name = name;
+  request.info = &info;
+  request.sink = &values;
+  request.max_side = max_side;
+  request.width = width;
+  request.height = height;
+  request.plain_gray = true;
+  Status s = codecs::DecodePng(src, request);
+  if (!s.ok()) *out = GrayPng();
+  return s;
+}
+
+}  // namespace lb

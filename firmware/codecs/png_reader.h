@@ -1,17 +1,15 @@
-// Greyscale PNG to and from memory (libpng): the depth image inside the refocusable JPEG.
+// The product's PNG reader (png_reader.cc, libpng): image files and frames go through
+// image_file.h like every format; this is its other door, for the grey depth image that a
+// refocusable JPEG carries in memory.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
-#include "algo/core/image.h"
 #include "algo/core/status.h"
 
 namespace lb {
-
-// Encodes `values` (one channel) as an 8-bit (values 0..255) or 16-bit grey PNG.
-Status EncodeGrayPng(ConstImageU16 values, int bits, std::vector<uint8_t>* png);
 
 struct GrayPng {
   int32_t width = 0;
@@ -22,7 +20,7 @@ struct GrayPng {
 
 // Decodes a non-interlaced grey PNG of at most `max_side` pixels a side and, unless they are 0,
 // exactly `width` x `height`. `name` is used in error messages. Anything else (colour, alpha,
-// interlace, wrong size, bad CRC, truncation) is a Status.
+// interlace, wrong size, bad CRC, truncation) is a Status, and leaves `out` empty.
 Status DecodeGrayPng(const uint8_t* data, size_t size, const char* name, int32_t max_side,
                      int32_t width, int32_t height, GrayPng* out);
 

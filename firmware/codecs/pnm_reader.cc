@@ -2,9 +2,9 @@
 #include <cinttypes>
 #include <cstring>
 
-#include "sim/files/decoder.h"
+#include "firmware/codecs/decoder.h"
 
-namespace lb::files {
+namespace lb::codecs {
 namespace {
 
 class PnmHeader {
@@ -181,4 +181,4 @@ Status DecodePnm(ByteSource& src, const DecodeRequest& request) {
   return request.sink->EndFrame();
 }
 
-}  // namespace lb::files
+}  // namespace lb::codecs

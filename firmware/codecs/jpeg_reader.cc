@@ -12,9 +12,9 @@
 #include <jpeglib.h>
 // clang-format on
 
-#include "sim/files/decoder.h"
+#include "firmware/codecs/decoder.h"
 
-namespace lb::files {
+namespace lb::codecs {
 namespace {
 
 // A real progressive JPEG has about ten scans; thousands of tiny ones are a decoding-time attack.
@@ -224,4 +224,4 @@ Status DecodeJpeg(ByteSource& src, const DecodeRequest& request) {
   return reader.Run();
 }
 
-}  // namespace lb::files
+}  // namespace lb::codecs

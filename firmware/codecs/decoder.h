@@ -1,5 +1,5 @@
-// Internal to sim/files: the byte sources the decoders read from (a file or bytes in memory) and
-// the one entry point of each format's decoder.
+// Internal to firmware/codecs: the byte sources the readers read from (a file or bytes in memory)
+// and the one entry point of each format's reader.
 #pragma once
 
 #include <cstddef>
@@ -8,9 +8,9 @@
 
 #include "algo/core/frame.h"
 #include "algo/core/status.h"
-#include "sim/files/image_file.h"
+#include "firmware/codecs/image_file.h"
 
-namespace lb::files {
+namespace lb::codecs {
 
 // Sequential bytes with a little look-ahead, so the format can be detected without consuming
 // the signature the decoder then checks again.
@@ -81,14 +81,21 @@ struct DecodeRequest {
   ImageFileInfo* info = nullptr;
   FrameSink* sink = nullptr;
   int32_t index = 0;
+  // Narrower than any image file (the depth image of a refocusable JPEG), checked on the header
+  // before anything is allocated: a side limit, and when non-zero the only size accepted.
+  int32_t max_side = kMaxImageSide;
+  int32_t width = 0;
+  int32_t height = 0;
+  bool plain_gray = false;  // PNG only: grey without alpha, not interlaced
 };
 
 Status DecodePnm(ByteSource& src, const DecodeRequest& request);
 Status DecodePng(ByteSource& src, const DecodeRequest& request);
 Status DecodeJpeg(ByteSource& src, const DecodeRequest& request);
 
-// Checks the header's size against kMaxImageSide.
-Status CheckImageSize(const char* name, int64_t width, int64_t height);
+// Checks the header's size against `max_side` (kMaxImageSide for a file).
+Status CheckImageSize(const char* name, int64_t width, int64_t height,
+                      int32_t max_side = kMaxImageSide);
 
 // True on a little-endian host (the readers deliver native-endian 16-bit samples).
 inline bool HostIsLittleEndian() {
@@ -98,4 +105,4 @@ inline bool HostIsLittleEndian() {
   return first == 1;
 }
 
-}  // namespace lb::files
+}  // namespace lb::codecs

@@ -1,17 +1,17 @@
 // JpegWriter: encodes the render stage's YCbCr 4:2:0 strips straight into a JPEG with
 // libjpeg-turbo's raw-data path (no colour conversion, no full-resolution frame), with an EXIF
-// APP1 segment built by libexif and optional extra APP segments (the refocusable XMP).
+// APP1 segment (exif.h) and optional extra APP segments (the refocusable XMP).
 // libjpeg errors and write failures come back as a Status; nothing calls exit().
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 #include <memory>
-#include <string>
 #include <vector>
 
 #include "algo/core/image.h"
 #include "algo/core/status.h"
+#include "firmware/codecs/exif.h"
 #include "firmware/storage/atomic_file.h"
 
 namespace lb {
@@ -24,23 +24,10 @@ struct JpegSegment {
   std::vector<uint8_t> payload;
 };
 
-struct JpegMetadata {
-  std::string make;
-  std::string model;
-  std::string software;
-  std::string datetime_original;            // "YYYY:MM:DD HH:MM:SS"
-  float f_number = 0.0f;                    // 0 = not recorded
-  int32_t focal_35mm = 0;                   // 35 mm equivalent focal length, mm; 0 = not recorded
-  int32_t orientation = 0;                  // EXIF Orientation 1..8; 0 = not recorded
+// The EXIF tags (written when any is set; otherwise a JFIF header is) and the other segments.
+struct JpegMetadata : ExifTags {
   std::vector<JpegSegment> extra_segments;  // written after the EXIF segment, in order
-
-  // EXIF is written when any field above is set; otherwise a JFIF header is.
-  bool has_exif() const;
 };
-
-// Builds the EXIF APP1 payload ("Exif\0\0" + TIFF) for a width x height image.
-Status BuildExif(const JpegMetadata& meta, int32_t width, int32_t height,
-                 std::vector<uint8_t>* payload);
 
 class JpegWriter {
  public:

@@ -1,4 +1,4 @@
-#include "sim/files/image_file.h"
+#include "firmware/codecs/image_file.h"
 
 #include <cerrno>
 #include <cinttypes>
@@ -6,74 +6,13 @@
 #include <cstring>
 #include <memory>
 
-#include "sim/files/decoder.h"
+#include "firmware/codecs/decoder.h"
 
 namespace lb {
-namespace files {
-
-size_t ByteSource::Read(void* dst, size_t n) {
-  uint8_t* out = static_cast<uint8_t*>(dst);
-  size_t got = 0;
-  while (got < n && ahead_begin_ < ahead_end_) out[got++] = ahead_[ahead_begin_++];
-  if (got < n) got += ReadRaw(out + got, n - got);
-  consumed_ += got;
-  return got;
-}
-
-size_t ByteSource::Peek(uint8_t* dst, size_t n) {
-  if (n > kMaxPeek) n = kMaxPeek;
-  if (ahead_end_ - ahead_begin_ < n) {
-    memmove(ahead_, ahead_ + ahead_begin_, ahead_end_ - ahead_begin_);
-    ahead_end_ -= ahead_begin_;
-    ahead_begin_ = 0;
-    ahead_end_ += ReadRaw(ahead_ + ahead_end_, n - ahead_end_);
-  }
-  const size_t have = ahead_end_ - ahead_begin_ < n ? ahead_end_ - ahead_begin_ : n;
-  memcpy(dst, ahead_ + ahead_begin_, have);
-  return have;
-}
-
-size_t MemorySource::ReadRaw(uint8_t* dst, size_t n) {
-  const size_t left = size_ - pos_;
-  if (n > left) n = left;
-  if (n > 0) memcpy(dst, data_ + pos_, n);
-  pos_ += n;
-  return n;
-}
-
-size_t FileSource::ReadRaw(uint8_t* dst, size_t n) {
-  const size_t got = fread(dst, 1, n, file_);
-  if (got < n && ferror(file_) && error_ == 0) error_ = errno != 0 ? errno : EIO;
-  return got;
-}
-
-Buffer::~Buffer() { free(data_); }
-
-bool Buffer::Allocate(uint64_t bytes) {
-  free(data_);
-  data_ = nullptr;
-  if (bytes == 0 || bytes > SIZE_MAX / 2) return false;
-  data_ = static_cast<uint8_t*>(malloc(static_cast<size_t>(bytes)));
-  return data_ != nullptr;
-}
-
-Status CheckImageSize(const char* name, int64_t width, int64_t height) {
-  if (width <= 0 || height <= 0) {
-    return Status(Code::kCorruptData, "%s: bad image size %" PRId64 "x%" PRId64, name, width,
-                  height);
-  }
-  if (width > kMaxImageSide || height > kMaxImageSide) {
-    return Status(Code::kUnsupported, "%s: %" PRId64 "x%" PRId64 " is larger than %dx%d", name,
-                  width, height, kMaxImageSide, kMaxImageSide);
-  }
-  return Status::Ok();
-}
-
-}  // namespace files
 
 namespace {
 
-using files::ByteSource;
+using codecs::ByteSource;
 
 Status Detect(ByteSource& src, const char* name, ImageFileType* type) {
   static constexpr uint8_t kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
@@ -97,15 +36,15 @@ Status Detect(ByteSource& src, const char* name, ImageFileType* type) {
   return Status::Ok();
 }
 
-Status Decode(ByteSource& src, ImageFileType type, const files::DecodeRequest& request) {
+Status Decode(ByteSource& src, ImageFileType type, const codecs::DecodeRequest& request) {
   if (type == ImageFileType::kAuto) LB_RETURN_IF_ERROR(Detect(src, request.name, &type));
   switch (type) {
     case ImageFileType::kPnm:
-      return files::DecodePnm(src, request);
+      return codecs::DecodePnm(src, request);
     case ImageFileType::kPng:
-      return files::DecodePng(src, request);
+      return codecs::DecodePng(src, request);
     case ImageFileType::kJpeg:
-      return files::DecodeJpeg(src, request);
+      return codecs::DecodeJpeg(src, request);
     case ImageFileType::kAuto:
       break;
   }
@@ -170,17 +109,17 @@ Status OpenFile(const char* path, FilePtr* out) {
   return Status::Ok();
 }
 
-Status DecodeFile(const char* path, const files::DecodeRequest& request) {
+Status DecodeFile(const char* path, const codecs::DecodeRequest& request) {
   FilePtr file;
   LB_RETURN_IF_ERROR(OpenFile(path, &file));
-  files::FileSource src(file.get());
+  codecs::FileSource src(file.get());
   return Decode(src, ImageFileType::kAuto, request);
 }
 
 }  // namespace
 
 Status ProbeImageFile(const char* path, ImageFileInfo* info) {
-  files::DecodeRequest request;
+  codecs::DecodeRequest request;
   request.name = path;
   request.info = info;
   return DecodeFile(path, request);
@@ -188,7 +127,7 @@ Status ProbeImageFile(const char* path, ImageFileInfo* info) {
 
 Status StreamImageFile(const char* path, int32_t index, FrameSink& sink) {
   ImageFileInfo info;
-  files::DecodeRequest request;
+  codecs::DecodeRequest request;
   request.name = path;
   request.info = &info;
   request.sink = &sink;
@@ -206,8 +145,8 @@ Status ReadImageFile(const char* path, ImageFileInfo* info, std::vector<uint8_t>
 Status ReadImageMemory(const uint8_t* data, size_t size, const char* name, ImageFileInfo* info,
                        std::vector<uint8_t>* pixels, ImageFileType type) {
   CollectSink collect(name, info, pixels);
-  files::MemorySource src(data, size);
-  files::DecodeRequest request;
+  codecs::MemorySource src(data, size);
+  codecs::DecodeRequest request;
   request.name = name;
   request.info = info;
   request.sink = &collect;
@@ -218,8 +157,8 @@ Status ReadImageMemory(const uint8_t* data, size_t size, const char* name, Image
 
 Status ProbeImageMemory(const uint8_t* data, size_t size, const char* name, ImageFileInfo* info,
                         ImageFileType type) {
-  files::MemorySource src(data, size);
-  files::DecodeRequest request;
+  codecs::MemorySource src(data, size);
+  codecs::DecodeRequest request;
   request.name = name;
   request.info = info;
   return Decode(src, type, request);
