@@ -53,6 +53,32 @@ bool Buffer::Allocate(uint64_t bytes) {
   return data_ != nullptr;
 }
 
+bool SetHeader(const DecodeRequest& request, PixelFormat format, int32_t width, int32_t height) {
+  request.info->format = format;
+  request.info->width = width;
+  request.info->height = height;
+  return request.sink != nullptr;
+}
+
+Status BeginFrame(const DecodeRequest& request) {
+  FrameInfo frame;
+  frame.index = request.index;
+  frame.format = request.info->format;
+  frame.width = request.info->width;
+  frame.height = request.info->height;
+  return request.sink->BeginFrame(frame);
+}
+
+Status DeliverRows(const DecodeRequest& request, const uint8_t* rows, size_t row_bytes, int32_t y0,
+                   int32_t count) {
+  FrameRows strip;
+  strip.y0 = y0;
+  strip.height = count;
+  strip.planes[0] = rows;
+  strip.strides[0] = static_cast<ptrdiff_t>(row_bytes);
+  return request.sink->Rows(strip);
+}
+
 Status CheckImageSize(const char* name, int64_t width, int64_t height, int32_t max_side) {
   if (width <= 0 || height <= 0) {
     return Status(Code::kCorruptData, "%s: bad image size %" PRId64 "x%" PRId64, name, width,

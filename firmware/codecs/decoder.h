@@ -93,6 +93,18 @@ Status DecodePnm(ByteSource& src, const DecodeRequest& request);
 Status DecodePng(ByteSource& src, const DecodeRequest& request);
 Status DecodeJpeg(ByteSource& src, const DecodeRequest& request);
 
+// Records the header in request.info; true when the pixels are wanted too (a sink is given).
+bool SetHeader(const DecodeRequest& request, PixelFormat format, int32_t width, int32_t height);
+// Starts frame request.index in the sink with the header SetHeader recorded.
+Status BeginFrame(const DecodeRequest& request);
+// Hands rows y0 .. y0 + count - 1, `row_bytes` apart from `rows`, to the sink.
+Status DeliverRows(const DecodeRequest& request, const uint8_t* rows, size_t row_bytes, int32_t y0,
+                   int32_t count);
+// How many rows the strip starting at row y0 of a `height`-row image has.
+inline int32_t StripRows(int32_t y0, int32_t height) {
+  return height - y0 < kImageStripRows ? height - y0 : kImageStripRows;
+}
+
 // Checks the header's size against `max_side` (kMaxImageSide for a file).
 Status CheckImageSize(const char* name, int64_t width, int64_t height,
                       int32_t max_side = kMaxImageSide);

@@ -164,19 +164,18 @@ Status JpegReader::Decode() {
                     "%s: JPEG with %d components in an unknown colour space is not supported", name,
                     cinfo_.num_components);
   }
-  request_.info->format = format;
-  request_.info->width = static_cast<int32_t>(cinfo_.image_width);
-  request_.info->height = static_cast<int32_t>(cinfo_.image_height);
-  if (request_.sink == nullptr) return Status::Ok();
+  const int32_t width = static_cast<int32_t>(cinfo_.image_width);
+  const int32_t height = static_cast<int32_t>(cinfo_.image_height);
+  if (!SetHeader(request_, format, width, height)) return Status::Ok();
 
   jpeg_start_decompress(&cinfo_);
   const int channels = format == PixelFormat::kGray8 ? 1 : 3;
   if (cinfo_.output_components != channels ||
-      cinfo_.output_width != static_cast<JDIMENSION>(request_.info->width) ||
-      cinfo_.output_height != static_cast<JDIMENSION>(request_.info->height)) {
+      cinfo_.output_width != static_cast<JDIMENSION>(width) ||
+      cinfo_.output_height != static_cast<JDIMENSION>(height)) {
     return Status(Code::kInternal, "%s: libjpeg output is %ux%u x %d, expected %dx%d x %d", name,
-                  cinfo_.output_width, cinfo_.output_height, cinfo_.output_components,
-                  request_.info->width, request_.info->height, channels);
+                  cinfo_.output_width, cinfo_.output_height, cinfo_.output_components, width,
+                  height, channels);
   }
   const size_t row_bytes = static_cast<size_t>(cinfo_.output_width) * channels;
   if (!rows_.Allocate(static_cast<uint64_t>(row_bytes) * kImageStripRows)) {
@@ -188,14 +187,9 @@ Status JpegReader::Decode() {
     pointers[y] = rows_.data() + row_bytes * static_cast<size_t>(y);
   }
 
-  FrameInfo frame;
-  frame.index = request_.index;
-  frame.format = format;
-  frame.width = request_.info->width;
-  frame.height = request_.info->height;
-  LB_RETURN_IF_ERROR(request_.sink->BeginFrame(frame));
-  for (int32_t y0 = 0; y0 < frame.height; y0 += kImageStripRows) {
-    const int32_t n = frame.height - y0 < kImageStripRows ? frame.height - y0 : kImageStripRows;
+  LB_RETURN_IF_ERROR(BeginFrame(request_));
+  for (int32_t y0 = 0; y0 < height; y0 += kImageStripRows) {
+    const int32_t n = StripRows(y0, height);
     int32_t done = 0;
     while (done < n) {
       const JDIMENSION got =
@@ -205,12 +199,7 @@ Status JpegReader::Decode() {
       }
       done += static_cast<int32_t>(got);
     }
-    FrameRows strip;
-    strip.y0 = y0;
-    strip.height = n;
-    strip.planes[0] = rows_.data();
-    strip.strides[0] = static_cast<ptrdiff_t>(row_bytes);
-    LB_RETURN_IF_ERROR(request_.sink->Rows(strip));
+    LB_RETURN_IF_ERROR(DeliverRows(request_, rows_.data(), row_bytes, y0, n));
   }
   // Reads on to the EOI marker, so corrupt or missing data after the last row is still an error.
   jpeg_finish_decompress(&cinfo_);

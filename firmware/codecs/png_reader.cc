@@ -40,7 +40,6 @@ class PngReader {
 
   Status Decode();
   Status CheckPlainGray(png_uint_32 width, png_uint_32 height, int color, int interlace) const;
-  Status Deliver(const uint8_t* rows, int32_t y0, int32_t count);
 
   ByteSource& src_;
   const DecodeRequest& request_;
@@ -90,10 +89,8 @@ Status PngReader::Decode() {
   const bool wide = depth == 16;
   const PixelFormat format = gray ? (wide ? PixelFormat::kGray16 : PixelFormat::kGray8)
                                   : (wide ? PixelFormat::kRgb16 : PixelFormat::kRgb8);
-  request_.info->format = format;
-  request_.info->width = static_cast<int32_t>(width);
-  request_.info->height = static_cast<int32_t>(height);
-  if (request_.sink == nullptr) return Status::Ok();
+  const int32_t rows = static_cast<int32_t>(height);
+  if (!SetHeader(request_, format, static_cast<int32_t>(width), rows)) return Status::Ok();
 
   if (color == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(png_);
   if (gray && depth < 8) png_set_expand_gray_1_2_4_to_8(png_);
@@ -115,29 +112,24 @@ Status PngReader::Decode() {
     return Status(Code::kOutOfMemory, "%s: no memory for %ux%d PNG rows", name, width, buffer_rows);
   }
 
-  FrameInfo frame;
-  frame.index = request_.index;
-  frame.format = format;
-  frame.width = static_cast<int32_t>(width);
-  frame.height = static_cast<int32_t>(height);
-  LB_RETURN_IF_ERROR(request_.sink->BeginFrame(frame));
+  LB_RETURN_IF_ERROR(BeginFrame(request_));
   if (passes > 1) {
     for (int pass = 0; pass < passes; ++pass) {
-      for (int32_t y = 0; y < frame.height; ++y) {
+      for (int32_t y = 0; y < rows; ++y) {
         png_read_row(png_, rows_.data() + row_bytes_ * static_cast<size_t>(y), nullptr);
       }
     }
-    for (int32_t y0 = 0; y0 < frame.height; y0 += kImageStripRows) {
-      const int32_t n = frame.height - y0 < kImageStripRows ? frame.height - y0 : kImageStripRows;
-      LB_RETURN_IF_ERROR(Deliver(rows_.data() + row_bytes_ * static_cast<size_t>(y0), y0, n));
+    for (int32_t y0 = 0; y0 < rows; y0 += kImageStripRows) {
+      const uint8_t* strip = rows_.data() + row_bytes_ * static_cast<size_t>(y0);
+      LB_RETURN_IF_ERROR(DeliverRows(request_, strip, row_bytes_, y0, StripRows(y0, rows)));
     }
   } else {
-    for (int32_t y0 = 0; y0 < frame.height; y0 += kImageStripRows) {
-      const int32_t n = frame.height - y0 < kImageStripRows ? frame.height - y0 : kImageStripRows;
+    for (int32_t y0 = 0; y0 < rows; y0 += kImageStripRows) {
+      const int32_t n = StripRows(y0, rows);
       for (int32_t y = 0; y < n; ++y) {
         png_read_row(png_, rows_.data() + row_bytes_ * static_cast<size_t>(y), nullptr);
       }
-      LB_RETURN_IF_ERROR(Deliver(rows_.data(), y0, n));
+      LB_RETURN_IF_ERROR(DeliverRows(request_, rows_.data(), row_bytes_, y0, n));
     }
   }
   // Reads up to IEND, so a broken CRC after the image data is still an error.
@@ -160,15 +152,6 @@ Status PngReader::CheckPlainGray(png_uint_32 width, png_uint_32 height, int colo
                   request_.height);
   }
   return Status::Ok();
-}
-
-Status PngReader::Deliver(const uint8_t* rows, int32_t y0, int32_t count) {
-  FrameRows strip;
-  strip.y0 = y0;
-  strip.height = count;
-  strip.planes[0] = rows;
-  strip.strides[0] = static_cast<ptrdiff_t>(row_bytes_);
-  return request_.sink->Rows(strip);
 }
 
 // Gathers grey rows (8 or 16 bits, native-endian) as 16-bit values, growing with the rows

@@ -135,10 +135,8 @@ Status DecodePnm(ByteSource& src, const DecodeRequest& request) {
   const bool wide = maxval > 255;
   const PixelFormat format = channels == 1 ? (wide ? PixelFormat::kGray16 : PixelFormat::kGray8)
                                            : (wide ? PixelFormat::kRgb16 : PixelFormat::kRgb8);
-  request.info->format = format;
-  request.info->width = static_cast<int32_t>(width);
-  request.info->height = static_cast<int32_t>(height);
-  if (request.sink == nullptr) return Status::Ok();
+  const int32_t height_rows = static_cast<int32_t>(height);
+  if (!SetHeader(request, format, static_cast<int32_t>(width), height_rows)) return Status::Ok();
 
   const size_t samples = static_cast<size_t>(width) * static_cast<size_t>(channels);
   const size_t row_bytes = samples * (wide ? 2 : 1);
@@ -149,14 +147,9 @@ Status DecodePnm(ByteSource& src, const DecodeRequest& request) {
                   kImageStripRows);
   }
 
-  FrameInfo frame;
-  frame.index = request.index;
-  frame.format = format;
-  frame.width = static_cast<int32_t>(width);
-  frame.height = static_cast<int32_t>(height);
-  LB_RETURN_IF_ERROR(request.sink->BeginFrame(frame));
-  for (int32_t y0 = 0; y0 < frame.height; y0 += kImageStripRows) {
-    const int32_t rows = frame.height - y0 < kImageStripRows ? frame.height - y0 : kImageStripRows;
+  LB_RETURN_IF_ERROR(BeginFrame(request));
+  for (int32_t y0 = 0; y0 < height_rows; y0 += kImageStripRows) {
+    const int32_t rows = StripRows(y0, height_rows);
     const size_t want = row_bytes * static_cast<size_t>(rows);
     const size_t got = src.Read(strip.data(), want);
     if (got != want) {
@@ -171,12 +164,7 @@ Status DecodePnm(ByteSource& src, const DecodeRequest& request) {
       LB_RETURN_IF_ERROR(ConvertRow(strip.data() + row_bytes * static_cast<size_t>(y), samples,
                                     maxval, name, y0 + y));
     }
-    FrameRows strip_rows;
-    strip_rows.y0 = y0;
-    strip_rows.height = rows;
-    strip_rows.planes[0] = strip.data();
-    strip_rows.strides[0] = static_cast<ptrdiff_t>(row_bytes);
-    LB_RETURN_IF_ERROR(request.sink->Rows(strip_rows));
+    LB_RETURN_IF_ERROR(DeliverRows(request, strip.data(), row_bytes, y0, rows));
   }
   return request.sink->EndFrame();
 }

@@ -17,7 +17,7 @@
 #include "firmware/codecs/jpeg_writer.h"
 #include "firmware/jpeg/refocusable_reader.h"
 #include "firmware/jpeg/xmp_writer.h"
-#include "tests/sim/files/test_images.h"
+#include "tests/firmware/codecs/test_images.h"
 
 namespace {
 

@@ -13,7 +13,7 @@
 #include "firmware/codecs/codec_decoder.h"
 #include "sim/files/file_sensor.h"
 #include "tests/algo/motion/burst.h"
-#include "tests/sim/files/test_images.h"
+#include "tests/firmware/codecs/test_images.h"
 
 namespace lb {
 namespace {

@@ -18,7 +18,7 @@
 #include "firmware/codecs/jpeg_writer.h"
 #include "tests/algo/motion/burst.h"
 #include "tests/firmware/cli/cli_fixture.h"
-#include "tests/sim/files/test_images.h"
+#include "tests/firmware/codecs/test_images.h"
 
 namespace lb {
 namespace {

@@ -13,7 +13,7 @@
 #include "firmware/app/refocusable.h"
 #include "firmware/codecs/jpeg_writer.h"
 #include "tests/firmware/cli/cli_fixture.h"
-#include "tests/sim/files/test_images.h"
+#include "tests/firmware/codecs/test_images.h"
 
 namespace lb {
 namespace {

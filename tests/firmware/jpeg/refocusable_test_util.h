@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "firmware/jpeg/xmp_writer.h"
-#include "tests/firmware/jpeg/jpeg_test_util.h"
+#include "tests/firmware/codecs/jpeg_test_util.h"
 
 namespace lb::test {
 

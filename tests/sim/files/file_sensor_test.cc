@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "tests/sim/files/recording_sink.h"
-#include "tests/sim/files/test_images.h"
+#include "tests/firmware/codecs/recording_sink.h"
+#include "tests/firmware/codecs/test_images.h"
 
 namespace lb {
 namespace {
@@ -156,6 +156,24 @@ TEST_F(FileSensorTest, FramesOfDifferentSizesAreRejectedNamingBoth) {
   EXPECT_EQ(s.code(), Code::kInvalidArgument);
   EXPECT_EQ(std::string(s.message()),
             Path("b.png") + " is 64x48 but " + Path("a.png") + " is 32x24");
+}
+
+// `refocus run` sets the limits so that the one Configure of the job refuses a size the
+// pipeline cannot take, naming the file.
+TEST_F(FileSensorTest, SizeLimitsRefuseNamingTheFirstFile) {
+  WritePnm("a.pgm", 8, 8, 1, 0);
+  WritePnm("b.pgm", 8, 8, 1, 0);
+  std::unique_ptr<FileSensor> sensor;
+  ASSERT_TRUE(FileSensor::FromDirectory(dir_.c_str(), CodecImageDecoder(), &sensor).ok());
+  SensorMode mode;
+  ASSERT_TRUE(sensor->Configure(SensorConfig{}, &mode).ok());  // no limits by default
+  sensor->LimitSize(16, 8192, 8192);
+  const Status s = sensor->Configure(SensorConfig{}, &mode);
+  EXPECT_EQ(s.code(), Code::kUnsupported);
+  EXPECT_EQ(std::string(s.message()),
+            Path("a.pgm") + ": 8x8 frames: refocus takes 16x16 .. 8192x8192");
+  sensor->LimitSize(8, 8, 8);
+  EXPECT_TRUE(sensor->Configure(SensorConfig{}, &mode).ok());
 }
 
 TEST_F(FileSensorTest, MixedGrayAndColourAreRejectedNamingBoth) {

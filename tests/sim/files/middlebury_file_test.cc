@@ -10,7 +10,7 @@
 #include "firmware/codecs/codec_decoder.h"
 #include "firmware/codecs/image_file.h"
 #include "sim/files/file_sensor.h"
-#include "tests/sim/files/recording_sink.h"
+#include "tests/firmware/codecs/recording_sink.h"
 
 namespace lb {
 namespace {

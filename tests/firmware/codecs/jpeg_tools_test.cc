@@ -4,7 +4,7 @@
 #include <string>
 
 #include "firmware/codecs/jpeg_writer.h"
-#include "tests/firmware/jpeg/jpeg_test_util.h"
+#include "tests/firmware/codecs/jpeg_test_util.h"
 
 namespace lb {
 namespace {

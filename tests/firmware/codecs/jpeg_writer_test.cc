@@ -11,7 +11,7 @@
 #include <string>
 
 #include "firmware/jpeg/base64.h"
-#include "tests/firmware/jpeg/jpeg_test_util.h"
+#include "tests/firmware/codecs/jpeg_test_util.h"
 
 namespace lb {
 namespace {

@@ -1,4 +1,4 @@
-#include "tests/firmware/jpeg/jpeg_test_util.h"
+#include "tests/firmware/codecs/jpeg_test_util.h"
 
 #include <dirent.h>
 #include <stdlib.h>

@@ -5,8 +5,8 @@
 #include <vector>
 
 #include "firmware/codecs/image_file.h"
-#include "tests/sim/files/recording_sink.h"
-#include "tests/sim/files/test_images.h"
+#include "tests/firmware/codecs/recording_sink.h"
+#include "tests/firmware/codecs/test_images.h"
 
 namespace lb {
 namespace {

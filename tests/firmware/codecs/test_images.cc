@@ -1,4 +1,4 @@
-#include "tests/sim/files/test_images.h"
+#include "tests/firmware/codecs/test_images.h"
 
 #include <png.h>
 

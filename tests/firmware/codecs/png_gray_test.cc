@@ -53,5 +53,20 @@ TEST(PngMemoryTest, DefectsAreReportedNotCrashed) {
   EXPECT_FALSE(DecodeGrayPng(flipped.data(), flipped.size(), "depth", 100, 0, 0, &out).ok());
 }
 
+// The depth image is plain grey: a colour, alpha or interlaced PNG is refused before a pixel
+// is decoded, by the same reader that reads the frames.
+TEST(PngMemoryTest, OnlyPlainGreyIsADepthImage) {
+  std::vector<uint8_t> rgb(4 * 3 * 3, 7), png;
+  ASSERT_TRUE(EncodeRgbPng(MakeView(rgb.data(), 4, 3, 3), &png).ok());
+  GrayPng out;
+  const Status colour = DecodeGrayPng(png.data(), png.size(), "depth", 100, 0, 0, &out);
+  EXPECT_STREQ(colour.message(), "depth: PNG: not a greyscale image without alpha");
+  EXPECT_TRUE(out.values.empty());
+  EXPECT_EQ(out.width, 0);
+  const uint8_t not_png[] = "P5\n1 1\n255\n";
+  EXPECT_STREQ(DecodeGrayPng(not_png, sizeof(not_png), "depth", 100, 0, 0, &out).message(),
+               "depth: not a PNG");
+}
+
 }  // namespace
 }  // namespace lb
