@@ -7,7 +7,7 @@
 #include "firmware/app/refocusable.h"
 #include "firmware/codecs/image_file.h"
 #include "firmware/codecs/jpeg_writer.h"
-#include "firmware/jpeg/refocusable_reader.h"
+#include "firmware/refocusable/refocusable_reader.h"
 #include "firmware/storage/atomic_file.h"
 
 namespace lb {

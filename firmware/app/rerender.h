@@ -9,7 +9,7 @@
 #include "algo/core/image.h"
 #include "algo/render/render_stage.h"
 #include "firmware/app/job.h"
-#include "firmware/jpeg/depth_encoding.h"
+#include "firmware/refocusable/depth_encoding.h"
 
 namespace lb {
 

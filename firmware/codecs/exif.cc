@@ -3,7 +3,6 @@
 #include <libexif/exif-data.h>
 #include <libexif/exif-loader.h>
 
-#include <climits>
 #include <cstring>
 
 #include "algo/motion/camera.h"
@@ -171,13 +170,14 @@ int32_t ExifOrientation(const uint8_t* data, size_t size) {
   // The loader a path goes through too, so both find the same APP1 segment.
   ExifLoader* loader = exif_loader_new();
   if (loader == nullptr) return 0;
-  // libexif takes a non-const buffer it only reads, and stops by itself after the EXIF block.
-  auto* bytes = const_cast<unsigned char*>(data);
-  while (size > 0) {
-    const unsigned int n = size > UINT_MAX ? UINT_MAX : static_cast<unsigned int>(size);
-    if (!exif_loader_write(loader, bytes, n)) break;
-    bytes += n;
-    size -= n;
+  // In the 1 KiB pieces libexif's own file reader hands the loader, so that both reads make the
+  // same calls; the loader takes a non-const buffer it only reads, and says when it has enough.
+  constexpr size_t kPiece = 1024;
+  unsigned char piece[kPiece];
+  for (size_t pos = 0; pos < size; pos += kPiece) {
+    const size_t n = size - pos < kPiece ? size - pos : kPiece;
+    memcpy(piece, data + pos, n);
+    if (!exif_loader_write(loader, piece, static_cast<unsigned int>(n))) break;
   }
   ExifData* exif = exif_loader_get_data(loader);
   exif_loader_unref(loader);

@@ -10,7 +10,7 @@
 #include <cstring>
 #include <string>
 
-#include "firmware/jpeg/base64.h"
+#include "firmware/refocusable/base64.h"
 #include "tests/firmware/codecs/jpeg_test_util.h"
 
 namespace lb {

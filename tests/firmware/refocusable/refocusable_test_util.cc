@@ -1,4 +1,4 @@
-#include "tests/firmware/jpeg/refocusable_test_util.h"
+#include "tests/firmware/refocusable/refocusable_test_util.h"
 
 namespace lb::test {
 

@@ -1,4 +1,4 @@
-#include "firmware/jpeg/base64.h"
+#include "firmware/refocusable/base64.h"
 
 #include <md5.h>
 

@@ -1,11 +1,11 @@
-#include "firmware/jpeg/xmp_writer.h"
+#include "firmware/refocusable/xmp_writer.h"
 
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 
 #include "firmware/codecs/png_writer.h"
-#include "firmware/jpeg/base64.h"
+#include "firmware/refocusable/base64.h"
 
 namespace lb {
 namespace {

@@ -1,4 +1,4 @@
-#include "firmware/jpeg/refocusable_reader.h"
+#include "firmware/refocusable/refocusable_reader.h"
 
 #include <sys/stat.h>
 
@@ -11,7 +11,7 @@
 #include <string_view>
 
 #include "firmware/codecs/exif.h"
-#include "firmware/jpeg/base64.h"
+#include "firmware/refocusable/base64.h"
 
 namespace lb {
 namespace {

@@ -1,4 +1,4 @@
-#include "firmware/jpeg/refocusable_reader.h"
+#include "firmware/refocusable/refocusable_reader.h"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <regex>
 #include <string>
 
-#include "tests/firmware/jpeg/refocusable_test_util.h"
+#include "tests/firmware/refocusable/refocusable_test_util.h"
 
 namespace lb {
 namespace {

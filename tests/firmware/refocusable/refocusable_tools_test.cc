@@ -4,7 +4,7 @@
 #include <string>
 
 #include "firmware/storage/atomic_file.h"
-#include "tests/firmware/jpeg/refocusable_test_util.h"
+#include "tests/firmware/refocusable/refocusable_test_util.h"
 
 namespace lb {
 namespace {

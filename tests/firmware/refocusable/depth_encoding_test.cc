@@ -1,4 +1,4 @@
-#include "firmware/jpeg/depth_encoding.h"
+#include "firmware/refocusable/depth_encoding.h"
 
 #include <gtest/gtest.h>
 

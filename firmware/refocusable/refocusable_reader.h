@@ -10,7 +10,7 @@
 
 #include "algo/core/status.h"
 #include "firmware/codecs/png_reader.h"
-#include "firmware/jpeg/xmp_writer.h"
+#include "firmware/refocusable/xmp_writer.h"
 
 namespace lb {
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "firmware/jpeg/xmp_writer.h"
+#include "firmware/refocusable/xmp_writer.h"
 #include "tests/firmware/codecs/jpeg_test_util.h"
 
 namespace lb::test {
