@@ -1,6 +1,8 @@
-// Image files on the host: binary PPM/PGM (8 and 16 bit, comments), PNG (libpng) and JPEG
-// (libjpeg-turbo). Every reader checks every byte it uses; a bad file gives a Status whose
-// message names the file and the problem, never a crash.
+// The product's image readers, one per format, behind one door that tells them apart by their
+// magic bytes: binary PPM/PGM (8 and 16 bit, comments; pnm_reader.cc), PNG (libpng;
+// png_reader.cc) and JPEG (libjpeg-turbo; jpeg_reader.cc), from a file or from memory. Every
+// reader checks every byte it uses; a bad file gives a Status whose message names the file and
+// the problem, never a crash.
 #pragma once
 
 #include <cstddef>
@@ -33,7 +35,7 @@ Status StreamImageFile(const char* path, int32_t index, FrameSink& sink);
 // convenience for tests, tools and the Middlebury loaders; allocates.
 Status ReadImageFile(const char* path, ImageFileInfo* info, std::vector<uint8_t>* pixels);
 
-// The same readers over bytes in memory (the fuzz targets and the JPEG/XMP reader use them).
+// The same readers over bytes in memory (the fuzz targets and `refocus rerender` use them).
 // `name` is used in error messages. On error `pixels` is left empty.
 Status ReadImageMemory(const uint8_t* data, size_t size, const char* name, ImageFileInfo* info,
                        std::vector<uint8_t>* pixels, ImageFileType type = ImageFileType::kAuto);
