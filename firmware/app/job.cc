@@ -7,7 +7,7 @@
 #include "algo/motion/camera.h"
 #include "firmware/app/focus.h"
 #include "firmware/app/refocusable.h"
-#include "firmware/jpeg/jpeg_writer.h"
+#include "firmware/codecs/jpeg_writer.h"
 #include "firmware/platform/worker_pool.h"
 #include "firmware/storage/atomic_file.h"
 #include "firmware/storage/output_target.h"

@@ -1,6 +1,6 @@
 #include "firmware/app/refocusable.h"
 
-#include "firmware/jpeg/xmp_writer.h"
+#include "firmware/refocusable/xmp_writer.h"
 
 namespace lb {
 

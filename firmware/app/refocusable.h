@@ -9,8 +9,8 @@
 
 #include "algo/core/image.h"
 #include "algo/render/render_stage.h"
-#include "firmware/jpeg/depth_encoding.h"
-#include "firmware/jpeg/jpeg_writer.h"
+#include "firmware/codecs/jpeg_writer.h"
+#include "firmware/refocusable/depth_encoding.h"
 
 namespace lb {
 

@@ -5,12 +5,11 @@
 
 #include "algo/core/color.h"
 #include "firmware/app/refocusable.h"
-#include "firmware/jpeg/jpeg_writer.h"
-#include "firmware/jpeg/refocusable_reader.h"
+#include "firmware/codecs/image_file.h"
+#include "firmware/codecs/jpeg_writer.h"
 #include "firmware/platform/worker_pool.h"
+#include "firmware/refocusable/refocusable_reader.h"
 #include "firmware/storage/atomic_file.h"
-#include "sim/files/exif_focal.h"
-#include "sim/files/image_file.h"
 
 namespace lb {
 
@@ -37,7 +36,7 @@ Status Rerenderer::Load(const char* path) {
   s = ReadImageMemory(file.xmp.image.data(), file.xmp.image.size(), "GImage", &info, &pixels,
                       ImageFileType::kJpeg);
   if (!s.ok()) return s.Prefix("%s: ", path);
-  orientation_ = ExifOrientation(path);
+  orientation_ = file.orientation;
   depth_w_ = file.depth.width;
   depth_h_ = file.depth.height;
   width_ = info.width;

@@ -10,7 +10,7 @@
 #include "algo/render/render_stage.h"
 #include "firmware/app/job.h"
 #include "firmware/app/progress.h"
-#include "firmware/jpeg/depth_encoding.h"
+#include "firmware/refocusable/depth_encoding.h"
 
 namespace lb {
 

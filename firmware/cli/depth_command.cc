@@ -17,11 +17,11 @@
 #include "algo/pipeline/auto_geometry.h"
 #include "firmware/cli/commands.h"
 #include "firmware/cli/options.h"
+#include "firmware/codecs/exif.h"
+#include "firmware/codecs/image_file.h"
 #include "firmware/depth_out/depth_out.h"
 #include "firmware/storage/atomic_file.h"
 #include "firmware/storage/output_target.h"
-#include "sim/files/exif_focal.h"
-#include "sim/files/image_file.h"
 
 namespace lb::cli {
 namespace {

@@ -9,6 +9,7 @@
 #include "firmware/app/job.h"
 #include "firmware/cli/commands.h"
 #include "firmware/cli/options.h"
+#include "firmware/codecs/codec_decoder.h"
 #include "firmware/storage/output_target.h"
 #include "sim/files/file_sensor.h"
 #include "sim/synthetic/synthetic_sensor.h"
@@ -128,21 +129,12 @@ int RunCommand(int argc, char** argv) {
   const FileSensor* file_sensor = nullptr;
   if (!input_dir.empty() || !files.empty()) {
     std::unique_ptr<FileSensor> fs;
-    Status s = input_dir.empty() ? FileSensor::FromFiles(files, &fs)
-                                 : FileSensor::FromDirectory(input_dir.c_str(), &fs);
+    const ImageDecoder& codecs = CodecImageDecoder();
+    Status s = input_dir.empty() ? FileSensor::FromFiles(files, codecs, &fs)
+                                 : FileSensor::FromDirectory(input_dir.c_str(), codecs, &fs);
     if (!s.ok()) return Fail(s.message());
-    // The frames' size from their headers, checked here so that the message names a file.
-    SensorMode mode;
-    s = fs->Configure(SensorConfig(), &mode);
-    if (!s.ok()) return Fail(s.message());
-    if (mode.width < 16 || mode.height < 16 || mode.width > PipelineConfig::kMaxWidth ||
-        mode.height > PipelineConfig::kMaxHeight) {
-      char msg[600];
-      snprintf(msg, sizeof(msg), "%s: %dx%d frames: refocus takes 16x16 .. %dx%d",
-               fs->paths()[0].c_str(), mode.width, mode.height, PipelineConfig::kMaxWidth,
-               PipelineConfig::kMaxHeight);
-      return Fail(msg);
-    }
+    // Checked once, by the sensor's Configure inside the job's, where the message names a file.
+    fs->LimitSize(16, PipelineConfig::kMaxWidth, PipelineConfig::kMaxHeight);
     file_sensor = fs.get();
     sensor = std::move(fs);
     job.sensor.width = job.sensor.height = 0;  // the files decide

@@ -1,12 +1,9 @@
 #include "firmware/depth_out/depth_out.h"
 
-#include <png.h>
-
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
-#include <string>
 #include <vector>
+
+#include "firmware/codecs/pfm_writer.h"
+#include "firmware/codecs/png_writer.h"
 
 namespace lb {
 namespace {
@@ -22,20 +19,15 @@ Status CheckMap(const char* path, ConstImageU16 disp_q8) {
 
 Status EncodeDisparityPfm(AtomicFile* out, ConstImageU16 disp_q8, int32_t bias_q8) {
   LB_RETURN_IF_ERROR(CheckMap(out->path(), disp_q8));
-  char header[64];
-  const int n =
-      snprintf(header, sizeof(header), "Pf\n%d %d\n-1.0\n", disp_q8.width, disp_q8.height);
-  LB_RETURN_IF_ERROR(out->Write(header, static_cast<size_t>(n)));
-  std::vector<uint8_t> row(static_cast<size_t>(disp_q8.width) * 4);
+  PfmWriter pfm;
+  LB_RETURN_IF_ERROR(pfm.Begin(out, disp_q8.width, disp_q8.height));
+  std::vector<float> row(static_cast<size_t>(disp_q8.width));
   for (int32_t y = disp_q8.height - 1; y >= 0; --y) {
     const uint16_t* src = disp_q8.Row(y);
     for (int32_t x = 0; x < disp_q8.width; ++x) {
-      const float v = static_cast<float>(src[x] - bias_q8) / 256.0f;
-      uint32_t bits;
-      memcpy(&bits, &v, 4);
-      for (int b = 0; b < 4; ++b) row[4 * x + b] = static_cast<uint8_t>(bits >> (8 * b));
+      row[x] = static_cast<float>(src[x] - bias_q8) / 256.0f;
     }
-    LB_RETURN_IF_ERROR(out->Write(row.data(), row.size()));
+    LB_RETURN_IF_ERROR(pfm.WriteRow(row.data()));
   }
   return Status::Ok();
 }
@@ -72,22 +64,10 @@ Status EncodeDisparityPreview(AtomicFile* out, ConstImageU16 disp_q8, int32_t mi
                       &pixels[(static_cast<size_t>(y) * disp_q8.width + x) * 3]);
     }
   }
-  // libpng's simplified API reports errors through image.message instead of longjmp.
-  png_image image;
-  memset(&image, 0, sizeof(image));
-  image.version = PNG_IMAGE_VERSION;
-  image.width = static_cast<png_uint_32>(disp_q8.width);
-  image.height = static_cast<png_uint_32>(disp_q8.height);
-  image.format = PNG_FORMAT_RGB;
-  png_alloc_size_t size = 0;
-  if (!png_image_write_to_memory(&image, nullptr, &size, 0, pixels.data(), 0, nullptr)) {
-    return Status(Code::kIoError, "%s: PNG encoder: %s", out->path(), image.message);
-  }
-  std::vector<uint8_t> png(size);
-  if (!png_image_write_to_memory(&image, png.data(), &size, 0, pixels.data(), 0, nullptr)) {
-    return Status(Code::kIoError, "%s: PNG encoder: %s", out->path(), image.message);
-  }
-  return out->Write(png.data(), size);
+  std::vector<uint8_t> png;
+  Status s = EncodeRgbPng(MakeView(pixels.data(), disp_q8.width, disp_q8.height, 3), &png);
+  if (!s.ok()) return s.Prefix("%s: ", out->path());
+  return out->Write(png.data(), png.size());
 }
 
 Status WriteDisparityPreview(const char* path, ConstImageU16 disp_q8, int32_t min_q8,

@@ -8,9 +8,6 @@
 #include <cerrno>
 #include <cstring>
 
-#include "sim/files/exif_focal.h"
-#include "sim/files/image_file.h"
-
 namespace lb {
 namespace {
 
@@ -55,21 +52,28 @@ class StampingSink final : public FrameSink {
 
 }  // namespace
 
-Status FileSensor::FromDirectory(const char* dir, std::unique_ptr<FileSensor>* out) {
+Status FileSensor::FromDirectory(const char* dir, const ImageDecoder& decoder,
+                                 std::unique_ptr<FileSensor>* out) {
   if (dir == nullptr || dir[0] == '\0') {
     return Status(Code::kInvalidArgument, "file sensor: no directory given");
   }
-  out->reset(new FileSensor());
+  out->reset(new FileSensor(decoder));
   (*out)->dir_ = dir;
   return Status::Ok();
 }
 
-Status FileSensor::FromFiles(const std::vector<std::string>& paths,
+Status FileSensor::FromFiles(const std::vector<std::string>& paths, const ImageDecoder& decoder,
                              std::unique_ptr<FileSensor>* out) {
   if (paths.empty()) return Status(Code::kInvalidArgument, "file sensor: no image files given");
-  out->reset(new FileSensor());
+  out->reset(new FileSensor(decoder));
   (*out)->paths_ = paths;
   return Status::Ok();
+}
+
+void FileSensor::LimitSize(int32_t min_side, int32_t max_width, int32_t max_height) {
+  min_side_ = min_side;
+  max_width_ = max_width;
+  max_height_ = max_height;
 }
 
 Status FileSensor::ListDirectory() {
@@ -100,13 +104,24 @@ Status FileSensor::ListDirectory() {
   return Status::Ok();
 }
 
+Status FileSensor::CheckLimits(const ImageHeader& first) const {
+  if (max_width_ == 0) return Status::Ok();
+  if (first.width < min_side_ || first.height < min_side_ || first.width > max_width_ ||
+      first.height > max_height_) {
+    return Status(Code::kUnsupported, "%s: %dx%d frames: refocus takes %dx%d .. %dx%d",
+                  paths_[0].c_str(), first.width, first.height, min_side_, min_side_, max_width_,
+                  max_height_);
+  }
+  return Status::Ok();
+}
+
 Status FileSensor::Configure(const SensorConfig& config, SensorMode* mode) {
   configured_ = false;
   if (!dir_.empty()) LB_RETURN_IF_ERROR(ListDirectory());
-  ImageFileInfo first;
+  ImageHeader first;
   for (size_t i = 0; i < paths_.size(); ++i) {
-    ImageFileInfo info;
-    LB_RETURN_IF_ERROR(ProbeImageFile(paths_[i].c_str(), &info));
+    ImageHeader info;
+    LB_RETURN_IF_ERROR(decoder_.Probe(paths_[i].c_str(), &info));
     if (i == 0) {
       first = info;
       continue;
@@ -122,6 +137,7 @@ Status FileSensor::Configure(const SensorConfig& config, SensorMode* mode) {
                     PixelFormatName(first.format));
     }
   }
+  LB_RETURN_IF_ERROR(CheckLimits(first));
   if ((config.width != 0 && config.width != first.width) ||
       (config.height != 0 && config.height != first.height)) {
     return Status(Code::kUnsupported, "%s: frames are %dx%d, cannot deliver the requested %dx%d",
@@ -131,8 +147,9 @@ Status FileSensor::Configure(const SensorConfig& config, SensorMode* mode) {
   mode_.height = first.height;
   mode_.format = first.format;
   mode_.frames = static_cast<int32_t>(paths_.size());
-  mode_.focal_px = ExifFocalPx(paths_[0].c_str(), first.width, first.height);
-  mode_.orientation = ExifOrientation(paths_[0].c_str());
+  const CameraTags tags = decoder_.Tags(paths_[0].c_str(), first.width, first.height);
+  mode_.focal_px = tags.focal_px;
+  mode_.orientation = tags.orientation;
   *mode = mode_;
   configured_ = true;
   return Status::Ok();
@@ -142,7 +159,7 @@ Status FileSensor::CaptureBurst(FrameSink& sink) {
   if (!configured_) return Status(Code::kInvalidArgument, "file sensor: not configured");
   for (size_t i = 0; i < paths_.size(); ++i) {
     StampingSink stamping(sink, mode_, paths_[i].c_str());
-    LB_RETURN_IF_ERROR(StreamImageFile(paths_[i].c_str(), static_cast<int32_t>(i), stamping));
+    LB_RETURN_IF_ERROR(decoder_.Stream(paths_[i].c_str(), static_cast<int32_t>(i), stamping));
   }
   return Status::Ok();
 }

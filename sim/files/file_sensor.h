@@ -10,16 +10,24 @@
 
 #include "algo/core/status.h"
 #include "hal/sensor.h"
+#include "sim/files/image_decoder.h"
 
 namespace lb {
 
 class FileSensor : public Sensor {
  public:
   // The image files in `dir` (.ppm .pgm .pnm .png .jpg .jpeg in any case, sorted by name); the
-  // folder is listed and every file probed by Configure.
-  static Status FromDirectory(const char* dir, std::unique_ptr<FileSensor>* out);
+  // folder is listed and every file probed by Configure. `decoder` reads them; it is borrowed
+  // for the sensor's life.
+  static Status FromDirectory(const char* dir, const ImageDecoder& decoder,
+                              std::unique_ptr<FileSensor>* out);
   // These files in this order.
-  static Status FromFiles(const std::vector<std::string>& paths, std::unique_ptr<FileSensor>* out);
+  static Status FromFiles(const std::vector<std::string>& paths, const ImageDecoder& decoder,
+                          std::unique_ptr<FileSensor>* out);
+
+  // Frames outside min_side x min_side .. max_width x max_height are refused by Configure, with
+  // a message naming the first file (by default any size the decoder reads is taken).
+  void LimitSize(int32_t min_side, int32_t max_width, int32_t max_height);
 
   const char* name() const override { return "file"; }
   // Reads every file's header. A non-zero config.width/height must match the files (no
@@ -33,8 +41,14 @@ class FileSensor : public Sensor {
   const std::vector<std::string>& paths() const { return paths_; }
 
  private:
-  FileSensor() = default;
+  explicit FileSensor(const ImageDecoder& decoder) : decoder_(decoder) {}
   Status ListDirectory();
+  Status CheckLimits(const ImageHeader& first) const;
+
+  const ImageDecoder& decoder_;
+  int32_t min_side_ = 0;
+  int32_t max_width_ = 0;  // 0: no limit
+  int32_t max_height_ = 0;
 
   std::string dir_;  // empty when built from a file list
   std::vector<std::string> paths_;

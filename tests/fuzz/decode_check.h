@@ -8,7 +8,7 @@
 #include <cstring>
 #include <vector>
 
-#include "sim/files/image_file.h"
+#include "firmware/codecs/image_file.h"
 
 namespace lb::fuzz {
 

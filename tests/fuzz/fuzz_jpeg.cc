@@ -1,7 +1,8 @@
 // libFuzzer target: any bytes through the JPEG reader (forced, so no mutation is lost to format
-// detection), then as a burst frame file the way the file sensor opens one (FileSensor::Configure:
-// ProbeImageFile, then libexif through ExifFocalPx and ExifOrientation). The EXIF readers take a
-// path, so the input is also written to an in-memory file (memfd) opened by its /proc name.
+// detection), then as a burst frame file the way the file sensor opens one through the codecs
+// (CodecImageDecoder: ProbeImageFile, then libexif through ExifFocalPx and ExifOrientation). The
+// EXIF readers take a path, so the input is also written to an in-memory file (memfd) opened by
+// its /proc name; the orientation read from memory (as `refocus rerender` does) must agree.
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -10,7 +11,7 @@
 #include <cstdint>
 #include <cstdio>
 
-#include "sim/files/exif_focal.h"
+#include "firmware/codecs/exif.h"
 #include "tests/fuzz/decode_check.h"
 
 namespace {
@@ -71,5 +72,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   LB_FUZZ_REQUIRE(std::isfinite(focal_px) && focal_px >= 0, "focal %g px", focal_px);
   const int32_t orientation = lb::ExifOrientation(path);
   LB_FUZZ_REQUIRE(orientation >= 0 && orientation <= 8, "orientation %d", orientation);
+  const int32_t in_memory = lb::ExifOrientation(data, size);
+  LB_FUZZ_REQUIRE(in_memory == orientation, "orientation %d from memory, %d from the file",
+                  in_memory, orientation);
   return 0;
 }

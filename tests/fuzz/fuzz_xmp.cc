@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "firmware/jpeg/base64.h"
-#include "firmware/jpeg/refocusable_reader.h"
+#include "firmware/refocusable/base64.h"
+#include "firmware/refocusable/refocusable_reader.h"
 
 namespace {
 

@@ -14,10 +14,10 @@
 #include <vector>
 
 #include "algo/core/image.h"
-#include "firmware/jpeg/jpeg_writer.h"
-#include "firmware/jpeg/refocusable_reader.h"
-#include "firmware/jpeg/xmp_writer.h"
-#include "tests/sim/files/test_images.h"
+#include "firmware/codecs/jpeg_writer.h"
+#include "firmware/refocusable/refocusable_reader.h"
+#include "firmware/refocusable/xmp_writer.h"
+#include "tests/firmware/codecs/test_images.h"
 
 namespace {
 

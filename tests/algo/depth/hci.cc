@@ -7,7 +7,7 @@
 #include <cstdlib>
 #include <cstring>
 
-#include "sim/files/image_file.h"
+#include "firmware/codecs/image_file.h"
 #include "tests/algo/depth/fit_score.h"
 
 namespace lb::hci {

@@ -6,7 +6,7 @@
 #include <cstdlib>
 #include <utility>
 
-#include "sim/files/image_file.h"
+#include "firmware/codecs/image_file.h"
 
 namespace lb::middlebury {
 

@@ -10,9 +10,10 @@
 #include <vector>
 
 #include "firmware/app/job.h"
+#include "firmware/codecs/codec_decoder.h"
 #include "sim/files/file_sensor.h"
 #include "tests/algo/motion/burst.h"
-#include "tests/sim/files/test_images.h"
+#include "tests/firmware/codecs/test_images.h"
 
 namespace lb {
 namespace {
@@ -70,7 +71,7 @@ class DegenerateBurst : public ::testing::Test {
                                   Geometry geometry = Geometry::kAuto,
                                   int64_t pixels = int64_t{kW} * kH) {
     std::unique_ptr<FileSensor> sensor;
-    ASSERT_TRUE(FileSensor::FromFiles(paths, &sensor).ok());
+    ASSERT_TRUE(FileSensor::FromFiles(paths, CodecImageDecoder(), &sensor).ok());
     JobOptions o;
     o.pipeline.geometry = geometry;
     o.pipeline.labels = 16;

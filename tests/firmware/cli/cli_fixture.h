@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "tests/sim/files/test_images.h"
+#include "tests/firmware/codecs/test_images.h"
 
 namespace lb::clitest {
 

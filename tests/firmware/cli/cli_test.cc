@@ -14,11 +14,11 @@
 #include <string>
 #include <vector>
 
-#include "firmware/jpeg/jpeg_writer.h"
-#include "sim/files/exif_focal.h"
+#include "firmware/codecs/exif.h"
+#include "firmware/codecs/jpeg_writer.h"
 #include "tests/algo/motion/burst.h"
 #include "tests/firmware/cli/cli_fixture.h"
-#include "tests/sim/files/test_images.h"
+#include "tests/firmware/codecs/test_images.h"
 
 namespace lb {
 namespace {

@@ -11,9 +11,9 @@
 #include <vector>
 
 #include "firmware/app/refocusable.h"
-#include "firmware/jpeg/jpeg_writer.h"
+#include "firmware/codecs/jpeg_writer.h"
 #include "tests/firmware/cli/cli_fixture.h"
-#include "tests/sim/files/test_images.h"
+#include "tests/firmware/codecs/test_images.h"
 
 namespace lb {
 namespace {

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "sim/synthetic/synthetic_sensor.h"
-#include "tests/firmware/jpeg/jpeg_test_util.h"
+#include "tests/firmware/codecs/jpeg_test_util.h"
 
 namespace lb {
 namespace {

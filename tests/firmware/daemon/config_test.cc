@@ -8,7 +8,7 @@
 
 #include "firmware/app/focus.h"
 #include "firmware/app/settings.h"
-#include "tests/firmware/jpeg/jpeg_test_util.h"
+#include "tests/firmware/codecs/jpeg_test_util.h"
 
 namespace lb {
 namespace {

@@ -8,7 +8,7 @@
 #include <cstdio>
 #include <string>
 
-#include "tests/firmware/jpeg/jpeg_test_util.h"
+#include "tests/firmware/codecs/jpeg_test_util.h"
 
 namespace lb {
 namespace {

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "tests/firmware/codecs/jpeg_test_util.h"
 #include "tests/firmware/daemon/refocusd_process.h"
-#include "tests/firmware/jpeg/jpeg_test_util.h"
 
 namespace lb::test {
 namespace {

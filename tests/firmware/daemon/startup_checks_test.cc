@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "tests/firmware/jpeg/jpeg_test_util.h"
+#include "tests/firmware/codecs/jpeg_test_util.h"
 
 namespace lb {
 namespace {

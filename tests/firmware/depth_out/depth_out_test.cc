@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "firmware/codecs/image_file.h"
 #include "firmware/depth_out/depth_out.h"
-#include "sim/files/image_file.h"
 
 namespace lb {
 namespace {

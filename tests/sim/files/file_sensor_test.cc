@@ -1,4 +1,5 @@
 #include "sim/files/file_sensor.h"
+#include "firmware/codecs/codec_decoder.h"
 
 #include <libexif/exif-data.h>
 #include <png.h>
@@ -9,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "tests/sim/files/recording_sink.h"
-#include "tests/sim/files/test_images.h"
+#include "tests/firmware/codecs/recording_sink.h"
+#include "tests/firmware/codecs/test_images.h"
 
 namespace lb {
 namespace {
@@ -46,7 +47,7 @@ class FileSensorTest : public ::testing::Test {
 
   Status ConfigureDir(SensorMode* mode) {
     std::unique_ptr<FileSensor> sensor;
-    Status s = FileSensor::FromDirectory(dir_.c_str(), &sensor);
+    Status s = FileSensor::FromDirectory(dir_.c_str(), CodecImageDecoder(), &sensor);
     if (!s.ok()) return s;
     return sensor->Configure(SensorConfig{}, mode);
   }
@@ -106,7 +107,7 @@ TEST_F(FileSensorTest, StreamsEveryImageFileInNameOrderWithBurstTiming) {
   ASSERT_TRUE(test::WriteFile(Path(".hidden.png"), {'x'}));
 
   std::unique_ptr<FileSensor> sensor;
-  ASSERT_TRUE(FileSensor::FromDirectory(dir_.c_str(), &sensor).ok());
+  ASSERT_TRUE(FileSensor::FromDirectory(dir_.c_str(), CodecImageDecoder(), &sensor).ok());
   SensorMode mode;
   const Status s = sensor->Configure(SensorConfig{}, &mode);
   ASSERT_TRUE(s.ok()) << s.message();
@@ -134,7 +135,8 @@ TEST_F(FileSensorTest, FromFilesKeepsTheGivenOrder) {
   WritePnm("a.pgm", 4, 4, 1, 1);
   WritePnm("b.pgm", 4, 4, 1, 2);
   std::unique_ptr<FileSensor> sensor;
-  ASSERT_TRUE(FileSensor::FromFiles({Path("b.pgm"), Path("a.pgm")}, &sensor).ok());
+  ASSERT_TRUE(
+      FileSensor::FromFiles({Path("b.pgm"), Path("a.pgm")}, CodecImageDecoder(), &sensor).ok());
   SensorMode mode;
   ASSERT_TRUE(sensor->Configure(SensorConfig{}, &mode).ok());
   EXPECT_EQ(mode.format, PixelFormat::kGray8);
@@ -154,6 +156,24 @@ TEST_F(FileSensorTest, FramesOfDifferentSizesAreRejectedNamingBoth) {
   EXPECT_EQ(s.code(), Code::kInvalidArgument);
   EXPECT_EQ(std::string(s.message()),
             Path("b.png") + " is 64x48 but " + Path("a.png") + " is 32x24");
+}
+
+// `refocus run` sets the limits so that the one Configure of the job refuses a size the
+// pipeline cannot take, naming the file.
+TEST_F(FileSensorTest, SizeLimitsRefuseNamingTheFirstFile) {
+  WritePnm("a.pgm", 8, 8, 1, 0);
+  WritePnm("b.pgm", 8, 8, 1, 0);
+  std::unique_ptr<FileSensor> sensor;
+  ASSERT_TRUE(FileSensor::FromDirectory(dir_.c_str(), CodecImageDecoder(), &sensor).ok());
+  SensorMode mode;
+  ASSERT_TRUE(sensor->Configure(SensorConfig{}, &mode).ok());  // no limits by default
+  sensor->LimitSize(16, 8192, 8192);
+  const Status s = sensor->Configure(SensorConfig{}, &mode);
+  EXPECT_EQ(s.code(), Code::kUnsupported);
+  EXPECT_EQ(std::string(s.message()),
+            Path("a.pgm") + ": 8x8 frames: refocus takes 16x16 .. 8192x8192");
+  sensor->LimitSize(8, 8, 8);
+  EXPECT_TRUE(sensor->Configure(SensorConfig{}, &mode).ok());
 }
 
 TEST_F(FileSensorTest, MixedGrayAndColourAreRejectedNamingBoth) {
@@ -176,14 +196,15 @@ TEST_F(FileSensorTest, EmptyDirectoryIsAnError) {
 
 TEST_F(FileSensorTest, MissingPathsAreErrors) {
   std::unique_ptr<FileSensor> sensor;
-  ASSERT_TRUE(FileSensor::FromDirectory("missing/dir", &sensor).ok());
+  ASSERT_TRUE(FileSensor::FromDirectory("missing/dir", CodecImageDecoder(), &sensor).ok());
   SensorMode mode;
   Status s = sensor->Configure(SensorConfig{}, &mode);
   EXPECT_EQ(s.code(), Code::kNotFound);
   EXPECT_STREQ(s.message(), "missing/dir: no such file or directory");
 
   WritePnm("a.ppm", 8, 8, 3, 0);
-  ASSERT_TRUE(FileSensor::FromFiles({Path("a.ppm"), Path("gone.ppm")}, &sensor).ok());
+  ASSERT_TRUE(
+      FileSensor::FromFiles({Path("a.ppm"), Path("gone.ppm")}, CodecImageDecoder(), &sensor).ok());
   s = sensor->Configure(SensorConfig{}, &mode);
   EXPECT_EQ(s.code(), Code::kNotFound);
   EXPECT_EQ(std::string(s.message()), Path("gone.ppm") + ": no such file or directory");
@@ -201,7 +222,7 @@ TEST_F(FileSensorTest, CorruptHeaderFailsConfigureNamingTheFile) {
 TEST_F(FileSensorTest, RequestedSizeMustMatchAndCaptureNeedsConfigure) {
   WritePnm("a.ppm", 8, 6, 3, 0);
   std::unique_ptr<FileSensor> sensor;
-  ASSERT_TRUE(FileSensor::FromDirectory(dir_.c_str(), &sensor).ok());
+  ASSERT_TRUE(FileSensor::FromDirectory(dir_.c_str(), CodecImageDecoder(), &sensor).ok());
   test::RecordingSink sink;
   EXPECT_EQ(sensor->CaptureBurst(sink).code(), Code::kInvalidArgument);
   SensorConfig config;
@@ -220,7 +241,7 @@ TEST_F(FileSensorTest, RequestedSizeMustMatchAndCaptureNeedsConfigure) {
 TEST_F(FileSensorTest, FileReplacedAfterConfigureFailsTheCapture) {
   WritePnm("a.ppm", 8, 6, 3, 0);
   std::unique_ptr<FileSensor> sensor;
-  ASSERT_TRUE(FileSensor::FromDirectory(dir_.c_str(), &sensor).ok());
+  ASSERT_TRUE(FileSensor::FromDirectory(dir_.c_str(), CodecImageDecoder(), &sensor).ok());
   SensorMode mode;
   ASSERT_TRUE(sensor->Configure(SensorConfig{}, &mode).ok());
   WritePnm("a.ppm", 8, 7, 3, 0);

@@ -7,9 +7,10 @@
 #include <string>
 #include <vector>
 
+#include "firmware/codecs/codec_decoder.h"
+#include "firmware/codecs/image_file.h"
 #include "sim/files/file_sensor.h"
-#include "sim/files/image_file.h"
-#include "tests/sim/files/recording_sink.h"
+#include "tests/firmware/codecs/recording_sink.h"
 
 namespace lb {
 namespace {
@@ -45,7 +46,7 @@ TEST(MiddleburyFiles, FiveTsukubaViewsMakeABurst) {
   }
   if (!Exists(paths[0])) GTEST_SKIP() << paths[0] << " is absent (shared data not installed)";
   std::unique_ptr<FileSensor> sensor;
-  ASSERT_TRUE(FileSensor::FromFiles(paths, &sensor).ok());
+  ASSERT_TRUE(FileSensor::FromFiles(paths, CodecImageDecoder(), &sensor).ok());
   SensorMode mode;
   const Status s = sensor->Configure(SensorConfig{}, &mode);
   ASSERT_TRUE(s.ok()) << s.message();

@@ -1,0 +1,167 @@
+#include "firmware/codecs/image_file.h"
+
+#include <cerrno>
+#include <cinttypes>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+
+#include "firmware/codecs/decoder.h"
+
+namespace lb {
+
+namespace {
+
+using codecs::ByteSource;
+
+Status Detect(ByteSource& src, const char* name, ImageFileType* type) {
+  static constexpr uint8_t kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  uint8_t magic[8] = {};
+  const size_t n = src.Peek(magic, sizeof(magic));
+  if (src.error() != 0) {
+    return Status(Code::kIoError, "%s: read error: %s", name, strerror(src.error()));
+  }
+  if (n == 0) return Status(Code::kCorruptData, "%s: empty file", name);
+  if (n >= 2 && magic[0] == 'P' && magic[1] >= '1' && magic[1] <= '7') {
+    *type = ImageFileType::kPnm;
+  } else if (n == 8 && memcmp(magic, kPng, 8) == 0) {
+    *type = ImageFileType::kPng;
+  } else if (n >= 3 && magic[0] == 0xff && magic[1] == 0xd8 && magic[2] == 0xff) {
+    *type = ImageFileType::kJpeg;
+  } else {
+    return Status(Code::kUnsupported,
+                  "%s: not a PPM, PGM, PNG or JPEG file (starts %02x %02x %02x %02x)", name,
+                  magic[0], magic[1], magic[2], magic[3]);
+  }
+  return Status::Ok();
+}
+
+Status Decode(ByteSource& src, ImageFileType type, const codecs::DecodeRequest& request) {
+  if (type == ImageFileType::kAuto) LB_RETURN_IF_ERROR(Detect(src, request.name, &type));
+  switch (type) {
+    case ImageFileType::kPnm:
+      return codecs::DecodePnm(src, request);
+    case ImageFileType::kPng:
+      return codecs::DecodePng(src, request);
+    case ImageFileType::kJpeg:
+      return codecs::DecodeJpeg(src, request);
+    case ImageFileType::kAuto:
+      break;
+  }
+  return Status(Code::kInternal, "%s: no decoder", request.name);
+}
+
+// Gathers the strips of one frame into a packed buffer.
+class CollectSink final : public FrameSink {
+ public:
+  CollectSink(const char* name, ImageFileInfo* info, std::vector<uint8_t>* pixels)
+      : name_(name), info_(info), pixels_(pixels) {}
+
+  Status BeginFrame(const FrameInfo& info) override {
+    info_->format = info.format;
+    info_->width = info.width;
+    info_->height = info.height;
+    row_bytes_ = static_cast<size_t>(info.width) * static_cast<size_t>(BytesPerPixel(info.format));
+    next_row_ = 0;
+    pixels_->clear();
+    return Status::Ok();
+  }
+  Status Rows(const FrameRows& rows) override {
+    if (rows.y0 != next_row_ || rows.height <= 0 || rows.y0 + rows.height > info_->height) {
+      return Status(Code::kInternal, "%s: decoder delivered rows %d..%d out of order", name_,
+                    rows.y0, rows.y0 + rows.height);
+    }
+    for (int32_t y = 0; y < rows.height; ++y) {
+      const uint8_t* row = rows.planes[0] + y * rows.strides[0];
+      pixels_->insert(pixels_->end(), row, row + row_bytes_);
+    }
+    next_row_ += rows.height;
+    return Status::Ok();
+  }
+  Status EndFrame() override {
+    if (next_row_ != info_->height) {
+      return Status(Code::kInternal, "%s: decoder ended the frame after %d of %d rows", name_,
+                    next_row_, info_->height);
+    }
+    return Status::Ok();
+  }
+
+ private:
+  const char* name_;
+  ImageFileInfo* info_;
+  std::vector<uint8_t>* pixels_;
+  size_t row_bytes_ = 0;
+  int32_t next_row_ = 0;
+};
+
+struct FileCloser {
+  void operator()(FILE* f) const { fclose(f); }
+};
+using FilePtr = std::unique_ptr<FILE, FileCloser>;
+
+Status OpenFile(const char* path, FilePtr* out) {
+  FILE* f = fopen(path, "rb");
+  if (f == nullptr) {
+    if (errno == ENOENT) return Status(Code::kNotFound, "%s: no such file or directory", path);
+    return Status(Code::kIoError, "%s: cannot open: %s", path, strerror(errno));
+  }
+  out->reset(f);
+  return Status::Ok();
+}
+
+Status DecodeFile(const char* path, const codecs::DecodeRequest& request) {
+  FilePtr file;
+  LB_RETURN_IF_ERROR(OpenFile(path, &file));
+  codecs::FileSource src(file.get());
+  return Decode(src, ImageFileType::kAuto, request);
+}
+
+}  // namespace
+
+Status ProbeImageFile(const char* path, ImageFileInfo* info) {
+  codecs::DecodeRequest request;
+  request.name = path;
+  request.info = info;
+  return DecodeFile(path, request);
+}
+
+Status StreamImageFile(const char* path, int32_t index, FrameSink& sink) {
+  ImageFileInfo info;
+  codecs::DecodeRequest request;
+  request.name = path;
+  request.info = &info;
+  request.sink = &sink;
+  request.index = index;
+  return DecodeFile(path, request);
+}
+
+Status ReadImageFile(const char* path, ImageFileInfo* info, std::vector<uint8_t>* pixels) {
+  CollectSink collect(path, info, pixels);
+  Status s = StreamImageFile(path, 0, collect);
+  if (!s.ok()) pixels->clear();
+  return s;
+}
+
+Status ReadImageMemory(const uint8_t* data, size_t size, const char* name, ImageFileInfo* info,
+                       std::vector<uint8_t>* pixels, ImageFileType type) {
+  CollectSink collect(name, info, pixels);
+  codecs::MemorySource src(data, size);
+  codecs::DecodeRequest request;
+  request.name = name;
+  request.info = info;
+  request.sink = &collect;
+  Status s = Decode(src, type, request);
+  if (!s.ok()) pixels->clear();
+  return s;
+}
+
+Status ProbeImageMemory(const uint8_t* data, size_t size, const char* name, ImageFileInfo* info,
+                        ImageFileType type) {
+  codecs::MemorySource src(data, size);
+  codecs::DecodeRequest request;
+  request.name = name;
+  request.info = info;
+  return Decode(src, type, request);
+}
+
+}  // namespace lb

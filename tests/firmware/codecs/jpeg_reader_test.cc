@@ -1,0 +1,139 @@
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "firmware/codecs/image_file.h"
+#include "tests/firmware/codecs/recording_sink.h"
+#include "tests/firmware/codecs/test_images.h"
+
+namespace lb {
+namespace {
+
+using test::Bytes;
+
+std::vector<uint8_t> Pattern(int width, int height, int components) {
+  std::vector<uint8_t> pixels;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      for (int c = 0; c < components; ++c) pixels.push_back(test::Smooth(x, y, c));
+    }
+  }
+  return pixels;
+}
+
+Bytes Encode(int width, int height, int components, bool progressive = false) {
+  Bytes out;
+  const std::vector<uint8_t> pixels = Pattern(width, height, components);
+  EXPECT_TRUE(test::EncodeJpeg(width, height, components, pixels.data(), 95, progressive, &out));
+  return out;
+}
+
+int MaxDifference(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b) {
+  if (a.size() != b.size()) return 1000;
+  int worst = 0;
+  for (size_t i = 0; i < a.size(); ++i) worst = std::max(worst, std::abs(a[i] - b[i]));
+  return worst;
+}
+
+Status Read(const Bytes& bytes, ImageFileInfo* info, std::vector<uint8_t>* pixels) {
+  return ReadImageMemory(bytes.data(), bytes.size(), "x.jpg", info, pixels);
+}
+
+TEST(JpegReader, ReadsRgbInStripsCloseToTheOriginal) {
+  const std::string path = ::testing::TempDir() + "rgb.jpg";
+  ASSERT_TRUE(test::WriteFile(path, Encode(24, 40, 3)));
+  test::RecordingSink sink;
+  ASSERT_TRUE(StreamImageFile(path.c_str(), 2, sink).ok()) << sink.error;
+  ASSERT_EQ(sink.frames.size(), 1u);
+  EXPECT_EQ(sink.frames[0].info.index, 2);
+  EXPECT_EQ(sink.frames[0].info.format, PixelFormat::kRgb8);
+  EXPECT_EQ(sink.frames[0].info.width, 24);
+  EXPECT_EQ(sink.frames[0].info.height, 40);
+  EXPECT_EQ(sink.frames[0].strip_heights, (std::vector<int32_t>{16, 16, 8}));
+  // Quality 95 on a smooth gradient: chroma subsampling and rounding cost a few levels.
+  EXPECT_LE(MaxDifference(sink.frames[0].pixels, Pattern(24, 40, 3)), 6);
+}
+
+TEST(JpegReader, ReadsGrayAndProgressive) {
+  ImageFileInfo info;
+  std::vector<uint8_t> pixels;
+  ASSERT_TRUE(Read(Encode(17, 9, 1), &info, &pixels).ok());
+  EXPECT_EQ(info.format, PixelFormat::kGray8);
+  EXPECT_LE(MaxDifference(pixels, Pattern(17, 9, 1)), 3);
+
+  const Status s = Read(Encode(33, 18, 3, true), &info, &pixels);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(info.format, PixelFormat::kRgb8);
+  EXPECT_LE(MaxDifference(pixels, Pattern(33, 18, 3)), 6);
+}
+
+TEST(JpegReader, TruncatedJpegIsAnErrorNotGreyPadding) {
+  const Bytes bytes = Encode(64, 64, 3);
+  for (size_t keep : {size_t{100}, bytes.size() / 2, bytes.size() - 2}) {
+    const Bytes cut(bytes.begin(), bytes.begin() + static_cast<long>(keep));
+    ImageFileInfo info;
+    std::vector<uint8_t> pixels;
+    const Status s = Read(cut, &info, &pixels);
+    EXPECT_EQ(s.code(), Code::kCorruptData) << keep;
+    EXPECT_EQ(std::string(s.message()),
+              "x.jpg: truncated: JPEG data ends after " + std::to_string(keep) + " bytes");
+    EXPECT_TRUE(pixels.empty());
+  }
+}
+
+TEST(JpegReader, CorruptEntropyDataIsAnError) {
+  Bytes bytes = Encode(64, 64, 3);
+  // Garbage markers in the middle of the scan: libjpeg would only warn and carry on.
+  for (size_t i = bytes.size() / 2; i < bytes.size() / 2 + 16; i += 2) {
+    bytes[i] = 0xff;
+    bytes[i + 1] = 0xd3;
+  }
+  ImageFileInfo info;
+  std::vector<uint8_t> pixels;
+  const Status s = Read(bytes, &info, &pixels);
+  EXPECT_EQ(s.code(), Code::kCorruptData);
+  EXPECT_EQ(std::string(s.message()).rfind("x.jpg: JPEG ", 0), 0u) << s.message();
+}
+
+TEST(JpegReader, CmykIsRejectedClearly) {
+  ImageFileInfo info;
+  const Bytes bytes = Encode(8, 8, 4);
+  const Status s = ProbeImageMemory(bytes.data(), bytes.size(), "print.jpg", &info);
+  EXPECT_EQ(s.code(), Code::kUnsupported);
+  EXPECT_STREQ(s.message(), "print.jpg: CMYK JPEG is not supported (save it as RGB)");
+}
+
+TEST(ImageFile, DetectsTheFormatByMagicNotByName) {
+  const std::string path = ::testing::TempDir() + "really_a_jpeg.png";
+  ASSERT_TRUE(test::WriteFile(path, Encode(8, 8, 1)));
+  ImageFileInfo info;
+  std::vector<uint8_t> pixels;
+  ASSERT_TRUE(ReadImageFile(path.c_str(), &info, &pixels).ok());
+  EXPECT_EQ(info.format, PixelFormat::kGray8);
+  EXPECT_EQ(pixels.size(), 64u);
+
+  const std::string text = ::testing::TempDir() + "notes.jpg";
+  ASSERT_TRUE(test::WriteFile(text, {'h', 'e', 'l', 'l', 'o'}));
+  const Status s = ProbeImageFile(text.c_str(), &info);
+  EXPECT_EQ(s.code(), Code::kUnsupported);
+  EXPECT_EQ(std::string(s.message()),
+            text + ": not a PPM, PGM, PNG or JPEG file (starts 68 65 6c 6c)");
+}
+
+TEST(ImageFile, MissingAndEmptyFilesAreErrorsNamingThem) {
+  ImageFileInfo info;
+  Status s = ProbeImageFile("missing/a.ppm", &info);
+  EXPECT_EQ(s.code(), Code::kNotFound);
+  EXPECT_STREQ(s.message(), "missing/a.ppm: no such file or directory");
+
+  const std::string empty = ::testing::TempDir() + "empty.ppm";
+  ASSERT_TRUE(test::WriteFile(empty, {}));
+  s = ProbeImageFile(empty.c_str(), &info);
+  EXPECT_EQ(s.code(), Code::kCorruptData);
+  EXPECT_EQ(std::string(s.message()), empty + ": empty file");
+}
+
+}  // namespace
+}  // namespace lb
