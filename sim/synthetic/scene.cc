@@ -110,6 +110,10 @@ Status Scene::Configure(const SceneParams& params, int32_t width, int32_t height
   if (reference >= views)
     return Status(Code::kInvalidArgument, "synthetic scene: reference %d not among %d views",
                   params.reference, views);
+  if (params.geometry != ViewGeometry::kRectified && params.geometry != ViewGeometry::kHandheld)
+    return Status(Code::kInvalidArgument,
+                  "synthetic scene: geometry %d is neither rectified nor handheld",
+                  static_cast<int>(params.geometry));
   if (!(params.fov_deg >= 10 && params.fov_deg <= 120))
     return Status(Code::kInvalidArgument, "synthetic scene: field of view %.1f outside 10..120",
                   params.fov_deg);
@@ -297,7 +301,7 @@ void Scene::BuildFixedPoint() {
 // Turns `pose` so the reference point (0, 0, depth) lies on the view's optical axis: the
 // rotation taking its direction a to b = (0, 0, 1), I + [v]x + [v]x^2 / (1 + a.b) with
 // v = a x b (no trigonometry: the same bits everywhere).
-static void TurnToward(double depth, Pose* pose) {
+static void TurnToward(double depth, ViewMotion* pose) {
   double q[3];
   for (int i = 0; i < 3; ++i) q[i] = pose->rotation[i][2] * depth + pose->translation[i];
   const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
@@ -313,7 +317,7 @@ static void TurnToward(double depth, Pose* pose) {
       r[i][j] = (i == j ? 1.0 : 0.0) + vx[i][j] + sq / (1 + c);
     }
   }
-  Pose out;
+  ViewMotion out;
   for (int i = 0; i < 3; ++i) {
     out.translation[i] = 0;
     for (int j = 0; j < 3; ++j) {
@@ -326,9 +330,9 @@ static void TurnToward(double depth, Pose* pose) {
 }
 
 Status Scene::BuildView(int32_t view) {
-  Pose& pose = poses_[view];
-  pose = Pose();
-  if (params_.motion == CameraMotion::kRectified) {
+  ViewMotion& pose = poses_[view];
+  pose = ViewMotion();
+  if (params_.geometry == ViewGeometry::kRectified) {
     pose.translation[0] = -(view - reference_) * baseline_;
   } else if (view != reference_) {
     Rng rng{params_.seed * 0x2545F4914F6CDD1Dull + static_cast<uint64_t>(view) * 0x9E37ull + 7};
@@ -351,7 +355,7 @@ Status Scene::BuildView(int32_t view) {
     if (params_.converge_m > 0) TurnToward(params_.converge_m, &pose);
   }
 
-  const Intrinsics& in = intrinsics_;
+  const CameraIntrinsics& in = intrinsics_;
   const Mat3 k = {{in.fx, 0, in.cx}, {0, in.fy, in.cy}, {0, 0, 1}};
   const Mat3 k_inv = {{1 / in.fx, 0, -in.cx / in.fx}, {0, 1 / in.fy, -in.cy / in.fy}, {0, 0, 1}};
   for (int32_t i = 0; i < object_count_; ++i) {

@@ -41,7 +41,7 @@ TEST(PlanesTest, RectifiedRigAsPlanesGivesTheRectifiedLabels) {
   motion.intrinsics = {128, 128, 32, 20};
   for (int32_t v = 0; v < c.views; ++v)
     motion.motion[v].translation[0] = -(v - c.reference) / 128.0;
-  c.geometry = DepthGeometry::kPlanes;
+  c.geometry = ViewGeometry::kKnownPoses;
   std::vector<PlaneHomography> planes(static_cast<size_t>(c.views) * c.labels);
   MakeLabelPlanes(motion, c, 1.0, planes.data());
   Stage sweep;
@@ -78,7 +78,7 @@ TEST(PlanesTest, SetPlanesContract) {
   EXPECT_EQ(s.Compute(b.views.data()).code(), Code::kInvalidArgument) << "planes are per burst";
 
   DepthConfig rect = l.config;
-  rect.geometry = DepthGeometry::kRectified;
+  rect.geometry = ViewGeometry::kRectified;
   Stage r;
   ASSERT_TRUE(r.Configure(rect).ok());
   EXPECT_EQ(r.depth.SetPlanes(planes.data()).code(), Code::kInvalidArgument);
@@ -101,7 +101,7 @@ TEST(PlanesTest, ComputeAllocatesNothing) {
   EXPECT_GT(testing::AllocationCount(), guard) << "the counter must see allocations";
 }
 
-// FNV-1a of a kPlanes depth map: the scene renders the same bytes everywhere, the homographies
+// FNV-1a of a kKnownPoses depth map: the scene renders the same bytes everywhere, the homographies
 // are double geometry without FMA contraction and the kernel integer-only, so this value is the
 // same on x86-64, aarch64 and armhf (checked under qemu).
 TEST(PlanesTest, DepthMapBitsArePinned) {

@@ -92,7 +92,7 @@ TEST(SceneTest, SameSeedSameBytesOtherSeedOtherBytes) {
 TEST(SceneTest, BytesMatchTheGoldenOnEveryArchitecture) {
   Scene rect = Make(200, 150, 5);
   SceneParams hand_params;
-  hand_params.motion = CameraMotion::kHandheld;
+  hand_params.geometry = ViewGeometry::kHandheld;
   hand_params.seed = 7;
   Scene hand = Make(200, 150, 5, hand_params);
   std::vector<uint8_t> disp_bytes;
@@ -107,9 +107,9 @@ TEST(SceneTest, BytesMatchTheGoldenOnEveryArchitecture) {
 }
 
 TEST(SceneTest, StripsEqualWholeFrame) {
-  for (CameraMotion motion : {CameraMotion::kRectified, CameraMotion::kHandheld}) {
+  for (ViewGeometry geometry : {ViewGeometry::kRectified, ViewGeometry::kHandheld}) {
     SceneParams params;
-    params.motion = motion;
+    params.geometry = geometry;
     Scene scene = Make(97, 71, 4, params);
     const Frame whole = Render(scene, 3);
     for (int32_t strip : {1, 7, 16}) {
@@ -174,11 +174,11 @@ TEST(SceneTest, RectifiedDisparityMatchesTheViews) {
 // into view v with the pose and project it with the intrinsics.
 TEST(SceneTest, HandheldPosesAndDepthMatchTheViews) {
   SceneParams params;
-  params.motion = CameraMotion::kHandheld;
+  params.geometry = ViewGeometry::kHandheld;
   params.seed = 11;
   Scene scene = Make(800, 600, 3, params);
   const int32_t w = scene.width(), h = scene.height(), ref = scene.reference();
-  const Intrinsics& k = scene.intrinsics();
+  const CameraIntrinsics& k = scene.intrinsics();
   const Frame rf = Render(scene, ref);
   std::vector<uint16_t> rho_q12(size_t(w) * h);
   ASSERT_TRUE(scene.InverseDepthRows(1, 0, h, rho_q12.data(), w).ok());
@@ -188,7 +188,7 @@ TEST(SceneTest, HandheldPosesAndDepthMatchTheViews) {
   const std::vector<uint8_t> ref_ids = Objects(scene, ref);
   for (int32_t v = 0; v < scene.views(); ++v) {
     if (v == ref) continue;
-    const Pose& pose = scene.pose(v);
+    const ViewMotion& pose = scene.pose(v);
     const Frame vf = Render(scene, v);
     const std::vector<uint8_t> ids = Objects(scene, v);
     double err = 0, err_par = 0, err_wrong = 0;
@@ -242,14 +242,14 @@ TEST(SceneTest, HandheldPosesAndDepthMatchTheViews) {
 
 TEST(SceneTest, HandheldPosesStayWithinTheirBounds) {
   SceneParams params;
-  params.motion = CameraMotion::kHandheld;
+  params.geometry = ViewGeometry::kHandheld;
   params.max_rotation_deg = 1.0;
   params.max_translation = 0.01;
   Scene scene = Make(320, 240, 7, params);
   ASSERT_EQ(scene.reference(), 3);
   double largest_angle = 0;
   for (int32_t v = 0; v < 7; ++v) {
-    const Pose& p = scene.pose(v);
+    const ViewMotion& p = scene.pose(v);
     const double trace = p.rotation[0][0] + p.rotation[1][1] + p.rotation[2][2];
     const double angle_deg = std::acos(std::min(1.0, (trace - 1) / 2)) * 180 / M_PI;
     const double t =
@@ -365,9 +365,9 @@ TEST(SceneTest, SceneIsResolutionIndependent) {
 
 TEST(SceneTest, AnyResolutionWorks) {
   for (auto [w, h] : {std::pair{64, 48}, {97, 71}, {16, 16}, {67, 17}, {50, 200}}) {
-    for (CameraMotion motion : {CameraMotion::kRectified, CameraMotion::kHandheld}) {
+    for (ViewGeometry geometry : {ViewGeometry::kRectified, ViewGeometry::kHandheld}) {
       SceneParams params;
-      params.motion = motion;
+      params.geometry = geometry;
       Scene scene = Make(w, h, 2, params);
       const Frame f = Render(scene, 1);
       EXPECT_NE(std::count(f.rgb.begin(), f.rgb.end(), f.rgb[0]), ptrdiff_t(f.rgb.size()));
@@ -389,9 +389,9 @@ TEST(SceneTest, ExtremeParametersStayInRange) {
                         {8192, 8192, 10, 8, 0, 0},    {8192, 6144, 120, 0.1, 10, 0.1},
                         {17, 16, 65, 1, 10, 0.1}};
   for (const Case& c : cases) {
-    for (CameraMotion motion : {CameraMotion::kRectified, CameraMotion::kHandheld}) {
+    for (ViewGeometry geometry : {ViewGeometry::kRectified, ViewGeometry::kHandheld}) {
       SceneParams params;
-      params.motion = motion;
+      params.geometry = geometry;
       params.fov_deg = c.fov;
       params.disparity_scale = c.disparity_scale;
       params.max_rotation_deg = c.rotation;
@@ -450,6 +450,11 @@ TEST(SceneTest, RejectsBadArguments) {
   bad = SceneParams();
   bad.max_rotation_deg = 45;
   EXPECT_EQ(scene.Configure(bad, 64, 48, 5).code(), Code::kInvalidArgument);
+  for (const ViewGeometry g : {ViewGeometry::kKnownPoses, ViewGeometry::kAuto}) {
+    bad = SceneParams();
+    bad.geometry = g;
+    EXPECT_EQ(scene.Configure(bad, 64, 48, 5).code(), Code::kInvalidArgument) << int(g);
+  }
   ASSERT_TRUE(scene.Configure(SceneParams(), 64, 48, 5).ok());
   EXPECT_EQ(scene.RenderRows(5, 0, 1, buf, 64 * 3).code(), Code::kInvalidArgument);
   EXPECT_EQ(scene.RenderRows(0, 47, 2, buf, 64 * 3).code(), Code::kInvalidArgument);
