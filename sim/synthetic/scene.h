@@ -168,6 +168,10 @@ class Scene {
   void Shade(int32_t object, int64_t xr_q16, int64_t yr_q16, int32_t* rgb) const;
   Status CheckTruthArgs(int32_t scale, int32_t y0, int32_t rows, const void* out,
                         ptrdiff_t stride) const;
+  // Calls fn(x, y, object, rho_q40) for rows [y0, y0 + rows) of `view`'s grid at full / scale,
+  // each sample at the centre of its block, with the renderer's z-test.
+  template <typename Fn>
+  void ForEachTruthSample(int32_t view, int32_t scale, int32_t y0, int32_t rows, Fn&& fn) const;
 
   SceneParams params_;
   int32_t width_ = 0, height_ = 0, views_ = 0, reference_ = 0;
