@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "algo/core/fixed_point.h"
+#include "algo/core/sin_cos.h"
 
 // This file is compiled with -ffp-contract=off (see CMakeLists.txt): the double setup below must
 // round the same way on every architecture, and it uses no libm function except sqrt.
@@ -10,7 +11,6 @@
 namespace lb {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDesignW = 640, kDesignH = 480;
 constexpr double kWallDepth = 12.0;  // metres
 constexpr double kWallDisp = 0.5;    // design px per view step at disparity_scale 1
@@ -30,20 +30,6 @@ struct Rng {
   double Range(double lo, double hi) { return lo + (hi - lo) * Uniform(); }
   int32_t Int(int32_t n) { return static_cast<int32_t>(Next() % static_cast<uint64_t>(n)); }
 };
-
-// Taylor series, accurate to double rounding for |x| <= pi/2, and identical on every target.
-void SinCos(double x, double* s, double* c) {
-  double sin_term = x, cos_term = 1, sum_sin = x, sum_cos = 1;
-  const double x2 = x * x;
-  for (int n = 1; n <= 14; ++n) {
-    sin_term *= -x2 / static_cast<double>((2 * n) * (2 * n + 1));
-    cos_term *= -x2 / static_cast<double>((2 * n - 1) * (2 * n));
-    sum_sin += sin_term;
-    sum_cos += cos_term;
-  }
-  *s = sum_sin;
-  *c = sum_cos;
-}
 
 int64_t ToFixed(double v, int frac) {
   return static_cast<int64_t>(std::floor(v * static_cast<double>(int64_t{1} << frac) + 0.5));
@@ -144,7 +130,7 @@ Status Scene::Configure(const SceneParams& params, int32_t width, int32_t height
 void Scene::BuildLayout(const SceneParams& params) {
   Rng rng{params.seed ^ 0x5CE7E5EEDull};
   double s, c;
-  SinCos(params.fov_deg * kPi / 360.0, &s, &c);
+  SinCosDeg(params.fov_deg / 2, &s, &c);
   focal_design_ = 0.5 * kDesignW * c / s;
   const double base_baseline = kWallDisp * kWallDepth / focal_design_;
   baseline_ = base_baseline * params.disparity_scale;
@@ -282,7 +268,7 @@ void Scene::BuildFixedPoint() {
     o.r0sq_q32 = ToFixed(o.r0 * s * o.r0 * s, 32);
     o.r1sq_q32 = ToFixed(o.r1 * s * o.r1 * s, 32);
     double sn, cs;
-    SinCos(o.angle_deg * kPi / 180, &sn, &cs);
+    SinCosDeg(o.angle_deg, &sn, &cs);
     o.cos_q15 = ToFixed(cs, 15);
     o.sin_q15 = ToFixed(sn, 15);
     o.half_len_q31 = ToFixed(o.r0 * s, 31);
@@ -340,9 +326,9 @@ Status Scene::BuildView(int32_t view) {
     RandomUnit(rng, axis);
     // Magnitudes from the upper part of their range, and mostly sideways motion, as a burst
     // from a hand gives: enough parallax for depth in every view.
-    const double angle = rng.Range(0.3, 1) * params_.max_rotation_deg * kPi / 180;
+    const double angle_deg = rng.Range(0.3, 1) * params_.max_rotation_deg;
     double s, c;
-    SinCos(angle, &s, &c);
+    SinCosDeg(angle_deg, &s, &c);
     const double k[3][3] = {{0, -axis[2], axis[1]}, {axis[2], 0, -axis[0]}, {-axis[1], axis[0], 0}};
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j)
@@ -402,7 +388,7 @@ Status Scene::BuildView(int32_t view) {
     double ex = o.r0 * sc, ey = o.r0 * sc;
     if (o.shape == Shape::kBox) {
       double sn, cs;
-      SinCos(o.angle_deg * kPi / 180, &sn, &cs);
+      SinCosDeg(o.angle_deg, &sn, &cs);
       ex = std::fabs(o.r0 * sn) * sc + std::fabs(o.r1 * cs) * sc;
       ey = std::fabs(o.r0 * cs) * sc + std::fabs(o.r1 * sn) * sc;
     }
