@@ -53,8 +53,8 @@ Status DepthStage::Validate(const DepthConfig& c) {
                   c.color_trunc, c.census_weight, c.smooth_weight, c.smooth_trunc, c.edge_threshold,
                   c.edge_weight_q8, c.max_cycles, c.coarse_step, c.fine_window);
   }
-  if (c.geometry != DepthGeometry::kRectified && c.geometry != DepthGeometry::kPlanes) {
-    return Status(Code::kInvalidArgument, "depth: unknown geometry %d",
+  if (c.geometry != ViewGeometry::kRectified && c.geometry != ViewGeometry::kKnownPoses) {
+    return Status(Code::kInvalidArgument, "depth: geometry %d is neither rectified nor known poses",
                   static_cast<int>(c.geometry));
   }
   return Status::Ok();
@@ -104,7 +104,7 @@ Status DepthStage::Carve(Arena& arena) {
   Arena blocks(refine, refine == nullptr ? 0 : refine_bytes);
   CarveGrid(blocks, coarse_, (w + 1) / 2, (h + 1) / 2, false);
   planes_ = nullptr;
-  if (config_.geometry == DepthGeometry::kPlanes) {
+  if (config_.geometry == ViewGeometry::kKnownPoses) {
     planes_ = arena.Allocate<PlaneHomography>(static_cast<size_t>(config_.labels) * config_.views);
   }
   stats_.arena_bytes = arena.used() - start;
@@ -131,8 +131,8 @@ Status DepthStage::Configure(const DepthConfig& config, Arena& arena) {
 
 Status DepthStage::SetPlanes(const PlaneHomography* homographies) {
   const DepthConfig& c = config_;
-  if (c.geometry != DepthGeometry::kPlanes || planes_ == nullptr || homographies == nullptr) {
-    return Status(Code::kInvalidArgument, "depth: planes need a kPlanes configuration");
+  if (c.geometry != ViewGeometry::kKnownPoses || planes_ == nullptr || homographies == nullptr) {
+    return Status(Code::kInvalidArgument, "depth: planes need a known-poses configuration");
   }
   // Label-major, so one label's views are contiguous for the data term.
   for (int32_t v = 0; v < c.views; ++v) {
@@ -295,7 +295,7 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
                     views[v].width, views[v].height, views[v].channels, c.width, c.height);
     }
   }
-  if (c.geometry == DepthGeometry::kPlanes) {
+  if (c.geometry == ViewGeometry::kKnownPoses) {
     if (!planes_set_) return Status(Code::kInvalidArgument, "depth: no planes set for this burst");
     planes_set_ = false;
   }

@@ -6,10 +6,11 @@
 // the focus plane, and the points behind it have negative disparities. The map is unsigned: it
 // holds d + MapBiasQ8, the bias lifting the farthest label of a signed range to 0.
 //
-// Plane sweep (DepthGeometry::kPlanes, for handheld bursts): label l is instead a fronto-parallel
-// plane of the reference camera, given per view as its plane-induced homography (SetPlanes,
-// planes.h), and view v is sampled at H_vl(x, y) (warp_cost.h). The output stays LabelDispQ8(l):
-// the caller picks disp_min_q8..disp_max_q8 proportional to the planes' inverse depths.
+// Plane sweep (ViewGeometry::kKnownPoses, for handheld bursts): label l is instead a
+// fronto-parallel plane of the reference camera, given per view as its plane-induced homography
+// (SetPlanes, planes.h), and view v is sampled at H_vl(x, y) (warp_cost.h). The output stays
+// LabelDispQ8(l): the caller picks disp_min_q8..disp_max_q8 proportional to the planes' inverse
+// depths.
 #pragma once
 
 #include <cstddef>
@@ -21,11 +22,10 @@
 #include "algo/core/status.h"
 #include "algo/depth/data_term.h"
 #include "algo/depth/grid_maxflow.h"
+#include "algo/motion/camera.h"
 #include "algo/motion/plane_homography.h"
 
 namespace lb {
-
-enum class DepthGeometry : uint8_t { kRectified, kPlanes };
 
 struct DepthConfig {
   static constexpr int32_t kMaxViews = 16;
@@ -41,7 +41,7 @@ struct DepthConfig {
   // most 65535 apart.
   int32_t disp_min_q8 = 0;
   int32_t disp_max_q8 = 0;
-  DepthGeometry geometry = DepthGeometry::kRectified;
+  ViewGeometry geometry = ViewGeometry::kRectified;  // or kKnownPoses
 
   // Data term (see data_term.h).
   int32_t color_trunc = 45;   // truncation of |dR|+|dG|+|dB|, 1..765
@@ -101,11 +101,11 @@ class DepthStage {
   // Told after each expansion move of Compute (borrowed; nullptr: nobody).
   void SetProgress(ProgressSink* progress) { progress_ = progress; }
 
-  // kPlanes only, after Configure and before each Compute (a Compute consumes them, so a new
+  // kKnownPoses only, after Configure and before each Compute (a Compute consumes them, so a new
   // burst cannot run on the last one's poses): homographies[v * labels + l] is label l's plane
   // seen from view v (the reference's entries are ignored), copied into the arena.
   Status SetPlanes(const PlaneHomography* homographies);
-  // A new label range for the next bursts (kPlanes: each burst's own, from its tracked points),
+  // A new label range for the next bursts (kKnownPoses: each burst's own, from its tracked points),
   // within Validate's limits; the memory does not depend on it.
   Status SetDisparityRange(int32_t disp_min_q8, int32_t disp_max_q8);
 
@@ -157,9 +157,9 @@ class DepthStage {
 
   Status Carve(Arena& arena);
   void EdgeWeights(const ConstImageU8& ref);
-  // kPlanes: points the data term at one label's planes (a no-op for rectified shifts).
+  // kKnownPoses: points the data term at one label's planes (a no-op for rectified shifts).
   void UseLabelPlanes(int32_t label) {
-    if (config_.geometry == DepthGeometry::kPlanes)
+    if (config_.geometry == ViewGeometry::kKnownPoses)
       data_.SetPlanes(planes_ + label * config_.views);
   }
   void LabelCosts(int32_t label, uint16_t* out);  // D of one label for the whole image
@@ -204,7 +204,7 @@ class DepthStage {
   uint16_t* above_ = nullptr;  // D_p(f_p + 1)
   int64_t energy_ = 0;
   int32_t window_ = DepthConfig::kMaxLabels;  // the move in progress frees labels this near alpha
-  PlaneHomography* planes_ = nullptr;         // kPlanes: [label * views + view]
+  PlaneHomography* planes_ = nullptr;         // kKnownPoses: [label * views + view]
   bool planes_set_ = false;
 };
 

@@ -1,4 +1,4 @@
-// Plane-sweep pixel costs (DepthGeometry::kPlanes): one reference row against one view warped
+// Plane-sweep pixel costs (ViewGeometry::kKnownPoses): one reference row against one view warped
 // through a label's plane homography. The pixel cost is the rectified one (data_term.h) but the
 // sample position changes per pixel and in both axes: colour is bilinear over 4 taps, and the
 // census Hamming distance is the nearest tap's: on handheld bursts no worse than interpolating

@@ -1,5 +1,5 @@
-// Camera model shared by the motion stage and its users: a pinhole with square-ish pixels, and
-// each view's pose relative to the reference.
+// Camera model shared by the motion stage and its users: a pinhole with square-ish pixels, each
+// view's pose relative to the reference, and how the views of a burst relate.
 //
 // Coordinates: continuous pixel coordinates put pixel (i, j) on [i, i+1) x [j, j+1), so its
 // centre is (i + 0.5, j + 0.5); cx, cy are in those coordinates (the image centre is (w/2, h/2)).
@@ -42,6 +42,24 @@ inline double UndistortScale(double k1, double x, double y, double k0 = 0) {
 struct ViewMotion {
   double rotation[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
   double translation[3] = {0, 0, 0};
+};
+
+// How the views of a burst relate: one vocabulary for the synthetic scene (which moves its camera
+// so), the depth stage (which is told so) and the pipeline (which is told so, or finds out). Each
+// takes the values it can act on and refuses the others.
+enum class ViewGeometry : uint8_t {
+  // A rectified rig: equally spaced views, left to right, none turned; a point moves along its
+  // row by its disparity per view step. Scene, depth stage and pipeline.
+  kRectified,
+  // A hand holding the camera: each view turned and moved a little at random. Scene only: it
+  // knows the poses it drew; a pipeline given such a burst uses kAuto.
+  kHandheld,
+  // Every view's pose is given (ViewMotion): the depth stage sweeps planes through the views'
+  // homographies. Depth stage only.
+  kKnownPoses,
+  // The poses are unknown: the motion stage recovers them from the frames, then the depth stage
+  // runs as kKnownPoses. Pipeline only.
+  kAuto,
 };
 
 }  // namespace lb

@@ -44,14 +44,14 @@ struct LabelPlan {
 // kDegenerate when the estimate has no baseline or no depth range to label.
 Status PlanLabelRange(const MotionResult& motion, const LabelPlan& plan, LabelRange* out);
 
-// Hands a motion estimate to a kPlanes depth stage for its next Compute: the label range
+// Hands a motion estimate to a kKnownPoses depth stage for its next Compute: the label range
 // PlanLabelRange plans for the stage's labels and coarse step (set on the stage unless
 // keep_range, for a range the caller chose) and the
 // planes of those labels, built in `planes` (views x labels entries). `range` receives the plan.
 Status SetDepthGeometry(const MotionResult& motion, bool keep_range, DepthStage* depth,
                         PlaneHomography* planes, LabelRange* range);
 
-// After a kPlanes Compute on the planes SetDepthGeometry built for `motion`: asks the views'
+// After a kKnownPoses Compute on the planes SetDepthGeometry built for `motion`: asks the views'
 // occlusions which end of the label range is near (depth_order.h) and, when a clear majority
 // (twice the other's votes) says the low end, reverses the depth: the map (d -> -d), the
 // stage's range and the motion (MotionStage::ReverseDepth; nullptr stage or motion: left as

@@ -40,8 +40,8 @@ static DepthConfig MakeDepthConfig(const PipelineConfig& c, int32_t w, int32_t h
   d.disp_min_q8 = c.disp_min_q8;
   d.disp_max_q8 = c.disp_max_q8;
   d.workers = c.workers;
-  if (c.geometry == Geometry::kAuto) {
-    d.geometry = DepthGeometry::kPlanes;
+  if (c.geometry == ViewGeometry::kAuto) {
+    d.geometry = ViewGeometry::kKnownPoses;
     // Placeholder range for sizing; every burst sets its own (auto_geometry.h).
     d.disp_min_q8 = 0;
     d.disp_max_q8 = 16 << 8;
@@ -51,7 +51,7 @@ static DepthConfig MakeDepthConfig(const PipelineConfig& c, int32_t w, int32_t h
 
 // Frames too small to follow get no motion stage: ComputeDepth reports them as degenerate.
 static bool UsesMotion(const PipelineConfig& c, int32_t work_w, int32_t work_h) {
-  return c.geometry == Geometry::kAuto && work_w >= MotionConfig::kMinSize &&
+  return c.geometry == ViewGeometry::kAuto && work_w >= MotionConfig::kMinSize &&
          work_h >= MotionConfig::kMinSize;
 }
 
@@ -91,6 +91,11 @@ Status Pipeline::RequiredBytes(const PipelineConfig& c, size_t* bytes) {
   if (c.frames > PipelineConfig::kMaxFrames) {
     return Status(Code::kInvalidArgument, "a burst of %d frames: at most %d are used", c.frames,
                   PipelineConfig::kMaxFrames);
+  }
+  if (c.geometry != ViewGeometry::kRectified && c.geometry != ViewGeometry::kAuto) {
+    // The pipeline takes no poses, and a handheld burst's are unknown to it: kAuto finds them.
+    return Status(Code::kInvalidArgument, "geometry %d is neither rectified nor auto",
+                  static_cast<int>(c.geometry));
   }
   if (c.max_working_width < 8 || c.max_working_height < 8) {
     return Status(Code::kInvalidArgument, "working size bound %dx%d is below 8x8",
@@ -298,7 +303,7 @@ Status Pipeline::ComputeDepth() {
                       "%dx%d they shrink below %dx%d (take frames of a less extreme shape)",
                       config_.width, config_.height, config_.max_working_width,
                       config_.max_working_height, DepthConfig::kMinSize, DepthConfig::kMinSize);
-  } else if (config_.geometry == Geometry::kAuto) {
+  } else if (config_.geometry == ViewGeometry::kAuto) {
     geometry = EstimateGeometry(views);
   }
   if (geometry.code() == Code::kDegenerate) {
@@ -313,7 +318,7 @@ Status Pipeline::ComputeDepth() {
   }
   LB_RETURN_IF_ERROR(geometry);
   LB_RETURN_IF_ERROR(depth_.Compute(views, disp_q8_));
-  if (config_.geometry == Geometry::kAuto) {
+  if (config_.geometry == ViewGeometry::kAuto) {
     // SetDepthGeometry rebuilds the planes for every burst, so they are still this one's.
     LB_RETURN_IF_ERROR(OrderDepth(views, planes_, order_scratch_, &depth_, &motion_,
                                   &motion_result_, disp_q8_, nullptr));

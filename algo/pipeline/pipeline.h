@@ -21,16 +21,11 @@
 #include "algo/core/status.h"
 #include "algo/core/task_runner.h"
 #include "algo/depth/depth_stage.h"
+#include "algo/motion/camera.h"
 #include "algo/motion/motion_stage.h"
 #include "algo/render/render_stage.h"
 
 namespace lb {
-
-// How the frames of a burst relate to each other.
-enum class Geometry : uint8_t {
-  kRectified,  // a rectified, equally spaced rig, left to right (laboratory data)
-  kAuto,       // a handheld burst: the motion stage recovers every frame's pose
-};
 
 struct PipelineConfig {
   static constexpr int32_t kMaxFrames = DepthConfig::kMaxViews;
@@ -46,7 +41,8 @@ struct PipelineConfig {
   int32_t max_working_width = 640;
   int32_t max_working_height = 480;
   int32_t labels = 64;
-  Geometry geometry = Geometry::kRectified;
+  // kRectified (laboratory data) or kAuto (a handheld burst, or any whose poses are unknown).
+  ViewGeometry geometry = ViewGeometry::kRectified;
   // Disparity range of the labels, in working-resolution px per view step, Q8.8 (kRectified;
   // kAuto sets it from the tracked points, see auto_geometry.h).
   int32_t disp_min_q8 = 0;

@@ -45,7 +45,4 @@ class ApertureShape {
 // the total weight (sum of all cell weights, Q8). A radius below 0.5 px gives the identity.
 uint32_t BuildKernel(const ApertureShape& shape, float radius, int32_t half, KernelRow* rows);
 
-// Deterministic sine and cosine of degrees (Taylor series after range reduction).
-void SinCosDeg(double degrees, double* s, double* c);
-
 }  // namespace lb

@@ -128,9 +128,9 @@ bool WorkingSize(const char* text, JobOptions* job, std::string* why) {
 
 bool GeometryName(const char* text, JobOptions* job, std::string* why) {
   if (strcmp(text, "auto") == 0) {
-    job->pipeline.geometry = Geometry::kAuto;
+    job->pipeline.geometry = ViewGeometry::kAuto;
   } else if (strcmp(text, "rectified") == 0) {
-    job->pipeline.geometry = Geometry::kRectified;
+    job->pipeline.geometry = ViewGeometry::kRectified;
   } else {
     return Why(why, "'%s' is neither auto nor rectified", text);
   }

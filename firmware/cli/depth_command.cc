@@ -135,7 +135,7 @@ int DepthCommand(int argc, char** argv) {
   c.subpixel = false;
   bool range_given = false;
   JobOptions settings;  // --geometry, --focal-35mm and --labels, as run takes them
-  settings.pipeline.geometry = Geometry::kAuto;
+  settings.pipeline.geometry = ViewGeometry::kAuto;
   std::string error;
   std::vector<option> table = WithSettings(
       {
@@ -203,7 +203,7 @@ int DepthCommand(int argc, char** argv) {
   for (int i = options.rest(); i < argc; ++i) {
     if (!view(argv[i])) return Usage(error);
   }
-  const Geometry geometry = settings.pipeline.geometry;
+  const ViewGeometry geometry = settings.pipeline.geometry;
   const int32_t focal_35mm = settings.focal_35mm;
   c.labels = settings.pipeline.labels;
   if (files.size() < 2) return Usage("--views needs at least two files");
@@ -253,7 +253,7 @@ int DepthCommand(int argc, char** argv) {
     return Fail(msg);
   }
   char msg[512];
-  if (geometry == Geometry::kAuto &&
+  if (geometry == ViewGeometry::kAuto &&
       (c.width < MotionConfig::kMinSize || c.height < MotionConfig::kMinSize)) {
     snprintf(msg, sizeof(msg),
              "%s: %dx%d views are too small to follow the camera's motion (at least %dx%d); "
@@ -262,7 +262,7 @@ int DepthCommand(int argc, char** argv) {
              DepthConfig::kMinSize, DepthConfig::kMinSize);
     return Fail(msg);
   }
-  if (geometry == Geometry::kAuto) c.geometry = DepthGeometry::kPlanes;
+  if (geometry == ViewGeometry::kAuto) c.geometry = ViewGeometry::kKnownPoses;
   const Status valid = DepthStage::Validate(c);
   if (!valid.ok()) {
     snprintf(msg, sizeof(msg), "%s: %s", files[0], valid.message());
@@ -291,7 +291,7 @@ int DepthCommand(int argc, char** argv) {
   std::vector<ConstImageU8> views;
   for (const auto& p : pixels) views.push_back(MakeView(p.data(), c.width, c.height, 3));
   AutoGeometry geometry_state;
-  if (geometry == Geometry::kAuto) {
+  if (geometry == ViewGeometry::kAuto) {
     const double focal = focal_35mm > 0 ? FocalPxFrom35mm(focal_35mm, c.width, c.height)
                                         : ExifFocalPx(files[0], c.width, c.height);
     s = EstimatePlanes(views, focal, range_given, &stage, &c, &geometry_state);
@@ -301,7 +301,7 @@ int DepthCommand(int argc, char** argv) {
   const ImageU16 out = MakeView(disp.data(), c.width, c.height);
   s = stage.Compute(views.data(), out);
   if (!s.ok()) return Fail(s.message());
-  if (geometry == Geometry::kAuto) {
+  if (geometry == ViewGeometry::kAuto) {
     std::vector<uint8_t> scratch(DepthOrderScratchBytes(c.width, c.height));
     s = OrderDepth(views.data(), geometry_state.planes.data(), scratch.data(), &stage,
                    &geometry_state.motion, &geometry_state.result, out, nullptr);

@@ -60,7 +60,7 @@ int RunCommand(int argc, char** argv) {
   bool synthetic = false, range_given = false;
   const char* synthetic_only = nullptr;  // the last option that only the synthetic scene takes
   const char* motion = nullptr;
-  job.pipeline.geometry = Geometry::kAuto;
+  job.pipeline.geometry = ViewGeometry::kAuto;
   SceneParams scene;
   int32_t seed = 1;
 
@@ -142,8 +142,8 @@ int RunCommand(int argc, char** argv) {
   } else {
     scene.seed = static_cast<uint64_t>(seed);
     const bool handheld =
-        motion ? !strcmp(motion, "handheld") : job.pipeline.geometry == Geometry::kAuto;
-    scene.motion = handheld ? CameraMotion::kHandheld : CameraMotion::kRectified;
+        motion ? !strcmp(motion, "handheld") : job.pipeline.geometry == ViewGeometry::kAuto;
+    scene.geometry = handheld ? ViewGeometry::kHandheld : ViewGeometry::kRectified;
     if (job.pipeline.reference >= 0) scene.reference = job.pipeline.reference;
     auto synth = std::make_unique<SyntheticSensor>(scene);
     SensorMode mode;
@@ -151,7 +151,7 @@ int RunCommand(int argc, char** argv) {
     if (!s.ok()) return Fail(s.message());
     const Scene& sc = synth->scene();
     job.pipeline.reference = sc.reference();
-    if (!range_given && job.pipeline.geometry == Geometry::kRectified) {
+    if (!range_given && job.pipeline.geometry == ViewGeometry::kRectified) {
       // The scene knows its depth range: pad it by one label step on each side.
       PipelineConfig probe = job.pipeline;
       probe.width = mode.width;
@@ -193,7 +193,7 @@ int RunCommand(int argc, char** argv) {
       static_cast<double>(report.arena_bytes) / (1024.0 * 1024.0),
       runner.pipeline().config().workers, runner.pipeline().config().workers == 1 ? "" : "s");
   const Pipeline& p = runner.pipeline();
-  if (job.pipeline.geometry == Geometry::kAuto && report.warning.ok()) {
+  if (job.pipeline.geometry == ViewGeometry::kAuto && report.warning.ok()) {
     printf(
         "motion: %d points followed (reprojection %.2f px)%s, focal length %.0f px%s, depth "
         "labels %.2f..%.2f px per frame\n",

@@ -137,7 +137,7 @@ JobOptions DaemonJobDefaults() {
   o.sensor.width = 1280;
   o.sensor.height = 960;
   o.pipeline.labels = 32;  // half the command line's: a board's seconds count
-  o.pipeline.geometry = Geometry::kAuto;
+  o.pipeline.geometry = ViewGeometry::kAuto;
   return o;
 }
 

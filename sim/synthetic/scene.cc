@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "algo/core/fixed_point.h"
+#include "algo/core/sin_cos.h"
 
 // This file is compiled with -ffp-contract=off (see CMakeLists.txt): the double setup below must
 // round the same way on every architecture, and it uses no libm function except sqrt.
@@ -10,7 +11,6 @@
 namespace lb {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDesignW = 640, kDesignH = 480;
 constexpr double kWallDepth = 12.0;  // metres
 constexpr double kWallDisp = 0.5;    // design px per view step at disparity_scale 1
@@ -30,20 +30,6 @@ struct Rng {
   double Range(double lo, double hi) { return lo + (hi - lo) * Uniform(); }
   int32_t Int(int32_t n) { return static_cast<int32_t>(Next() % static_cast<uint64_t>(n)); }
 };
-
-// Taylor series, accurate to double rounding for |x| <= pi/2, and identical on every target.
-void SinCos(double x, double* s, double* c) {
-  double sin_term = x, cos_term = 1, sum_sin = x, sum_cos = 1;
-  const double x2 = x * x;
-  for (int n = 1; n <= 14; ++n) {
-    sin_term *= -x2 / static_cast<double>((2 * n) * (2 * n + 1));
-    cos_term *= -x2 / static_cast<double>((2 * n - 1) * (2 * n));
-    sum_sin += sin_term;
-    sum_cos += cos_term;
-  }
-  *s = sum_sin;
-  *c = sum_cos;
-}
 
 int64_t ToFixed(double v, int frac) {
   return static_cast<int64_t>(std::floor(v * static_cast<double>(int64_t{1} << frac) + 0.5));
@@ -110,6 +96,10 @@ Status Scene::Configure(const SceneParams& params, int32_t width, int32_t height
   if (reference >= views)
     return Status(Code::kInvalidArgument, "synthetic scene: reference %d not among %d views",
                   params.reference, views);
+  if (params.geometry != ViewGeometry::kRectified && params.geometry != ViewGeometry::kHandheld)
+    return Status(Code::kInvalidArgument,
+                  "synthetic scene: geometry %d is neither rectified nor handheld",
+                  static_cast<int>(params.geometry));
   if (!(params.fov_deg >= 10 && params.fov_deg <= 120))
     return Status(Code::kInvalidArgument, "synthetic scene: field of view %.1f outside 10..120",
                   params.fov_deg);
@@ -140,7 +130,7 @@ Status Scene::Configure(const SceneParams& params, int32_t width, int32_t height
 void Scene::BuildLayout(const SceneParams& params) {
   Rng rng{params.seed ^ 0x5CE7E5EEDull};
   double s, c;
-  SinCos(params.fov_deg * kPi / 360.0, &s, &c);
+  SinCosDeg(params.fov_deg / 2, &s, &c);
   focal_design_ = 0.5 * kDesignW * c / s;
   const double base_baseline = kWallDisp * kWallDepth / focal_design_;
   baseline_ = base_baseline * params.disparity_scale;
@@ -278,7 +268,7 @@ void Scene::BuildFixedPoint() {
     o.r0sq_q32 = ToFixed(o.r0 * s * o.r0 * s, 32);
     o.r1sq_q32 = ToFixed(o.r1 * s * o.r1 * s, 32);
     double sn, cs;
-    SinCos(o.angle_deg * kPi / 180, &sn, &cs);
+    SinCosDeg(o.angle_deg, &sn, &cs);
     o.cos_q15 = ToFixed(cs, 15);
     o.sin_q15 = ToFixed(sn, 15);
     o.half_len_q31 = ToFixed(o.r0 * s, 31);
@@ -297,7 +287,7 @@ void Scene::BuildFixedPoint() {
 // Turns `pose` so the reference point (0, 0, depth) lies on the view's optical axis: the
 // rotation taking its direction a to b = (0, 0, 1), I + [v]x + [v]x^2 / (1 + a.b) with
 // v = a x b (no trigonometry: the same bits everywhere).
-static void TurnToward(double depth, Pose* pose) {
+static void TurnToward(double depth, ViewMotion* pose) {
   double q[3];
   for (int i = 0; i < 3; ++i) q[i] = pose->rotation[i][2] * depth + pose->translation[i];
   const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
@@ -313,7 +303,7 @@ static void TurnToward(double depth, Pose* pose) {
       r[i][j] = (i == j ? 1.0 : 0.0) + vx[i][j] + sq / (1 + c);
     }
   }
-  Pose out;
+  ViewMotion out;
   for (int i = 0; i < 3; ++i) {
     out.translation[i] = 0;
     for (int j = 0; j < 3; ++j) {
@@ -326,9 +316,9 @@ static void TurnToward(double depth, Pose* pose) {
 }
 
 Status Scene::BuildView(int32_t view) {
-  Pose& pose = poses_[view];
-  pose = Pose();
-  if (params_.motion == CameraMotion::kRectified) {
+  ViewMotion& pose = poses_[view];
+  pose = ViewMotion();
+  if (params_.geometry == ViewGeometry::kRectified) {
     pose.translation[0] = -(view - reference_) * baseline_;
   } else if (view != reference_) {
     Rng rng{params_.seed * 0x2545F4914F6CDD1Dull + static_cast<uint64_t>(view) * 0x9E37ull + 7};
@@ -336,9 +326,9 @@ Status Scene::BuildView(int32_t view) {
     RandomUnit(rng, axis);
     // Magnitudes from the upper part of their range, and mostly sideways motion, as a burst
     // from a hand gives: enough parallax for depth in every view.
-    const double angle = rng.Range(0.3, 1) * params_.max_rotation_deg * kPi / 180;
+    const double angle_deg = rng.Range(0.3, 1) * params_.max_rotation_deg;
     double s, c;
-    SinCos(angle, &s, &c);
+    SinCosDeg(angle_deg, &s, &c);
     const double k[3][3] = {{0, -axis[2], axis[1]}, {axis[2], 0, -axis[0]}, {-axis[1], axis[0], 0}};
     for (int i = 0; i < 3; ++i)
       for (int j = 0; j < 3; ++j)
@@ -351,7 +341,7 @@ Status Scene::BuildView(int32_t view) {
     if (params_.converge_m > 0) TurnToward(params_.converge_m, &pose);
   }
 
-  const Intrinsics& in = intrinsics_;
+  const CameraIntrinsics& in = intrinsics_;
   const Mat3 k = {{in.fx, 0, in.cx}, {0, in.fy, in.cy}, {0, 0, 1}};
   const Mat3 k_inv = {{1 / in.fx, 0, -in.cx / in.fx}, {0, 1 / in.fy, -in.cy / in.fy}, {0, 0, 1}};
   for (int32_t i = 0; i < object_count_; ++i) {
@@ -398,7 +388,7 @@ Status Scene::BuildView(int32_t view) {
     double ex = o.r0 * sc, ey = o.r0 * sc;
     if (o.shape == Shape::kBox) {
       double sn, cs;
-      SinCos(o.angle_deg * kPi / 180, &sn, &cs);
+      SinCosDeg(o.angle_deg, &sn, &cs);
       ex = std::fabs(o.r0 * sn) * sc + std::fabs(o.r1 * cs) * sc;
       ey = std::fabs(o.r0 * cs) * sc + std::fabs(o.r1 * sn) * sc;
     }

@@ -15,7 +15,7 @@
 // textured in its own plane coordinates). Continuous pixel coordinates put pixel (i, j) on
 // [i, i+1) x [j, j+1); the principal point is the image centre.
 //
-// Camera motion:
+// Geometry (ViewGeometry, algo/motion/camera.h), kRectified or kHandheld:
 //  - kRectified: view v's camera centre is at ((v - reference) * baseline, 0, 0), no rotation,
 //    so a reference point of per-step disparity d is at x + (reference - v) * d in view v, same
 //    row (the depth stage's convention).
@@ -39,16 +39,15 @@
 #include <vector>
 
 #include "algo/core/status.h"
+#include "algo/motion/camera.h"
 
 namespace lb {
 
-enum class CameraMotion : uint8_t { kRectified, kHandheld };
-
 struct SceneParams {
   uint64_t seed = 1;
-  CameraMotion motion = CameraMotion::kRectified;
-  int32_t reference = -1;         // reference view; -1 = views / 2
-  double fov_deg = 65.0;          // horizontal field of view of a 4:3 frame
+  ViewGeometry geometry = ViewGeometry::kRectified;  // or kHandheld
+  int32_t reference = -1;                            // reference view; -1 = views / 2
+  double fov_deg = 65.0;                             // horizontal field of view of a 4:3 frame
   double disparity_scale = 1.0;   // scales the rectified baseline (and so every disparity)
   double max_rotation_deg = 1.0;  // handheld: rotation bound per frame
   double max_translation = 0.01;  // handheld: translation bound, a fraction of scene_depth()
@@ -57,19 +56,6 @@ struct SceneParams {
   double converge_m = 0;
   bool ground_plane = true;
   bool point_lights = true;
-};
-
-// Pinhole intrinsics in pixels of the rendered resolution; pixel (i, j) has its centre at
-// (i + 0.5, j + 0.5).
-struct Intrinsics {
-  double fx = 0, fy = 0, cx = 0, cy = 0;
-};
-
-// Maps reference-camera coordinates to this view's: X_view = rotation * X_ref + translation
-// (row-major rotation, translation in metres).
-struct Pose {
-  double rotation[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
-  double translation[3] = {0, 0, 0};
 };
 
 class Scene {
@@ -120,8 +106,9 @@ class Scene {
   int32_t views() const { return views_; }
   int32_t reference() const { return reference_; }
   const SceneParams& params() const { return params_; }
-  const Intrinsics& intrinsics() const { return intrinsics_; }
-  const Pose& pose(int32_t view) const { return poses_[view]; }
+  // In px of the rendered resolution, and each view's pose in metres (camera.h's conventions).
+  const CameraIntrinsics& intrinsics() const { return intrinsics_; }
+  const ViewMotion& pose(int32_t view) const { return poses_[view]; }
   double baseline() const { return baseline_; }  // metres per view step (rectified rig)
   // Depth whose inverse is midway between the wall's and the nearest object's (metres).
   double scene_depth() const { return scene_depth_; }
@@ -181,14 +168,18 @@ class Scene {
   void Shade(int32_t object, int64_t xr_q16, int64_t yr_q16, int32_t* rgb) const;
   Status CheckTruthArgs(int32_t scale, int32_t y0, int32_t rows, const void* out,
                         ptrdiff_t stride) const;
+  // Calls fn(x, y, object, rho_q40) for rows [y0, y0 + rows) of `view`'s grid at full / scale,
+  // each sample at the centre of its block, with the renderer's z-test.
+  template <typename Fn>
+  void ForEachTruthSample(int32_t view, int32_t scale, int32_t y0, int32_t rows, Fn&& fn) const;
 
   SceneParams params_;
   int32_t width_ = 0, height_ = 0, views_ = 0, reference_ = 0;
   double px_per_design_ = 1;  // pixels per design px
   double focal_design_ = 0;   // focal length in design px
   double baseline_ = 0, scene_depth_ = 1;
-  Intrinsics intrinsics_;
-  Pose poses_[kMaxViews];
+  CameraIntrinsics intrinsics_;
+  ViewMotion poses_[kMaxViews];
   Object objects_[kMaxObjects];
   int32_t object_count_ = 0;
   int32_t order_[kMaxObjects] = {};  // test order: nearest first

@@ -23,26 +23,25 @@ Status Scene::CheckTruthArgs(int32_t scale, int32_t y0, int32_t rows, const void
   return Status::Ok();
 }
 
-namespace {
-// Walks the reference view's grid at full / scale, sampling each block's centre.
 template <typename Fn>
-void ForEachTruthSample(int32_t scale, int32_t y0, int32_t rows, int32_t grid_w, Fn&& fn) {
-  for (int32_t y = y0; y < y0 + rows; ++y)
-    for (int32_t x = 0; x < grid_w; ++x) fn(x, y, (2 * x + 1) * scale, (2 * y + 1) * scale);
+void Scene::ForEachTruthSample(int32_t view, int32_t scale, int32_t y0, int32_t rows,
+                               Fn&& fn) const {
+  const ViewMap* maps = maps_[view];
+  RowState row;
+  for (int32_t y = y0; y < y0 + rows; ++y) {
+    PrepareRow(maps, (2 * y + 1) * scale, &row);
+    for (int32_t x = 0; x < width_ / scale; ++x) {
+      int64_t rho;
+      const int32_t object = Winner(maps, row, (2 * x + 1) * scale, &rho);
+      fn(x, y, object, rho);
+    }
+  }
 }
-}  // namespace
 
 Status Scene::DisparityRows(int32_t scale, int32_t y0, int32_t rows, uint16_t* out_q8,
                             ptrdiff_t stride) const {
   LB_RETURN_IF_ERROR(CheckTruthArgs(scale, y0, rows, out_q8, stride));
-  const int32_t grid_w = width_ / scale;
-  const ViewMap* maps = maps_[reference_];
-  RowState row;
-  int32_t last_y2 = -1;
-  ForEachTruthSample(scale, y0, rows, grid_w, [&](int32_t x, int32_t y, int32_t x2, int32_t y2) {
-    if (y2 != last_y2) PrepareRow(maps, last_y2 = y2, &row);
-    int64_t rho;
-    Winner(maps, row, x2, &rho);
+  ForEachTruthSample(reference_, scale, y0, rows, [&](int32_t x, int32_t y, int32_t, int64_t rho) {
     out_q8[(y - y0) * stride + x] = static_cast<uint16_t>(DispQ8(rho, scale));
   });
   return Status::Ok();
@@ -51,14 +50,7 @@ Status Scene::DisparityRows(int32_t scale, int32_t y0, int32_t rows, uint16_t* o
 Status Scene::InverseDepthRows(int32_t scale, int32_t y0, int32_t rows, uint16_t* out_q12,
                                ptrdiff_t stride) const {
   LB_RETURN_IF_ERROR(CheckTruthArgs(scale, y0, rows, out_q12, stride));
-  const int32_t grid_w = width_ / scale;
-  const ViewMap* maps = maps_[reference_];
-  RowState row;
-  int32_t last_y2 = -1;
-  ForEachTruthSample(scale, y0, rows, grid_w, [&](int32_t x, int32_t y, int32_t x2, int32_t y2) {
-    if (y2 != last_y2) PrepareRow(maps, last_y2 = y2, &row);
-    int64_t rho;
-    Winner(maps, row, x2, &rho);
+  ForEachTruthSample(reference_, scale, y0, rows, [&](int32_t x, int32_t y, int32_t, int64_t rho) {
     out_q12[(y - y0) * stride + x] = fx::Saturate<uint16_t>(fx::RoundShift<int64_t>(rho, 28));
   });
   return Status::Ok();
@@ -69,14 +61,8 @@ Status Scene::ObjectRows(int32_t view, int32_t scale, int32_t y0, int32_t rows, 
   LB_RETURN_IF_ERROR(CheckTruthArgs(scale, y0, rows, out, stride));
   if (view < 0 || view >= views_)
     return Status(Code::kInvalidArgument, "synthetic scene: view %d not among %d", view, views_);
-  const int32_t grid_w = width_ / scale;
-  const ViewMap* maps = maps_[view];
-  RowState row;
-  int32_t last_y2 = -1;
-  ForEachTruthSample(scale, y0, rows, grid_w, [&](int32_t x, int32_t y, int32_t x2, int32_t y2) {
-    if (y2 != last_y2) PrepareRow(maps, last_y2 = y2, &row);
-    int64_t rho;
-    out[(y - y0) * stride + x] = static_cast<uint8_t>(Winner(maps, row, x2, &rho));
+  ForEachTruthSample(view, scale, y0, rows, [&](int32_t x, int32_t y, int32_t object, int64_t) {
+    out[(y - y0) * stride + x] = static_cast<uint8_t>(object);
   });
   return Status::Ok();
 }

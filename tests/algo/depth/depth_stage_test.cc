@@ -238,14 +238,10 @@ TEST(DepthStageTest, DepthMapBitsArePinned) {
   Stage s;
   ASSERT_TRUE(s.Configure(PinnedConfig(b)).ok());
   ASSERT_TRUE(s.Compute(b).ok());
-  uint32_t hash = 2166136261u;
-  for (uint16_t v : s.disp) {
-    hash = (hash ^ (v & 0xff)) * 16777619u;
-    hash = (hash ^ (v >> 8)) * 16777619u;
-  }
-  EXPECT_EQ(hash, 422342360u) << "energy " << s.depth.stats().energy
-                              << ": if PinnedBurstIsCloseToTheTruth passes, the change kept the "
-                                 "map within its tolerance; re-pin on x86-64, check under qemu";
+  EXPECT_EQ(synth::DisparityHash(s.disp), 422342360u)
+      << "energy " << s.depth.stats().energy
+      << ": if PinnedBurstIsCloseToTheTruth passes, the change kept the "
+         "map within its tolerance; re-pin on x86-64, check under qemu";
 }
 
 TEST(DepthStageTest, ArenaFor640x480With7ViewsAnd64LabelsIsAtMost24MiB) {
@@ -256,7 +252,7 @@ TEST(DepthStageTest, ArenaFor640x480With7ViewsAnd64LabelsIsAtMost24MiB) {
   c.reference = 3;
   c.labels = 64;
   c.disp_max_q8 = 16 << 8;
-  for (const DepthGeometry g : {DepthGeometry::kRectified, DepthGeometry::kPlanes}) {
+  for (const ViewGeometry g : {ViewGeometry::kRectified, ViewGeometry::kKnownPoses}) {
     c.geometry = g;
     ASSERT_TRUE(DepthStage::Validate(c).ok());
     EXPECT_LE(DepthStage::RequiredBytes(c), size_t{24} << 20) << static_cast<int>(g);
@@ -281,6 +277,11 @@ TEST(DepthStageTest, RefusesBadConfigurationsAndInputs) {
   bad = c;
   bad.reference = 3;
   EXPECT_EQ(DepthStage::Validate(bad).code(), Code::kInvalidArgument);
+  for (const ViewGeometry g : {ViewGeometry::kHandheld, ViewGeometry::kAuto}) {
+    bad = c;
+    bad.geometry = g;
+    EXPECT_EQ(DepthStage::Validate(bad).code(), Code::kInvalidArgument) << static_cast<int>(g);
+  }
 
   const synth::Burst b = synth::MakeBurst(32, 16, 3, 1, 1, 2, 8, 20, 4, 12, 5u);
   Stage s;

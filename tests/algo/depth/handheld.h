@@ -34,22 +34,13 @@ struct Stage {
   }
 };
 
-inline ViewMotion ToMotion(const Pose& p) {
-  ViewMotion m;
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) m.rotation[i][j] = p.rotation[i][j];
-    m.translation[i] = p.translation[i];
-  }
-  return m;
-}
-
 // The scene's true poses as a motion result: inverse depth in 1/m, translations in metres.
 inline MotionResult TrueMotion(const motiontest::Burst& b) {
   MotionResult r;
   r.views = b.scene.views();
   r.reference = b.scene.reference();
   r.intrinsics = b.intrinsics;
-  for (int32_t v = 0; v < r.views; ++v) r.motion[v] = ToMotion(b.scene.pose(v));
+  for (int32_t v = 0; v < r.views; ++v) r.motion[v] = b.scene.pose(v);
   return r;
 }
 
@@ -77,7 +68,7 @@ inline Labels HandheldLabels(const motiontest::Burst& b, double margin) {
   c.height = b.scene.height();
   c.views = b.scene.views();
   c.reference = b.scene.reference();
-  c.geometry = DepthGeometry::kPlanes;
+  c.geometry = ViewGeometry::kKnownPoses;
   c.disp_min_q8 =
       static_cast<int32_t>(std::max(0.0, lo - margin * span) * out.px_per_inv_depth * 256);
   const int32_t top =

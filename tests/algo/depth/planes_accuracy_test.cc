@@ -1,6 +1,6 @@
 // Plane-sweep depth on synthetic handheld bursts with the scene's true poses: the bad-pixel rate
 // (error over 1 px of mean-baseline motion, every pixel) against the scene's ground truth over
-// seeds and view counts at 320x240, and the speed of a kPlanes run against kRectified with the
+// seeds and view counts at 320x240, and the speed of a kKnownPoses run against kRectified with the
 // same labels at 320x240 and 640x480. Release only (label accuracy): figures, printed.
 #include <gtest/gtest.h>
 
@@ -19,7 +19,7 @@ struct DepthRun {
   int32_t labels = 0;
 };
 
-DepthRun Depth(const motiontest::Burst& b, DepthGeometry geometry) {
+DepthRun Depth(const motiontest::Burst& b, ViewGeometry geometry) {
   DepthRun out;
   const handheld::Labels l = handheld::HandheldLabels(b, 0.1);
   DepthConfig c = l.config;
@@ -29,7 +29,7 @@ DepthRun Depth(const motiontest::Burst& b, DepthGeometry geometry) {
   EXPECT_TRUE(s.Configure(c).ok());
   const std::vector<PlaneHomography> planes = handheld::Planes(b, l);
   const auto t0 = std::chrono::steady_clock::now();
-  if (geometry == DepthGeometry::kPlanes) {
+  if (geometry == ViewGeometry::kKnownPoses) {
     EXPECT_TRUE(s.depth.SetPlanes(planes.data()).ok());
   }
   EXPECT_TRUE(s.Compute(b.views.data()).ok());
@@ -46,7 +46,7 @@ TEST(PlanesAccuracy, HandheldBurstsWithTruePoses) {
     for (const uint64_t seed : {1u, 2u, 3u, 4u}) {
       motiontest::Burst b;
       ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(seed), 320, 240, views, &b));
-      const DepthRun r = Depth(b, DepthGeometry::kPlanes);
+      const DepthRun r = Depth(b, ViewGeometry::kKnownPoses);
       std::printf(
           "seed %d, %d views, %d labels: %.2f %% bad (> 1 px), %.2f %% (> 0.5 px), %.2f s\n",
           static_cast<int>(seed), views, r.labels, r.bad_1px, r.bad_half_px, r.seconds);
@@ -66,9 +66,9 @@ TEST(PlanesAccuracy, SpeedAgainstRectified) {
   for (const int32_t w : {320, 640}) {
     motiontest::Burst b;
     ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(1), w, w * 3 / 4, 7, &b));
-    const DepthRun planes = Depth(b, DepthGeometry::kPlanes);
-    const DepthRun rect = Depth(b, DepthGeometry::kRectified);
-    std::printf("%dx%d, 7 views, %d labels: kPlanes %.3f s, kRectified %.3f s (x%.2f)\n", w,
+    const DepthRun planes = Depth(b, ViewGeometry::kKnownPoses);
+    const DepthRun rect = Depth(b, ViewGeometry::kRectified);
+    std::printf("%dx%d, 7 views, %d labels: kKnownPoses %.3f s, kRectified %.3f s (x%.2f)\n", w,
                 w * 3 / 4, planes.labels, planes.seconds, rect.seconds,
                 planes.seconds / rect.seconds);
   }

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 #include "algo/depth/depth_stage.h"
@@ -41,7 +42,7 @@ TEST(PlanesTest, RectifiedRigAsPlanesGivesTheRectifiedLabels) {
   motion.intrinsics = {128, 128, 32, 20};
   for (int32_t v = 0; v < c.views; ++v)
     motion.motion[v].translation[0] = -(v - c.reference) / 128.0;
-  c.geometry = DepthGeometry::kPlanes;
+  c.geometry = ViewGeometry::kKnownPoses;
   std::vector<PlaneHomography> planes(static_cast<size_t>(c.views) * c.labels);
   MakeLabelPlanes(motion, c, 1.0, planes.data());
   Stage sweep;
@@ -78,7 +79,7 @@ TEST(PlanesTest, SetPlanesContract) {
   EXPECT_EQ(s.Compute(b.views.data()).code(), Code::kInvalidArgument) << "planes are per burst";
 
   DepthConfig rect = l.config;
-  rect.geometry = DepthGeometry::kRectified;
+  rect.geometry = ViewGeometry::kRectified;
   Stage r;
   ASSERT_TRUE(r.Configure(rect).ok());
   EXPECT_EQ(r.depth.SetPlanes(planes.data()).code(), Code::kInvalidArgument);
@@ -101,23 +102,47 @@ TEST(PlanesTest, ComputeAllocatesNothing) {
   EXPECT_GT(testing::AllocationCount(), guard) << "the counter must see allocations";
 }
 
-// FNV-1a of a kPlanes depth map: the scene renders the same bytes everywhere, the homographies
-// are double geometry without FMA contraction and the kernel integer-only, so this value is the
-// same on x86-64, aarch64 and armhf (checked under qemu).
+// The depth of the pinned burst below (64x48, 5 views, seed 6) through its true poses' planes.
+void PinnedBurstDepth(motiontest::Burst* b, handheld::Labels* l, Stage* s) {
+  ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(6), 64, 48, 5, b));
+  *l = handheld::HandheldLabels(*b, 0.1);
+  ASSERT_TRUE(s->Configure(l->config).ok());
+  ASSERT_TRUE(s->depth.SetPlanes(handheld::Planes(*b, *l).data()).ok());
+  ASSERT_TRUE(s->Compute(b->views.data()).ok());
+}
+
+// What the pinned bits stand for, with stated tolerances, so that a deliberate change to the
+// plane sweep reads as better or worse: the share of pixels off the scene's truth by more than
+// half a pixel (of the mean-baseline motion: two labels) and by more than one. Measured 1.63 %
+// and 0 %.
+TEST(PlanesTest, PinnedBurstIsCloseToTheTruth) {
+  motiontest::Burst b;
+  handheld::Labels l;
+  Stage s;
+  ASSERT_NO_FATAL_FAILURE(PinnedBurstDepth(&b, &l, &s));
+  const double off_half = handheld::BadPixelPercent(b, l, s.disp, 0.5);
+  const double off_one = handheld::BadPixelPercent(b, l, s.disp, 1.0);
+  std::printf("pinned burst: %.2f %% off by more than 0.5 px, %.2f %% by more than 1 px\n",
+              off_half, off_one);
+  RecordProperty("off_half_px_percent", std::to_string(off_half));
+  RecordProperty("off_one_px_percent", std::to_string(off_one));
+  EXPECT_LT(off_half, 5.0);
+  EXPECT_LT(off_one, 1.0);
+}
+
+// FNV-1a of a kKnownPoses depth map: the scene renders the same bytes everywhere, the
+// homographies are double geometry without FMA contraction and the kernel integer-only, so this
+// value is the same on x86-64, aarch64 and armhf (checked under qemu).
 TEST(PlanesTest, DepthMapBitsArePinned) {
   motiontest::Burst b;
-  ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(6), 64, 48, 5, &b));
-  const handheld::Labels l = handheld::HandheldLabels(b, 0.1);
+  handheld::Labels l;
   Stage s;
-  ASSERT_TRUE(s.Configure(l.config).ok());
-  ASSERT_TRUE(s.depth.SetPlanes(handheld::Planes(b, l).data()).ok());
-  ASSERT_TRUE(s.Compute(b.views.data()).ok());
-  uint32_t hash = 2166136261u;
-  for (uint16_t v : s.disp) {
-    hash = (hash ^ (v & 0xff)) * 16777619u;
-    hash = (hash ^ (v >> 8)) * 16777619u;
-  }
-  EXPECT_EQ(hash, 4022861897u) << "energy " << s.depth.stats().energy;
+  ASSERT_NO_FATAL_FAILURE(PinnedBurstDepth(&b, &l, &s));
+  EXPECT_EQ(synth::DisparityHash(s.disp), 4022861897u)
+      << "energy " << s.depth.stats().energy
+      << ": if PlanesTest.PinnedBurstIsCloseToTheTruth passes, the change "
+         "kept the map within its tolerance; re-pin on x86-64, check "
+         "under qemu";
 }
 
 // One small burst; the figures over seeds at 320x240 are in planes_accuracy_test.cc.

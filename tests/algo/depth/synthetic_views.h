@@ -61,4 +61,14 @@ inline Burst MakeBurst(int32_t w, int32_t h, int32_t views, int32_t reference, i
   return b;
 }
 
+// FNV-1a of a disparity map's bytes, low byte first: the checksum the depth tests pin.
+inline uint32_t DisparityHash(const std::vector<uint16_t>& disp) {
+  uint32_t hash = 2166136261u;
+  for (uint16_t v : disp) {
+    hash = (hash ^ (v & 0xff)) * 16777619u;
+    hash = (hash ^ (v >> 8)) * 16777619u;
+  }
+  return hash;
+}
+
 }  // namespace lb::synth

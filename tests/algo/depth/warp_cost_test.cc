@@ -210,10 +210,7 @@ Reference ReferenceTerm(const motiontest::Burst& b, const std::vector<ViewData>&
   std::vector<std::vector<SampleCost>> cost;  // per other view
   for (int32_t v = 0; v < b.scene.views(); ++v) {
     if (v == ref) continue;
-    const Pose& pose = b.scene.pose(v);
-    ViewMotion m;
-    std::copy(&pose.rotation[0][0], &pose.rotation[0][0] + 9, &m.rotation[0][0]);
-    std::copy(pose.translation, pose.translation + 3, m.translation);
+    const ViewMotion& m = b.scene.pose(v);
     std::vector<SampleCost> c(static_cast<size_t>(w) * h);
     for (int32_t y = 0; y < h; ++y) {
       for (int32_t x = 0; x < w; ++x) {
@@ -283,11 +280,7 @@ void PrepareTerm(Fixed& f, const motiontest::Burst& b, const DataTermParams& par
 std::vector<PlaneHomography> TruePlanes(const motiontest::Burst& b, double rho) {
   std::vector<PlaneHomography> planes(b.scene.views());
   for (int32_t v = 0; v < b.scene.views(); ++v) {
-    const Pose& pose = b.scene.pose(v);
-    ViewMotion m;
-    std::copy(&pose.rotation[0][0], &pose.rotation[0][0] + 9, &m.rotation[0][0]);
-    std::copy(pose.translation, pose.translation + 3, m.translation);
-    planes[v] = MakePlaneHomography(b.intrinsics, m, rho);
+    planes[v] = MakePlaneHomography(b.intrinsics, b.scene.pose(v), rho);
   }
   return planes;
 }

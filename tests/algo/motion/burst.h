@@ -59,7 +59,7 @@ inline bool MakeBurst(const SceneParams& params, int32_t width, int32_t height, 
     b->views.push_back(MakeView(b->pixels[v].data(), width, height, 3).AsConst());
   }
   // Pixel (i, j) covers [s i, s i + s) of the render: the same continuous coordinates / s.
-  const Intrinsics& k = b->scene.intrinsics();
+  const CameraIntrinsics& k = b->scene.intrinsics();
   b->intrinsics = {k.fx / s, k.fy / s, k.cx / s, k.cy / s};
   return true;
 }
@@ -67,12 +67,12 @@ inline bool MakeBurst(const SceneParams& params, int32_t width, int32_t height, 
 inline SceneParams Handheld(uint64_t seed) {
   SceneParams p;
   p.seed = seed;
-  p.motion = CameraMotion::kHandheld;
+  p.geometry = ViewGeometry::kHandheld;
   return p;
 }
 
 // Angle in degrees of R_est * R_true^T.
-inline double RotationErrorDeg(const ViewMotion& est, const Pose& truth) {
+inline double RotationErrorDeg(const ViewMotion& est, const ViewMotion& truth) {
   double tr = 0;
   for (int i = 0; i < 3; ++i) {
     for (int k = 0; k < 3; ++k) tr += est.rotation[i][k] * truth.rotation[i][k];
@@ -88,7 +88,7 @@ inline double AngleDeg(const double* a, const double* b) {
   return std::acos(std::fmax(-1.0, std::fmin(1.0, dot / (na * nb)))) * 180.0 / M_PI;
 }
 
-inline double TranslationErrorDeg(const ViewMotion& est, const Pose& truth) {
+inline double TranslationErrorDeg(const ViewMotion& est, const ViewMotion& truth) {
   return AngleDeg(est.translation, truth.translation);
 }
 

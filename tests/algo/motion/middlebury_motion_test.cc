@@ -36,7 +36,7 @@ TEST_P(MiddleburyMotion, HorizontalEquallySpacedTranslation) {
       stage.Estimate(views.data(), set.reference, DefaultIntrinsics(set.width, set.height), &r);
   ASSERT_TRUE(st.ok()) << st.message();
   // Per-step translation of each view; the rig's step is their mean.
-  const Pose identity;
+  const ViewMotion identity;
   double step = 0;
   int32_t n = 0;
   for (int32_t v = 0; v < config.views; ++v) {

@@ -71,7 +71,7 @@ void ThroughLens(Burst* b, double k1) {
 TEST(MotionStage, ARailThroughABarrelLensKeepsItsOrientation) {
   SceneParams rail;
   rail.seed = 4;
-  rail.motion = CameraMotion::kRectified;
+  rail.geometry = ViewGeometry::kRectified;
   Burst b;
   ASSERT_TRUE(motiontest::MakeBurst(rail, 480, 360, 5, &b, 2));
   ThroughLens(&b, -0.05);

@@ -21,9 +21,9 @@ bool TruePosition(const Scene& s, int32_t view, int32_t x, int32_t y, double* vx
   if (!s.InverseDepthRows(1, y, 1, row.data(), s.width()).ok()) return false;
   rho_q12 = row[x];
   const double rho = rho_q12 / 4096.0;
-  const Intrinsics& k = s.intrinsics();
+  const CameraIntrinsics& k = s.intrinsics();
   const double r[3] = {(x + 0.5 - k.cx) / k.fx, (y + 0.5 - k.cy) / k.fy, 1.0};
-  const Pose& p = s.pose(view);
+  const ViewMotion& p = s.pose(view);
   double a[3];
   for (int i = 0; i < 3; ++i) {
     a[i] = p.rotation[i][0] * r[0] + p.rotation[i][1] * r[1] + p.rotation[i][2] * r[2] +

@@ -38,7 +38,7 @@ struct Memory {
   }
 };
 
-// Depth of `views` in kPlanes mode for the poses of `m`: signed disparities (px per view
+// Depth of `views` in kKnownPoses mode for the poses of `m`: signed disparities (px per view
 // step) and the range used.
 Status SignedPlaneDepth(const std::vector<ConstImageU8>& views, const MotionResult& m,
                         int32_t labels, std::vector<float>* out, LabelRange* range);
@@ -67,7 +67,7 @@ Status SignedPlaneDepth(const std::vector<ConstImageU8>& views, const MotionResu
   c.labels = labels;
   c.disp_min_q8 = range->disp_min_q8;
   c.disp_max_q8 = range->disp_max_q8;
-  c.geometry = DepthGeometry::kPlanes;
+  c.geometry = ViewGeometry::kKnownPoses;
   c.subpixel = false;
   Memory memory;
   Arena arena = memory.Make(DepthStage::RequiredBytes(c));
@@ -109,13 +109,7 @@ MotionResult TruePoses(const motiontest::Burst& b) {
   truth.views = b.scene.views();
   truth.reference = b.scene.reference();
   truth.intrinsics = b.intrinsics;
-  for (int32_t v = 0; v < truth.views; ++v) {
-    const Pose& p = b.scene.pose(v);
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) truth.motion[v].rotation[i][j] = p.rotation[i][j];
-      truth.motion[v].translation[i] = p.translation[i];
-    }
-  }
+  for (int32_t v = 0; v < truth.views; ++v) truth.motion[v] = b.scene.pose(v);
   truth.inv_depth_min = b.scene.inverse_depth_min_q12() / 4096.0;
   truth.inv_depth_max = b.scene.inverse_depth_max_q12() / 4096.0;
   return truth;

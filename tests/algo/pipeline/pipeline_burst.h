@@ -44,11 +44,11 @@ struct Burst {
   void SetupBoard(int32_t width, int32_t height, int32_t frames, double max_translation) {
     SceneParams params;
     params.seed = 7;
-    params.motion = CameraMotion::kHandheld;
+    params.geometry = ViewGeometry::kHandheld;
     params.max_translation = max_translation;
     ASSERT_NO_FATAL_FAILURE(Open(params, width, height, frames));
     config.labels = 32;
-    config.geometry = Geometry::kAuto;
+    config.geometry = ViewGeometry::kAuto;
     ConfigurePipeline();
   }
 

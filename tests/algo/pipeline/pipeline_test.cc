@@ -310,5 +310,21 @@ TEST(Pipeline, ABurstOfOneFrameIsRejectedBeforeAnythingIsAllocated) {
   EXPECT_NE(std::string(s.message()).find("at least 2"), std::string::npos) << s.message();
 }
 
+TEST(Pipeline, TakesRectifiedOrAutoGeometryOnly) {
+  PipelineConfig c;
+  c.width = 64;
+  c.height = 48;
+  size_t bytes = 0;
+  for (const ViewGeometry g : {ViewGeometry::kRectified, ViewGeometry::kAuto}) {
+    c.geometry = g;
+    EXPECT_TRUE(Pipeline::RequiredBytes(c, &bytes).ok()) << static_cast<int>(g);
+  }
+  for (const ViewGeometry g : {ViewGeometry::kHandheld, ViewGeometry::kKnownPoses}) {
+    c.geometry = g;
+    EXPECT_EQ(Pipeline::RequiredBytes(c, &bytes).code(), Code::kInvalidArgument)
+        << static_cast<int>(g);
+  }
+}
+
 }  // namespace
 }  // namespace lb

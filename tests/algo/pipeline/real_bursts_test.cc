@@ -82,12 +82,12 @@ Status KnownDepth(const hci::Burst& b, hci::Layout layout, std::vector<float>* o
     views.clear();
     for (const auto& t : transposed) views.push_back(MakeView(t.data(), h, w, 3));
   }
-  if (layout == hci::Layout::kCross5) c.geometry = DepthGeometry::kPlanes;
+  if (layout == hci::Layout::kCross5) c.geometry = ViewGeometry::kKnownPoses;
   Memory memory;
   Arena arena = memory.Make(DepthStage::RequiredBytes(c));
   DepthStage stage;
   LB_RETURN_IF_ERROR(stage.Configure(c, arena));
-  if (c.geometry == DepthGeometry::kPlanes) {
+  if (c.geometry == ViewGeometry::kKnownPoses) {
     // R = I and t = -(dc, dr, 0) / f: label disparity d shifts a view by -d (dc, dr).
     MotionResult m;
     m.views = c.views;
@@ -132,7 +132,7 @@ Status AutoDepth(const hci::Burst& b, double focal_35mm, std::vector<float>* out
   if (focal_35mm > 0) k.fx = k.fy = FocalPxFrom35mm(focal_35mm, b.width, b.height);
   LB_RETURN_IF_ERROR(motion.Estimate(views.data(), b.reference, k, m));
   DepthConfig c = Config(b, b.width, b.height);
-  c.geometry = DepthGeometry::kPlanes;
+  c.geometry = ViewGeometry::kKnownPoses;
   c.disp_max_q8 = 16 << 8;  // sizing only: the plan sets the burst's own
   Memory memory;
   Arena arena = memory.Make(DepthStage::RequiredBytes(c));

@@ -33,15 +33,6 @@ Built Build(const Aperture& a, float radius) {
   return b;
 }
 
-TEST(Aperture, SinCosAgreesWithLibm) {
-  for (double deg = -720; deg <= 720; deg += 7.5) {
-    double s, c;
-    SinCosDeg(deg, &s, &c);
-    EXPECT_NEAR(s, std::sin(deg * M_PI / 180), 1e-9) << deg;
-    EXPECT_NEAR(c, std::cos(deg * M_PI / 180), 1e-9) << deg;
-  }
-}
-
 TEST(Aperture, SmallRadiusIsTheIdentity) {
   const Built b = Build(Aperture{}, 0.25f);
   EXPECT_EQ(b.half, 0);

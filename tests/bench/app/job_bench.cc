@@ -98,7 +98,7 @@ SensorConfig BenchSize() {
 ReplaySensor* RecordedBurst() {
   static ReplaySensor* replay = [] {
     SceneParams params;
-    params.motion = CameraMotion::kHandheld;
+    params.geometry = ViewGeometry::kHandheld;
     SyntheticSensor synthetic(params);
     auto* r = new ReplaySensor;
     const Status s = r->Record(synthetic, BenchSize());

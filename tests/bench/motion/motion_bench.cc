@@ -60,7 +60,7 @@ void BM_PipelineAuto7x640x480(benchmark::State& state) {
   c.height = mode.height;
   c.frames = mode.frames;
   c.reference = sensor.scene().reference();
-  c.geometry = Geometry::kAuto;
+  c.geometry = ViewGeometry::kAuto;
   c.focal_px = mode.focal_px;
   size_t bytes = 0;
   if (!Pipeline::RequiredBytes(c, &bytes).ok()) {

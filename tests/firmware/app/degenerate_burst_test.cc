@@ -68,7 +68,7 @@ class DegenerateBurst : public ::testing::Test {
   // Runs the burst's files through a Job; expects a saved, unblurred photo of `pixels` pixels
   // and a warning holding `advice`.
   void ExpectUnblurredWithWarning(const std::vector<std::string>& paths, const char* advice,
-                                  Geometry geometry = Geometry::kAuto,
+                                  ViewGeometry geometry = ViewGeometry::kAuto,
                                   int64_t pixels = int64_t{kW} * kH) {
     std::unique_ptr<FileSensor> sensor;
     ASSERT_TRUE(FileSensor::FromFiles(paths, CodecImageDecoder(), &sensor).ok());
@@ -139,7 +139,7 @@ TEST_F(DegenerateBurst, FramesTooThinForDepth) {
       paths.push_back(dir_ + "/thin" + std::to_string(v) + ".ppm");
       ASSERT_TRUE(test::WriteFile(paths.back(), test::EncodePnm("P6", w, h, 255, samples)));
     }
-    for (const Geometry g : {Geometry::kAuto, Geometry::kRectified}) {
+    for (const ViewGeometry g : {ViewGeometry::kAuto, ViewGeometry::kRectified}) {
       SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
       ExpectUnblurredWithWarning(paths, "too thin for depth", g, int64_t{w} * h);
     }

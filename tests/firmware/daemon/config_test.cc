@@ -105,10 +105,10 @@ TEST(ConfigTest, ValuesReachTheSettings) {
 
 TEST(ConfigTest, GeometryAndLensReachTheJob) {
   DaemonConfig c;
-  EXPECT_EQ(MakeJobOptions(c).pipeline.geometry, Geometry::kAuto) << "a camera is handheld";
+  EXPECT_EQ(MakeJobOptions(c).pipeline.geometry, ViewGeometry::kAuto) << "a camera is handheld";
   ASSERT_TRUE(Parse("geometry = rectified\nfocal_35mm = 28\n", &c).ok());
   const JobOptions o = MakeJobOptions(c);
-  EXPECT_EQ(o.pipeline.geometry, Geometry::kRectified);
+  EXPECT_EQ(o.pipeline.geometry, ViewGeometry::kRectified);
   EXPECT_EQ(o.focal_35mm, 28);
   EXPECT_EQ(Error("geometry = tripod\n"),
             "test.conf:1: geometry: 'tripod' is neither auto nor rectified");

@@ -96,10 +96,10 @@ TEST(SyntheticSensorTest, DeliversTheSceneInStripsWithoutAllocating) {
 
 TEST(SyntheticSensorTest, HandheldParamsReachTheScene) {
   SceneParams params;
-  params.motion = CameraMotion::kHandheld;
+  params.geometry = ViewGeometry::kHandheld;
   SyntheticSensor sensor(params);
   ASSERT_TRUE(sensor.Configure(SensorConfig{64, 48, 3, 2000}, nullptr).ok());
-  EXPECT_EQ(sensor.scene().params().motion, CameraMotion::kHandheld);
+  EXPECT_EQ(sensor.scene().params().geometry, ViewGeometry::kHandheld);
   EXPECT_NE(sensor.scene().pose(0).rotation[0][1], 0);
 }
 
