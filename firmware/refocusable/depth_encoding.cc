@@ -66,16 +66,20 @@ int32_t DecodeRangeInverse(uint16_t value, const DisparityRange& range, int bits
   return range.max_q8 - static_cast<int32_t>((v * span * 2 + top) / (2 * top));
 }
 
-Status EncodeDepthMap(ConstImageU16 disp_q8, const DisparityRange& range, int bits,
-                      ImageU16 values) {
+// What encoding and decoding a map both ask of their arguments.
+static Status CheckMaps(const DisparityRange& range, int bits, bool same_size) {
   double near_depth, far_depth;
   LB_RETURN_IF_ERROR(DepthNearFar(range, &near_depth, &far_depth));
   if (bits != 8 && bits != 16) {
     return Status(Code::kInvalidArgument, "depth encoding: %d bits (8 or 16)", bits);
   }
-  if (!SameSize(disp_q8, values)) {
-    return Status(Code::kInvalidArgument, "depth encoding: map sizes differ");
-  }
+  if (!same_size) return Status(Code::kInvalidArgument, "depth encoding: map sizes differ");
+  return Status::Ok();
+}
+
+Status EncodeDepthMap(ConstImageU16 disp_q8, const DisparityRange& range, int bits,
+                      ImageU16 values) {
+  LB_RETURN_IF_ERROR(CheckMaps(range, bits, SameSize(disp_q8, values)));
   for (int32_t y = 0; y < disp_q8.height; ++y) {
     const uint16_t* in = disp_q8.Row(y);
     uint16_t* out = values.Row(y);
@@ -86,14 +90,7 @@ Status EncodeDepthMap(ConstImageU16 disp_q8, const DisparityRange& range, int bi
 
 Status DecodeDepthMap(ConstImageU16 values, const DisparityRange& range, int bits,
                       ImageU16 disp_q8) {
-  double near_depth, far_depth;
-  LB_RETURN_IF_ERROR(DepthNearFar(range, &near_depth, &far_depth));
-  if (bits != 8 && bits != 16) {
-    return Status(Code::kInvalidArgument, "depth encoding: %d bits (8 or 16)", bits);
-  }
-  if (!SameSize(values, disp_q8)) {
-    return Status(Code::kInvalidArgument, "depth encoding: map sizes differ");
-  }
+  LB_RETURN_IF_ERROR(CheckMaps(range, bits, SameSize(values, disp_q8)));
   if (range.max_q8 > 65535) {
     return Status(Code::kUnsupported, "depth encoding: disparity %d (Q8) does not fit 16 bits",
                   static_cast<int>(range.max_q8));
