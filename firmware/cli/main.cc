@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include "firmware/cli/commands.h"
+#include "firmware/platform/cpu_features.h"
 #include "firmware/storage/temp_registry.h"
 
 namespace {
@@ -36,6 +37,7 @@ int main(int argc, char** argv) {
   }
   // An interrupted run leaves no hidden temporary behind (temp_registry.h).
   lb::RemoveTemporariesOnSignals();
+  lb::UseThisCpu();  // the row kernels this processor runs (NEON on a 32-bit ARM that has it)
   const char* cmd = argv[1];
   if (!strcmp(cmd, "run")) return lb::cli::RunCommand(argc - 1, argv + 1);
 #ifdef LB_HAVE_DEPTH_COMMAND

@@ -15,6 +15,7 @@
 #include "firmware/daemon/config.h"
 #include "firmware/daemon/log.h"
 #include "firmware/daemon/startup_checks.h"
+#include "firmware/platform/cpu_features.h"
 
 namespace {
 
@@ -116,6 +117,7 @@ int main(int argc, char** argv) {
     }
   }
   if (optind < argc) return Usage("unexpected argument");
+  lb::UseThisCpu();  // the row kernels this processor runs (NEON on a 32-bit ARM that has it)
 
   lb::DaemonConfig config;
   lb::Status s = lb::LoadConfig(config_path.c_str(), &config);
