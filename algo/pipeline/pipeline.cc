@@ -169,6 +169,7 @@ Status Pipeline::Carve(Arena& arena) {
 }
 
 void Pipeline::SetRunner(TaskRunner* runner) {
+  runner_ = runner != nullptr && runner->workers() <= config_.workers ? runner : &inline_;
   depth_.SetRunner(runner);
   motion_.SetRunner(runner);
   render_.SetRunner(runner);
@@ -184,6 +185,7 @@ Status Pipeline::Configure(const PipelineConfig& config, void* arena, size_t byt
     return Status(Code::kInvalidArgument, "pipeline arena is not %zu-byte aligned", Arena::kAlign);
   }
   config_ = config;
+  runner_ = &inline_;
   const Layout l = Plan(config);
   scale_ = l.scale;
   work_w_ = l.work_w;
@@ -235,39 +237,55 @@ Status Pipeline::Rows(const FrameRows& rows) {
     return Status(Code::kInvalidArgument, "frame %d: rows %d..%d out of order (expected row %d)",
                   frame_.index, rows.y0, rows.y0 + rows.height - 1, next_row_);
   }
-  for (int32_t i = 0; i < rows.height; ++i) {
-    const uint8_t* src = rows.planes[0] + rows.strides[0] * i;
-    const uint8_t* uv = nullptr;
-    if (frame_.format == PixelFormat::kNv12) {
-      uv = rows.planes[1] + rows.strides[1] * ((rows.y0 + i) / 2 - rows.y0 / 2);
+  // Bands of columns, each a whole number of boxes starting on an even column (a YUYV or NV12
+  // pair, a 4:2:0 chroma sample), so every task writes columns of its own: the same bytes for
+  // any number of workers.
+  const int32_t bands = runner_->workers() > 1 ? runner_->workers() : 1;
+  ParallelFor(*runner_, bands, [&](int32_t band, int32_t) {
+    const int32_t unit = scale_ % 2 == 0 ? 1 : 2;  // working columns a band boundary moves by
+    auto edge = [&](int32_t b) { return work_w_ * b / bands / unit * unit; };
+    const int32_t wx0 = edge(band), wx1 = band + 1 == bands ? work_w_ : edge(band + 1);
+    const int32_t x0 = wx0 * scale_, x1 = band + 1 == bands ? config_.width : wx1 * scale_;
+    if (x1 <= x0) return;
+    for (int32_t i = 0; i < rows.height; ++i) {
+      const uint8_t* src = rows.planes[0] + rows.strides[0] * i;
+      const uint8_t* uv = nullptr;
+      if (frame_.format == PixelFormat::kNv12) {
+        uv = rows.planes[1] + rows.strides[1] * ((rows.y0 + i) / 2 - rows.y0 / 2);
+      }
+      IngestRow(src, uv, rows.y0 + i, {x0, x1, wx0, wx1});
     }
-    IngestRow(src, uv, rows.y0 + i);
-  }
+  });
   next_row_ += rows.height;
   return Status::Ok();
 }
 
-void Pipeline::IngestRow(const uint8_t* src, const uint8_t* uv, int32_t y) {
-  uint8_t* rgb = rgb_rows_[y & 1];
-  RowToRgb8(frame_.format, src, uv, config_.width, rgb);
+void Pipeline::IngestRow(const uint8_t* src, const uint8_t* uv, int32_t y, const Columns& c) {
+  const int32_t n = c.x1 - c.x0;
+  uint8_t* rgb = rgb_rows_[y & 1] + 3 * c.x0;
+  // x0 is even: a YUYV pair or an NV12 chroma pair starts there.
+  RowToRgb8(frame_.format, src + static_cast<ptrdiff_t>(c.x0) * BytesPerPixel(frame_.format),
+            uv != nullptr ? uv + c.x0 : nullptr, n, rgb);
   if (frame_.index == config_.reference) {
-    RowRgb8ToY(rgb, config_.width, ref_.planes[0].Row(y));
-    if ((y & 1) || y == config_.height - 1) FlushChroma(y);
+    RowRgb8ToY(rgb, n, ref_.planes[0].Row(y) + c.x0);
+    if ((y & 1) || y == config_.height - 1) FlushChroma(y, c);
   }
   // Integer box downscale: accumulate `scale_` rows, then write their mean (rounded).
   const int32_t s = scale_;
-  if (y >= work_h_ * s) return;
-  ingest::BoxAccumulateRowC(rgb, work_w_, s, acc_);
-  if ((y + 1) % s == 0)
-    ingest::BoxEmitRowC(acc_, work_w_ * 3, s, working_[frame_.index].Row(y / s));
+  if (y >= work_h_ * s || c.wx1 <= c.wx0) return;
+  uint32_t* acc = acc_ + 3 * c.wx0;
+  ingest::BoxAccumulateRowC(rgb, c.wx1 - c.wx0, s, acc);
+  if ((y + 1) % s == 0) {
+    ingest::BoxEmitRowC(acc, (c.wx1 - c.wx0) * 3, s, working_[frame_.index].Row(y / s) + 3 * c.wx0);
+  }
 }
 
-void Pipeline::FlushChroma(int32_t y) {
-  const uint8_t* row0 = rgb_rows_[(y & 1) ? 0 : 1];
-  const uint8_t* row1 = rgb_rows_[y & 1];
+void Pipeline::FlushChroma(int32_t y, const Columns& c) {
+  const uint8_t* row0 = rgb_rows_[(y & 1) ? 0 : 1] + 3 * c.x0;
+  const uint8_t* row1 = rgb_rows_[y & 1] + 3 * c.x0;
   if (!(y & 1)) row0 = row1;  // a lone last row
-  RowsRgb8ToCbCr420(row0, row1, config_.width, ref_.planes[1].Row(y / 2),
-                    ref_.planes[2].Row(y / 2));
+  RowsRgb8ToCbCr420(row0, row1, c.x1 - c.x0, ref_.planes[1].Row(y / 2) + c.x0 / 2,
+                    ref_.planes[2].Row(y / 2) + c.x0 / 2);
 }
 
 Status Pipeline::EndFrame() {

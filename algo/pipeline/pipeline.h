@@ -111,8 +111,12 @@ class Pipeline : public FrameSink {
   static Layout Plan(const PipelineConfig& config);
   Status Carve(Arena& arena);
   Status EstimateGeometry(const ConstImageU8* views);
-  void IngestRow(const uint8_t* src, const uint8_t* uv, int32_t y);
-  void FlushChroma(int32_t y);
+  // A band of columns of the ingest: full resolution [x0, x1), working [wx0, wx1).
+  struct Columns {
+    int32_t x0, x1, wx0, wx1;
+  };
+  void IngestRow(const uint8_t* src, const uint8_t* uv, int32_t y, const Columns& columns);
+  void FlushChroma(int32_t y, const Columns& columns);
 
   PipelineConfig config_;
   int32_t scale_ = 1, work_w_ = 0, work_h_ = 0;
@@ -125,6 +129,8 @@ class Pipeline : public FrameSink {
   DepthStage depth_;
   RenderStage render_;
   MotionStage motion_;  // kAuto only
+  InlineRunner inline_;
+  TaskRunner* runner_ = &inline_;
   MotionResult motion_result_;
   PlaneHomography* planes_ = nullptr;  // kAuto: frames x labels, view-major
   uint8_t* order_scratch_ = nullptr;   // kAuto: DepthOrderScratchBytes (auto_geometry.h)

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "algo/core/color.h"
@@ -50,6 +51,75 @@ TEST(Pipeline, TheBoardsDefaultPathAtQuarterSizeAllocatesNothingAfterConfigure) 
 
 TEST(Pipeline, TheBoardsDefaultPathAllocatesNothingWithThreeThreads) {
   ExpectBoardPathAllocatesNothing(640, 480, 320, 240, 0.02, 3);
+}
+
+// Random frames of `format` through the ingest, split over `threads` workers: a checksum of the
+// full-resolution reference and the working views.
+uint64_t IngestChecksum(PixelFormat format, int32_t width, int32_t height, int32_t max_working,
+                        int32_t threads) {
+  PipelineConfig c;
+  c.width = width;
+  c.height = height;
+  c.frames = 2;
+  c.reference = 1;
+  c.labels = 8;
+  c.max_working_width = c.max_working_height = max_working;
+  c.workers = threads;
+  size_t bytes = 0;
+  EXPECT_TRUE(Pipeline::RequiredBytes(c, &bytes).ok());
+  std::unique_ptr<void, decltype(&free)> arena(aligned_alloc(Arena::kAlign, Arena::RoundUp(bytes)),
+                                               &free);
+  Pipeline p;
+  EXPECT_TRUE(p.Configure(c, arena.get(), bytes).ok());
+  WorkerPool pool;
+  EXPECT_TRUE(pool.Start(threads).ok());
+  p.SetRunner(&pool);
+  const ptrdiff_t stride = static_cast<ptrdiff_t>(width) * BytesPerPixel(format);
+  std::vector<uint8_t> frame(static_cast<size_t>(stride) * height), uv(frame.size());
+  uint32_t seed = 12345;
+  for (int32_t f = 0; f < 2; ++f) {
+    for (uint8_t& b : frame) b = static_cast<uint8_t>((seed = seed * 1664525u + 1013904223u) >> 24);
+    for (uint8_t& b : uv) b = static_cast<uint8_t>((seed = seed * 1664525u + 1013904223u) >> 24);
+    FrameInfo info;
+    info.index = f;
+    info.format = format;
+    info.width = width;
+    info.height = height;
+    EXPECT_TRUE(p.BeginFrame(info).ok());
+    for (int32_t y0 = 0; y0 < height; y0 += 16) {
+      FrameRows rows;
+      rows.y0 = y0;
+      rows.height = std::min(16, height - y0);
+      rows.planes[0] = frame.data() + y0 * stride;
+      rows.strides[0] = stride;
+      rows.planes[1] = uv.data() + (y0 / 2) * stride;
+      rows.strides[1] = stride;
+      EXPECT_TRUE(p.Rows(rows).ok());
+    }
+    EXPECT_TRUE(p.EndFrame().ok());
+  }
+  uint64_t h = 0;
+  for (int32_t i = 0; i < 3; ++i) h ^= ImageChecksum(p.reference().planes[i]) * (i + 1);
+  for (int32_t f = 0; f < 2; ++f) h ^= ImageChecksum(p.working_view(f)) * (f + 7);
+  return h;
+}
+
+// The ingest splits every strip into bands of columns: the same reference and working views
+// for any number of threads, in every sensor format, with odd and even box sizes and widths.
+TEST(Pipeline, IngestGivesTheSameBytesForAnyNumberOfThreads) {
+  for (PixelFormat format : {PixelFormat::kRgb8, PixelFormat::kYuyv, PixelFormat::kNv12,
+                             PixelFormat::kGray16, PixelFormat::kBgr8}) {
+    for (const auto& [w, h, working] :
+         {std::tuple{998, 302, 334}, {640, 480, 320}, {401, 97, 100}}) {
+      SCOPED_TRACE(std::string(PixelFormatName(format)) + " " + std::to_string(w) + "x" +
+                   std::to_string(h));
+      if ((format == PixelFormat::kYuyv || format == PixelFormat::kNv12) && w % 2 != 0) continue;
+      const uint64_t one = IngestChecksum(format, w, h, working, 1);
+      for (int32_t threads : {2, 3, 4}) {
+        EXPECT_EQ(IngestChecksum(format, w, h, working, threads), one) << threads << " threads";
+      }
+    }
+  }
 }
 
 // The motion and depth stages and the render share memory (pipeline.h): a second burst through
