@@ -174,23 +174,32 @@ LB_AVX2 void BoxPrefixRowAvx2(const int32_t* box, int32_t level, int32_t q0, int
   BoxPrefixRowC(box, level, q, q1, p);
 }
 
-// Fully covered runs (alpha exactly 65536, most of a photo) round the shift with the sign
-// outside ((|out| + 32768) >> 16, |out| < 2^31 - 2^16), then the saturating packs clamp to
-// 0..255 as the reference (int16 saturation keeps every value's side of 0..255); a step with
-// any other alpha divides in C.
+// The reference's round(out / alpha), half away from zero, as sign x trunc((|out| + alpha / 2)
+// / alpha) in double: the dividend is below 2^31 and the divisor at most 2^16, so a quotient
+// that is not an integer lies at least 2^-16 from one, far more than the division's rounding
+// error (2^31 x 2^-53), and truncating the rounded quotient gives the exact floor. Then the
+// saturating packs clamp to 0..255 as the reference (int16 saturation keeps every value's side
+// of 0..255). A step with an empty pixel (alpha 0: its own value) takes C.
+LB_AVX2 inline __m128i Quotients(__m128i num, __m128i den) {
+  return _mm256_cvttpd_epi32(_mm256_div_pd(_mm256_cvtepi32_pd(num), _mm256_cvtepi32_pd(den)));
+}
+
 LB_AVX2 void ResolveRowAvx2(const int32_t* out, const int32_t* alpha, const int16_t* v,
                             int32_t width, int32_t bias, uint8_t* dst) {
-  const __m256i unit = _mm256_set1_epi32(65536), half = _mm256_set1_epi32(32768);
-  const __m256i b = _mm256_set1_epi32(bias);
+  const __m256i zero = _mm256_setzero_si256(), b = _mm256_set1_epi32(bias);
   int32_t x = 0;
   for (; x + 7 < width; x += 8) {
-    if (_mm256_movemask_epi8(_mm256_cmpeq_epi32(Load(alpha + x), unit)) != -1) {
+    const __m256i a = Load(alpha + x);
+    if (_mm256_movemask_epi8(_mm256_cmpgt_epi32(a, zero)) != -1) {
       ResolveRowC(out + x, alpha + x, v + x, 8, bias, dst + x);
       continue;
     }
     const __m256i o = Load(out + x);
     const __m256i sign = _mm256_srai_epi32(o, 31);
-    const __m256i r = _mm256_srli_epi32(_mm256_add_epi32(_mm256_abs_epi32(o), half), 16);
+    const __m256i n = _mm256_add_epi32(_mm256_abs_epi32(o), _mm256_srli_epi32(a, 1));
+    const __m256i r = _mm256_setr_m128i(
+        Quotients(_mm256_castsi256_si128(n), _mm256_castsi256_si128(a)),
+        Quotients(_mm256_extracti128_si256(n, 1), _mm256_extracti128_si256(a, 1)));
     const __m256i value = _mm256_add_epi32(_mm256_sub_epi32(_mm256_xor_si256(r, sign), sign), b);
     const __m128i words =
         _mm_packs_epi32(_mm256_castsi256_si128(value), _mm256_extracti128_si256(value, 1));
