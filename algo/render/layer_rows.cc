@@ -1,6 +1,6 @@
-// The C reference of the layer row kernels (layer_rows.h) and, on x86-64, the gather kernel's
-// body compiled for AVX2 too: an always-inline function instantiated once in a plain function
-// and once in a target("avx2") one, so both come from one source (compilers vectorise it well;
+// The C reference of the layer row kernels (layer_rows.h) and the gather kernel's body compiled
+// for AVX2 (x86-64) and NEON (ARM) too: an always-inline function instantiated once in a plain
+// function and once in a target one, so all come from one source (compilers vectorise it well;
 // the kernels they do not are written with intrinsics in layer_rows_avx2.cc / _neon.cc).
 #include "algo/render/layer_rows.h"
 
@@ -8,6 +8,11 @@
 
 #if defined(__x86_64__)
 #define LB_ROW_AVX2 __attribute__((target("avx2")))
+#endif
+#if defined(__arm__)
+#define LB_ROW_NEON __attribute__((target("fpu=neon")))  // beyond armhf's baseline
+#elif defined(__ARM_NEON)
+#define LB_ROW_NEON
 #endif
 
 namespace lb::layer_rows {
@@ -238,6 +243,12 @@ const Kernels kReference = {
 
 #if defined(LB_ROW_AVX2)
 LB_ROW_AVX2 void GatherRowCAvx2(const uint32_t* p, const KernelRow& k, uint32_t* acc, int32_t x0,
+                                int32_t x1) {
+  GatherBody(p, k, acc, x0, x1);
+}
+#endif
+#if defined(LB_ROW_NEON)
+LB_ROW_NEON void GatherRowCNeon(const uint32_t* p, const KernelRow& k, uint32_t* acc, int32_t x0,
                                 int32_t x1) {
   GatherBody(p, k, acc, x0, x1);
 }

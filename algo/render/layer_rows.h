@@ -1,7 +1,7 @@
 // The row kernels of layered compositing (layer_plane.h): each a plain C reference; those on the
 // per-pixel path also have SIMD twins, picked once when a plane is carved (never per row):
-// AVX2 on x86-64 (layer_rows_avx2.cc: intrinsics, and gather the C source compiled for AVX2)
-// and NEON on ARM (layer_rows_neon.cc, ARMv7 intrinsics, so armhf builds it too). Integer
+// AVX2 on x86-64 and NEON on ARM (layer_rows_avx2.cc, layer_rows_neon.cc: intrinsics, ARMv7
+// ones so armhf builds them too; gather is the C source compiled for each). Integer
 // arithmetic only, so every variant gives the same bits as the reference; the tests
 // (tests/algo/render/layer_rows_test.cc) run each variant the CPU has against it.
 //
@@ -153,6 +153,10 @@ extern const Kernels kReference;
 #if defined(__x86_64__)
 // GatherRowC's source compiled for AVX2 (the caller checks the CPU).
 void GatherRowCAvx2(const uint32_t* p, const KernelRow& k, uint32_t* acc, int32_t x0, int32_t x1);
+#endif
+#if defined(__ARM_NEON) || defined(__arm__)
+// GatherRowC's source compiled for NEON (on armhf the caller checks the CPU).
+void GatherRowCNeon(const uint32_t* p, const KernelRow& k, uint32_t* acc, int32_t x0, int32_t x1);
 #endif
 // The AVX2 variants (x86-64) when the processor has AVX2, else nullptr.
 const Kernels* Avx2Kernels();

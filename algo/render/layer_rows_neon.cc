@@ -18,26 +18,6 @@
 namespace lb::layer_rows {
 namespace {
 
-// As GatherRowC: the three weighted spans, wrapping uint32 (only the low 32 bits are kept).
-void GatherRowNeon(const uint32_t* p, const KernelRow& k, uint32_t* acc, int32_t x0, int32_t x1) {
-  const uint32_t* pa = p + k.left - 1;
-  const uint32_t* pb = p + k.left;
-  const uint32_t* pc = p + k.right + 1;
-  const uint32_t* pd = p + k.right + 2;
-  const uint32_t w = static_cast<uint32_t>(k.w), wl = static_cast<uint32_t>(k.wl),
-                 wr = static_cast<uint32_t>(k.wr);
-  int32_t x = x0;
-  for (; x + 3 <= x1; x += 4) {
-    const uint32x4_t a = vld1q_u32(pa + x), b = vld1q_u32(pb + x);
-    const uint32x4_t c = vld1q_u32(pc + x), d = vld1q_u32(pd + x);
-    uint32x4_t t = vmulq_n_u32(vsubq_u32(c, b), w);
-    t = vmlaq_n_u32(t, vsubq_u32(b, a), wl);
-    t = vmlaq_n_u32(t, vsubq_u32(d, c), wr);
-    vst1q_u32(acc + x, vaddq_u32(vld1q_u32(acc + x), t));
-  }
-  GatherRowC(p, k, acc, x, x1);
-}
-
 // a + ((b - a) x f + 128) >> 8 (floor), f 0..255, |b - a| < 2^31: with d = 256 dh + dl that is
 // a + dh x f + ((dl x f + 128) >> 8), each part in 32 bits (|dh x f| < 2^31, dl x f < 2^16).
 inline int32x4_t Lerp(int32x4_t a, int32x4_t b, int32x4_t f) {
@@ -221,7 +201,7 @@ void ResolveRowNeon(const int32_t* out, const int32_t* alpha, const int16_t* v, 
 
 const Kernels* NeonKernels() {
   static constexpr Kernels kNeon = {
-      GatherRowNeon,         CompositeRowNeon,       {LerpCompositeNeon<1>, LerpCompositeNeon<2>},
+      GatherRowCNeon,        CompositeRowNeon,       {LerpCompositeNeon<1>, LerpCompositeNeon<2>},
       NormaliseAlphaRowNeon, NormaliseColourRowNeon, BlendRowsNeon,
       BoxPrefixRowNeon,      ResolveRowNeon};
   return &kNeon;
