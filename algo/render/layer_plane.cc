@@ -225,9 +225,9 @@ void LayerPlane::BuildPrefixT(Scratch& sc, int32_t k, int32_t level, int32_t h, 
           if (!(any & bit)) continue;
           const int32_t t1 = Min(x1, t0 + tile - 1);
           if ((pure & bit) && shift <= 8) {
-            layer_rows::PureBoxRowC<C>(v, shift, level, t0, t1, box);
+            rows_->pure_box[C - 1](v, shift, level, t0, t1, box);
           } else {
-            layer_rows::WeightedBoxRowC<C>(v, s, layer_of, offset, k, shift, level, t0, t1, box);
+            rows_->weighted_box[C - 1](v, s, layer_of, offset, k, shift, level, t0, t1, box);
           }
         }
       }

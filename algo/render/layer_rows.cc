@@ -236,10 +236,16 @@ void ResolveRowC(const int32_t* out, const int32_t* alpha, const int16_t* v, int
   }
 }
 
-const Kernels kReference = {
-    GatherRowC,         CompositeRowC,       {LerpCompositeC<1>, LerpCompositeC<2>},
-    NormaliseAlphaRowC, NormaliseColourRowC, BlendRowsC,
-    BoxPrefixRowC,      ResolveRowC};
+const Kernels kReference = {GatherRowC,
+                            CompositeRowC,
+                            {LerpCompositeC<1>, LerpCompositeC<2>},
+                            {WeightedBoxRowC<1>, WeightedBoxRowC<2>},
+                            {PureBoxRowC<1>, PureBoxRowC<2>},
+                            NormaliseAlphaRowC,
+                            NormaliseColourRowC,
+                            BlendRowsC,
+                            BoxPrefixRowC,
+                            ResolveRowC};
 
 #if defined(LB_ROW_AVX2)
 LB_ROW_AVX2 void GatherRowCAvx2(const uint32_t* p, const KernelRow& k, uint32_t* acc, int32_t x0,

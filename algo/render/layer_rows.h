@@ -138,6 +138,12 @@ struct Kernels {
   void (*lerp_composite[2])(const int32_t* col, ptrdiff_t stride, const uint8_t* frac,
                             int32_t level, int32_t x0, int32_t x1, int32_t* out,
                             ptrdiff_t out_stride);
+  // WeightedBoxRowC<1> and <2>, PureBoxRowC<1> and <2>.
+  void (*weighted_box[2])(const int16_t* const* v, const int16_t* s, const uint16_t* layer_of,
+                          int32_t offset, int32_t k, int32_t shift, int32_t level, int32_t x0,
+                          int32_t x1, int32_t* const* box);
+  void (*pure_box[2])(const int16_t* const* v, int32_t shift, int32_t level, int32_t x0, int32_t x1,
+                      int32_t* const* box);
   void (*normalise_alpha)(const uint32_t* acc, uint64_t rec, int32_t x0, int32_t x1,
                           int32_t* alpha);
   void (*normalise_colour)(const uint32_t* acc, uint64_t rec, int32_t shift, int32_t x0, int32_t x1,

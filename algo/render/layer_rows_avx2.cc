@@ -89,6 +89,108 @@ LB_AVX2 void LerpCompositeAvx2(const int32_t* col, ptrdiff_t stride, const uint8
   LerpCompositeC<C>(col, stride, frac, level, x, x1, out, out_stride);
 }
 
+// Adds each group of 2^L lanes' sum, in order, to box[0 ..]: four pairs (L 1), two quads (L 2)
+// or the whole vector (L >= 3: 8 columns, or 16 already added lane-wise). int32 wrapping adds,
+// as the reference's (its sums stay below 2^27: layer_rows.h).
+template <int L>
+LB_AVX2 inline void AddGroups(__m256i c, int32_t* box) {
+  if constexpr (L == 1) {
+    const __m256i h = _mm256_permute4x64_epi64(_mm256_hadd_epi32(c, c), _MM_SHUFFLE(3, 1, 2, 0));
+    __m128i* b = reinterpret_cast<__m128i*>(box);
+    _mm_storeu_si128(b, _mm_add_epi32(_mm_loadu_si128(b), _mm256_castsi256_si128(h)));
+  } else if constexpr (L == 2) {
+    const __m256i h = _mm256_hadd_epi32(c, c);
+    const __m256i h2 = _mm256_hadd_epi32(h, h);
+    box[0] += _mm256_cvtsi256_si32(h2);
+    box[1] += _mm_cvtsi128_si32(_mm256_extracti128_si256(h2, 1));
+  } else {
+    __m128i h = _mm_add_epi32(_mm256_castsi256_si128(c), _mm256_extracti128_si256(c, 1));
+    h = _mm_hadd_epi32(h, h);
+    box[0] += _mm_cvtsi128_si32(_mm_hadd_epi32(h, h));
+  }
+}
+
+// LayerWeightQ8 of layer k for 8 pixels: the table looked up one pixel at a time (there is no
+// 16-bit gather), the choice between 256 - frac, frac and 0 in-register.
+LB_AVX2 inline __m256i Weights(const int16_t* s, const uint16_t* table, __m256i k) {
+  const __m256i e = _mm256_setr_epi32(table[s[0]], table[s[1]], table[s[2]], table[s[3]],
+                                      table[s[4]], table[s[5]], table[s[6]], table[s[7]]);
+  const __m256i first = _mm256_srli_epi32(e, 8), frac = _mm256_and_si256(e, _mm256_set1_epi32(255));
+  const __m256i in_first = _mm256_and_si256(_mm256_cmpeq_epi32(first, k),
+                                            _mm256_sub_epi32(_mm256_set1_epi32(256), frac));
+  const __m256i in_next =
+      _mm256_and_si256(_mm256_cmpeq_epi32(_mm256_add_epi32(first, _mm256_set1_epi32(1)), k), frac);
+  return _mm256_or_si256(in_first, in_next);
+}
+
+LB_AVX2 inline __m256i Widen(const int16_t* v) {
+  return _mm256_cvtepi16_epi32(_mm_loadu_si128(reinterpret_cast<const __m128i*>(v)));
+}
+
+// As WeightedBoxRowC: c = (v x a) >> shift per pixel (|v x a| <= 2^15 x 2^8, int32), the weight
+// a itself in the last plane, each box's columns summed in-register. A step is a whole number
+// of boxes (8 columns, 16 at level 4), from x0 (a multiple of 2^L); the rest in C.
+template <int C, int L>
+LB_AVX2 void WeightedBoxAvx2T(const int16_t* const* v, const int16_t* s, const uint16_t* layer_of,
+                              int32_t offset, int32_t k, int32_t shift, int32_t x0, int32_t x1,
+                              int32_t* const* box) {
+  constexpr int32_t kStep = L <= 3 ? 8 : 16;
+  const __m128i count = _mm_cvtsi32_si128(shift);
+  const __m256i layer = _mm256_set1_epi32(k);
+  int32_t x = x0;
+  for (; x + kStep - 1 <= x1; x += kStep) {
+    __m256i sum[C + 1];
+    for (int32_t i = 0; i < kStep; i += 8) {
+      const __m256i a = Weights(s + x + i, layer_of + offset, layer);
+      for (int32_t c = 0; c <= C; ++c) {
+        const __m256i t =
+            c == C ? a : _mm256_sra_epi32(_mm256_mullo_epi32(Widen(v[c] + x + i), a), count);
+        sum[c] = i == 0 ? t : _mm256_add_epi32(sum[c], t);
+      }
+    }
+    for (int32_t c = 0; c <= C; ++c) AddGroups<L>(sum[c], box[c] + (x >> L));
+  }
+  WeightedBoxRowC<C>(v, s, layer_of, offset, k, shift, L, x, x1, box);
+}
+
+// As PureBoxRowC: v << (8 - shift) summed per box (the sum of the shifted values equals the
+// shifted sum, modulo 2^32 as the reference's int32), and the weight 256 per pixel.
+template <int C, int L>
+LB_AVX2 void PureBoxAvx2T(const int16_t* const* v, int32_t shift, int32_t x0, int32_t x1,
+                          int32_t* const* box) {
+  constexpr int32_t kStep = L <= 3 ? 8 : 16;
+  const __m128i up = _mm_cvtsi32_si128(8 - shift);
+  const __m256i weights = _mm256_set1_epi32(256 * kStep / 8);
+  int32_t x = x0;
+  for (; x + kStep - 1 <= x1; x += kStep) {
+    for (int32_t c = 0; c < C; ++c) {
+      __m256i sum = Widen(v[c] + x);
+      if (kStep == 16) sum = _mm256_add_epi32(sum, Widen(v[c] + x + 8));
+      AddGroups<L>(_mm256_sll_epi32(sum, up), box[c] + (x >> L));
+    }
+    AddGroups<L>(weights, box[C] + (x >> L));
+  }
+  PureBoxRowC<C>(v, shift, L, x, x1, box);
+}
+
+template <int C>
+LB_AVX2 void WeightedBoxRowAvx2(const int16_t* const* v, const int16_t* s, const uint16_t* layer_of,
+                                int32_t offset, int32_t k, int32_t shift, int32_t level, int32_t x0,
+                                int32_t x1, int32_t* const* box) {
+  constexpr decltype(&WeightedBoxAvx2T<C, 1>) kByLevel[] = {
+      WeightedBoxAvx2T<C, 1>, WeightedBoxAvx2T<C, 2>, WeightedBoxAvx2T<C, 3>,
+      WeightedBoxAvx2T<C, 4>};
+  kByLevel[level - 1](v, s, layer_of, offset, k, shift, x0, x1, box);
+}
+
+template <int C>
+LB_AVX2 void PureBoxRowAvx2(const int16_t* const* v, int32_t shift, int32_t level, int32_t x0,
+                            int32_t x1, int32_t* const* box) {
+  constexpr decltype(&PureBoxAvx2T<C, 1>) kByLevel[] = {PureBoxAvx2T<C, 1>, PureBoxAvx2T<C, 2>,
+                                                        PureBoxAvx2T<C, 3>, PureBoxAvx2T<C, 4>};
+  kByLevel[level - 1](v, shift, x0, x1, box);
+}
+
 // 32 x 32 -> 64-bit products of every lane with r (below 2^32 unsigned, 2^31 signed): the even
 // lanes' in `even`, the odd lanes' in `odd`.
 template <bool kSigned>
@@ -211,10 +313,16 @@ LB_AVX2 void ResolveRowAvx2(const int32_t* out, const int32_t* alpha, const int1
 }  // namespace
 
 const Kernels* Avx2Kernels() {
-  static constexpr Kernels kAvx2 = {
-      GatherRowCAvx2,        CompositeRowAvx2,       {LerpCompositeAvx2<1>, LerpCompositeAvx2<2>},
-      NormaliseAlphaRowAvx2, NormaliseColourRowAvx2, BlendRowsAvx2,
-      BoxPrefixRowAvx2,      ResolveRowAvx2};
+  static constexpr Kernels kAvx2 = {GatherRowCAvx2,
+                                    CompositeRowAvx2,
+                                    {LerpCompositeAvx2<1>, LerpCompositeAvx2<2>},
+                                    {WeightedBoxRowAvx2<1>, WeightedBoxRowAvx2<2>},
+                                    {PureBoxRowAvx2<1>, PureBoxRowAvx2<2>},
+                                    NormaliseAlphaRowAvx2,
+                                    NormaliseColourRowAvx2,
+                                    BlendRowsAvx2,
+                                    BoxPrefixRowAvx2,
+                                    ResolveRowAvx2};
   return __builtin_cpu_supports("avx2") ? &kAvx2 : nullptr;
 }
 

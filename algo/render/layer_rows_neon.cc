@@ -99,6 +99,93 @@ void LerpCompositeNeon(const int32_t* col, ptrdiff_t stride, const uint8_t* frac
   LerpCompositeC<C>(col, stride, frac, level, x, x1, out, out_stride);
 }
 
+// Adds each group of 2^L lanes' sum, in order, to box[0 ..]: two pairs (L 1) or the whole
+// vector (L >= 2: 4 columns, or 8 or 16 already added lane-wise). int32 wrapping adds, as the
+// reference's (its sums stay below 2^27: layer_rows.h).
+template <int L>
+inline void AddGroups(int32x4_t c, int32_t* box) {
+  const int32x2_t pairs = vpadd_s32(vget_low_s32(c), vget_high_s32(c));
+  if constexpr (L == 1) {
+    vst1_s32(box, vadd_s32(vld1_s32(box), pairs));
+  } else {
+    box[0] += vget_lane_s32(vpadd_s32(pairs, pairs), 0);
+  }
+}
+
+// LayerWeightQ8 of layer k for 4 pixels: the table looked up one pixel at a time, the choice
+// between 256 - frac, frac and 0 in-register.
+inline int32x4_t Weights(const int16_t* s, const uint16_t* table, int32x4_t k) {
+  const int32x4_t e = {table[s[0]], table[s[1]], table[s[2]], table[s[3]]};
+  const int32x4_t first = vshrq_n_s32(e, 8), frac = vandq_s32(e, vdupq_n_s32(255));
+  const int32x4_t in_first =
+      vandq_s32(vreinterpretq_s32_u32(vceqq_s32(first, k)), vsubq_s32(vdupq_n_s32(256), frac));
+  const int32x4_t in_next =
+      vandq_s32(vreinterpretq_s32_u32(vceqq_s32(vaddq_s32(first, vdupq_n_s32(1)), k)), frac);
+  return vorrq_s32(in_first, in_next);
+}
+
+// As WeightedBoxRowC: c = (v x a) >> shift per pixel (|v x a| <= 2^15 x 2^8, int32), the weight
+// a itself in the last plane, each box's columns summed in-register. A step is a whole number
+// of boxes (4 columns, 2^L from level 2), from x0 (a multiple of 2^L); the rest in C.
+template <int C, int L>
+void WeightedBoxNeonT(const int16_t* const* v, const int16_t* s, const uint16_t* layer_of,
+                      int32_t offset, int32_t k, int32_t shift, int32_t x0, int32_t x1,
+                      int32_t* const* box) {
+  constexpr int32_t kStep = L <= 2 ? 4 : 1 << L;
+  const int32x4_t down = vdupq_n_s32(-shift), layer = vdupq_n_s32(k);
+  int32_t x = x0;
+  for (; x + kStep - 1 <= x1; x += kStep) {
+    int32x4_t sum[C + 1];
+    for (int32_t i = 0; i < kStep; i += 4) {
+      const int32x4_t a = Weights(s + x + i, layer_of + offset, layer);
+      for (int32_t c = 0; c <= C; ++c) {
+        const int32x4_t t =
+            c == C ? a : vshlq_s32(vmulq_s32(vmovl_s16(vld1_s16(v[c] + x + i)), a), down);
+        sum[c] = i == 0 ? t : vaddq_s32(sum[c], t);
+      }
+    }
+    for (int32_t c = 0; c <= C; ++c) AddGroups<L>(sum[c], box[c] + (x >> L));
+  }
+  WeightedBoxRowC<C>(v, s, layer_of, offset, k, shift, L, x, x1, box);
+}
+
+// As PureBoxRowC: v << (8 - shift) summed per box (the sum of the shifted values equals the
+// shifted sum, modulo 2^32 as the reference's int32), and the weight 256 per pixel.
+template <int C, int L>
+void PureBoxNeonT(const int16_t* const* v, int32_t shift, int32_t x0, int32_t x1,
+                  int32_t* const* box) {
+  constexpr int32_t kStep = L <= 2 ? 4 : 1 << L;
+  const int32x4_t up = vdupq_n_s32(8 - shift), weights = vdupq_n_s32(256 * kStep / 4);
+  int32_t x = x0;
+  for (; x + kStep - 1 <= x1; x += kStep) {
+    for (int32_t c = 0; c < C; ++c) {
+      int32x4_t sum = vmovl_s16(vld1_s16(v[c] + x));
+      for (int32_t i = 4; i < kStep; i += 4) sum = vaddw_s16(sum, vld1_s16(v[c] + x + i));
+      AddGroups<L>(vshlq_s32(sum, up), box[c] + (x >> L));
+    }
+    AddGroups<L>(weights, box[C] + (x >> L));
+  }
+  PureBoxRowC<C>(v, shift, L, x, x1, box);
+}
+
+template <int C>
+void WeightedBoxRowNeon(const int16_t* const* v, const int16_t* s, const uint16_t* layer_of,
+                        int32_t offset, int32_t k, int32_t shift, int32_t level, int32_t x0,
+                        int32_t x1, int32_t* const* box) {
+  constexpr decltype(&WeightedBoxNeonT<C, 1>) kByLevel[] = {
+      WeightedBoxNeonT<C, 1>, WeightedBoxNeonT<C, 2>, WeightedBoxNeonT<C, 3>,
+      WeightedBoxNeonT<C, 4>};
+  kByLevel[level - 1](v, s, layer_of, offset, k, shift, x0, x1, box);
+}
+
+template <int C>
+void PureBoxRowNeon(const int16_t* const* v, int32_t shift, int32_t level, int32_t x0, int32_t x1,
+                    int32_t* const* box) {
+  constexpr decltype(&PureBoxNeonT<C, 1>) kByLevel[] = {PureBoxNeonT<C, 1>, PureBoxNeonT<C, 2>,
+                                                        PureBoxNeonT<C, 3>, PureBoxNeonT<C, 4>};
+  kByLevel[level - 1](v, shift, x0, x1, box);
+}
+
 // (acc x rec) >> 32 in 64-bit lanes for rec < 2^32 (then below 2^32: the narrowing shift keeps
 // it), clamped to 65536; a larger rec (a kernel of total weight 256) takes C.
 void NormaliseAlphaRowNeon(const uint32_t* acc, uint64_t rec, int32_t x0, int32_t x1,
@@ -200,10 +287,16 @@ void ResolveRowNeon(const int32_t* out, const int32_t* alpha, const int16_t* v, 
 }  // namespace
 
 const Kernels* NeonKernels() {
-  static constexpr Kernels kNeon = {
-      GatherRowCNeon,        CompositeRowNeon,       {LerpCompositeNeon<1>, LerpCompositeNeon<2>},
-      NormaliseAlphaRowNeon, NormaliseColourRowNeon, BlendRowsNeon,
-      BoxPrefixRowNeon,      ResolveRowNeon};
+  static constexpr Kernels kNeon = {GatherRowCNeon,
+                                    CompositeRowNeon,
+                                    {LerpCompositeNeon<1>, LerpCompositeNeon<2>},
+                                    {WeightedBoxRowNeon<1>, WeightedBoxRowNeon<2>},
+                                    {PureBoxRowNeon<1>, PureBoxRowNeon<2>},
+                                    NormaliseAlphaRowNeon,
+                                    NormaliseColourRowNeon,
+                                    BlendRowsNeon,
+                                    BoxPrefixRowNeon,
+                                    ResolveRowNeon};
   return &kNeon;
 }
 

@@ -467,6 +467,46 @@ TEST(LayerRows, BoxRowsSumEachBoxAndThePureShortcutAgrees) {
   }
 }
 
+template <int C>
+void CheckBoxRowVariants(std::mt19937& rng, int32_t trial) {
+  const int32_t level = 1 + trial % 4, n = 1 + trial % 130, k = trial % 4, shift = trial % 9;
+  const bool extreme = trial % 3 == 0;
+  const int32_t x0 = static_cast<int32_t>(rng() % n) & ~((1 << level) - 1);
+  const int32_t x1 = x0 + static_cast<int32_t>(rng() % (n - x0));
+  const int32_t boxes = (n >> level) + 1;
+  const LayerInput<C> mixed(rng, n, extreme), pure(rng, n, extreme, true, k);
+  std::vector<std::vector<int32_t>> start(C + 1, std::vector<int32_t>(boxes));
+  for (auto& plane : start) {
+    for (int32_t& b : plane) b = static_cast<int32_t>(rng() % 2000001) - 1000000;
+  }
+  const auto run = [&](const Kernels* kernels) {
+    std::vector<std::vector<int32_t>> w = start, p = start;
+    int32_t* pw[C + 1];
+    int32_t* pp[C + 1];
+    for (int32_t c = 0; c <= C; ++c) pw[c] = w[c].data(), pp[c] = p[c].data();
+    // A whole box of rows: the largest sums.
+    for (int32_t row = 0; row < (1 << level); ++row) {
+      kernels->weighted_box[C - 1](mixed.rows, mixed.s.data(), mixed.layer_of.data(),
+                                   LayerInput<C>::kOffset, k, shift, level, x0, x1, pw);
+      kernels->pure_box[C - 1](pure.rows, shift, level, x0, x1, pp);
+    }
+    return std::make_pair(w, p);
+  };
+  const auto want = run(&layer_rows::kReference);
+  for (const auto& [name, kernels] : Variants()) {
+    ASSERT_EQ(run(kernels), want) << name << " C " << C << " trial " << trial;
+  }
+}
+
+TEST(LayerRows, BoxRowVariantsEqualTheReference) {
+  SkipWithoutVariants();
+  std::mt19937 rng(35);
+  for (int32_t trial = 0; trial < 300; ++trial) {
+    CheckBoxRowVariants<1>(rng, trial);
+    CheckBoxRowVariants<2>(rng, trial);
+  }
+}
+
 TEST(LayerRows, BoxPrefixRowAddsTheRoundedMeans) {
   std::mt19937 rng(23);
   for (int32_t trial = 0; trial < 200; ++trial) {
