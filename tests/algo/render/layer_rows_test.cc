@@ -427,15 +427,32 @@ TEST(LayerRows, PrefixRowsAddEachPixelsWeightedValue) {
   }
 }
 
+// A box row's case: a level, a layer, a shift, columns [x0, x1] from a box edge, and the rows
+// of a pixel mix and of a tile wholly in the layer.
+template <int C>
+struct BoxCase {
+  const int32_t level, n, k, shift;
+  const bool extreme;
+  const int32_t x0, x1, boxes;
+  const LayerInput<C> mixed, pure;
+  BoxCase(std::mt19937& rng, int32_t trial, int32_t max_n)
+      : level(1 + trial % 4),
+        n(1 + trial % max_n),
+        k(trial % 4),
+        shift(trial % 9),
+        extreme(trial % 3 == 0),
+        x0(static_cast<int32_t>(rng() % n) & ~((1 << level) - 1)),
+        x1(x0 + static_cast<int32_t>(rng() % (n - x0))),
+        boxes((n >> level) + 1),
+        mixed(rng, n, extreme),
+        pure(rng, n, extreme, true, k) {}
+};
+
 template <int C>
 void CheckBoxRows(std::mt19937& rng, int32_t trial) {
-  const int32_t level = 1 + trial % 4, n = 1 + trial % 90, k = trial % 4, shift = trial % 9;
-  const bool extreme = trial % 3 == 0;
-  const int32_t x0 = static_cast<int32_t>(rng() % n) & ~((1 << level) - 1);
-  const int32_t x1 = x0 + static_cast<int32_t>(rng() % (n - x0));
-  const int32_t boxes = (n >> level) + 1;
+  const BoxCase<C> bc(rng, trial, 90);
+  const auto& [level, n, k, shift, extreme, x0, x1, boxes, mixed, pure] = bc;
   // A whole box of rows (the largest sums), weighted; and a pure one both ways.
-  const LayerInput<C> mixed(rng, n, extreme), pure(rng, n, extreme, true, k);
   std::vector<std::vector<int32_t>> got(C + 1, std::vector<int32_t>(boxes, 0));
   std::vector<std::vector<int32_t>> want = got, pure_w = got, pure_p = got;
   int32_t* g[C + 1];
@@ -469,12 +486,8 @@ TEST(LayerRows, BoxRowsSumEachBoxAndThePureShortcutAgrees) {
 
 template <int C>
 void CheckBoxRowVariants(std::mt19937& rng, int32_t trial) {
-  const int32_t level = 1 + trial % 4, n = 1 + trial % 130, k = trial % 4, shift = trial % 9;
-  const bool extreme = trial % 3 == 0;
-  const int32_t x0 = static_cast<int32_t>(rng() % n) & ~((1 << level) - 1);
-  const int32_t x1 = x0 + static_cast<int32_t>(rng() % (n - x0));
-  const int32_t boxes = (n >> level) + 1;
-  const LayerInput<C> mixed(rng, n, extreme), pure(rng, n, extreme, true, k);
+  const BoxCase<C> bc(rng, trial, 130);
+  const auto& [level, n, k, shift, extreme, x0, x1, boxes, mixed, pure] = bc;
   std::vector<std::vector<int32_t>> start(C + 1, std::vector<int32_t>(boxes));
   for (auto& plane : start) {
     for (int32_t& b : plane) b = static_cast<int32_t>(rng() % 2000001) - 1000000;
