@@ -225,13 +225,13 @@ void LayerPlane::BuildPrefixT(Scratch& sc, int32_t k, int32_t level, int32_t h, 
           if (!(any & bit)) continue;
           const int32_t t1 = Min(x1, t0 + tile - 1);
           if ((pure & bit) && shift <= 8) {
-            layer_rows::PureBoxRowC<C>(v, shift, level, t0, t1, box);
+            rows_->pure_box[C - 1](v, shift, level, t0, t1, box);
           } else {
-            layer_rows::WeightedBoxRowC<C>(v, s, layer_of, offset, k, shift, level, t0, t1, box);
+            rows_->weighted_box[C - 1](v, s, layer_of, offset, k, shift, level, t0, t1, box);
           }
         }
       }
-      for (int32_t c = 0; c <= C; ++c) layer_rows::BoxPrefixRowC(box[c], level, q0, q1, p[c]);
+      for (int32_t c = 0; c <= C; ++c) rows_->box_prefix(box[c], level, q0, q1, p[c]);
     }
     // Beyond the run the prefix stays flat: the kernel reads up to `h` + 1 columns outside.
     for (int32_t c = 0; c <= C; ++c) {
@@ -264,11 +264,11 @@ void LayerPlane::GatherNormalise(Scratch& s, int32_t kernel, int32_t m, int32_t 
   }
   // alpha = acc / (total * 256) in Q16 (rec = 2^40 / total); colour likewise, undoing the shift.
   const uint64_t rec = reciprocal_[kernel];
-  layer_rows::NormaliseAlphaRowC(s.acc + channels_ * static_cast<ptrdiff_t>(pitch_), rec, x0, x1,
-                                 layer + channels_ * stride);
+  rows_->normalise_alpha(s.acc + channels_ * static_cast<ptrdiff_t>(pitch_), rec, x0, x1,
+                         layer + channels_ * stride);
   for (int32_t c = 0; c < channels_; ++c) {
-    layer_rows::NormaliseColourRowC(s.acc + c * static_cast<ptrdiff_t>(pitch_), rec, shift_, x0, x1,
-                                    layer + c * stride);
+    rows_->normalise_colour(s.acc + c * static_cast<ptrdiff_t>(pitch_), rec, shift_, x0, x1,
+                            layer + c * stride);
   }
 }
 
@@ -369,14 +369,11 @@ void LayerPlane::RenderRun(Scratch& sc, int32_t k, int32_t y0, int32_t n, const 
     for (int32_t c = 0; c < planes; ++c) {
       const int32_t* a = ra + c * static_cast<ptrdiff_t>(pitch_);
       const int32_t* b = rb + c * static_cast<ptrdiff_t>(pitch_);
-      layer_rows::BlendRowsC(a, b, fy, q_lo, q_hi, sc.box + c * static_cast<ptrdiff_t>(pitch_) + 1);
+      rows_->blend(a, b, fy, q_lo, q_hi, sc.box + c * static_cast<ptrdiff_t>(pitch_) + 1);
     }
     int32_t* out = sc.out + (y - y0) * row_stride;
-    if (channels_ == 1) {
-      layer_rows::LerpCompositeC<1>(sc.box + 1, pitch_, frac_[level], level, x0, x1, out, width_);
-    } else {
-      layer_rows::LerpCompositeC<2>(sc.box + 1, pitch_, frac_[level], level, x0, x1, out, width_);
-    }
+    rows_->lerp_composite[channels_ - 1](sc.box + 1, pitch_, frac_[level], level, x0, x1, out,
+                                         width_);
   }
 }
 
@@ -394,8 +391,8 @@ void LayerPlane::RenderStrip(int32_t worker, int32_t y0, int32_t n, const uint16
     const int32_t* out_a = out + channels_ * static_cast<ptrdiff_t>(width_);
     for (int32_t c = 0; c < channels_; ++c) {
       // A pixel always covers itself, so alpha is positive (ResolveRowC keeps a fallback).
-      layer_rows::ResolveRowC(out + c * static_cast<ptrdiff_t>(width_), out_a, ValueRow(y, c),
-                              width_, bias, dst[c].Row(y - y0));
+      rows_->resolve(out + c * static_cast<ptrdiff_t>(width_), out_a, ValueRow(y, c), width_, bias,
+                     dst[c].Row(y - y0));
     }
   }
 }

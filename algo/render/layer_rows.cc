@@ -1,12 +1,18 @@
-// The C reference of the layer row kernels (layer_rows.h) and, on x86-64, the same bodies
-// compiled for AVX2: each body is an always-inline function, instantiated once in a plain
-// function and once in a target("avx2") one, so both come from one source.
+// The C reference of the layer row kernels (layer_rows.h) and the gather kernel's body compiled
+// for AVX2 (x86-64) and NEON (ARM) too: an always-inline function instantiated once in a plain
+// function and once in a target one, so all come from one source (compilers vectorise it well;
+// the kernels they do not are written with intrinsics in layer_rows_avx2.cc / _neon.cc).
 #include "algo/render/layer_rows.h"
 
 #include "algo/core/int_math.h"
 
 #if defined(__x86_64__)
 #define LB_ROW_AVX2 __attribute__((target("avx2")))
+#endif
+#if defined(__arm__)
+#define LB_ROW_NEON __attribute__((target("fpu=neon")))  // beyond armhf's baseline
+#elif defined(__ARM_NEON)
+#define LB_ROW_NEON
 #endif
 
 namespace lb::layer_rows {
@@ -39,14 +45,6 @@ LB_ROW_BODY void GatherBody(const uint32_t* p, const KernelRow& k, uint32_t* acc
   }
 }
 
-LB_ROW_BODY void CompositeBody(int32_t* out, const int32_t* colour, const int32_t* alpha,
-                               int32_t x0, int32_t x1) {
-  for (int32_t x = x0; x <= x1; ++x) {
-    const int64_t keep = 65536 - alpha[x];
-    out[x] = static_cast<int32_t>(((out[x] * keep + 32768) >> 16) + colour[x]);
-  }
-}
-
 // Whole groups have a fixed length, so the inner loop is unrolled for each level.
 template <int L>
 void SumGroupsT(const int16_t* v, int32_t x0, int32_t x1, int32_t up, int32_t* box) {
@@ -69,7 +67,10 @@ void GatherRowC(const uint32_t* p, const KernelRow& k, uint32_t* acc, int32_t x0
 
 void CompositeRowC(int32_t* out, const int32_t* colour, const int32_t* alpha, int32_t x0,
                    int32_t x1) {
-  CompositeBody(out, colour, alpha, x0, x1);
+  for (int32_t x = x0; x <= x1; ++x) {
+    const int64_t keep = 65536 - alpha[x];
+    out[x] = static_cast<int32_t>(((out[x] * keep + 32768) >> 16) + colour[x]);
+  }
 }
 
 template <int C>
@@ -235,35 +236,40 @@ void ResolveRowC(const int32_t* out, const int32_t* alpha, const int16_t* v, int
   }
 }
 
-const Kernels kReference = {GatherRowC, CompositeRowC};
+const Kernels kReference = {GatherRowC,
+                            CompositeRowC,
+                            {LerpCompositeC<1>, LerpCompositeC<2>},
+                            {WeightedBoxRowC<1>, WeightedBoxRowC<2>},
+                            {PureBoxRowC<1>, PureBoxRowC<2>},
+                            NormaliseAlphaRowC,
+                            NormaliseColourRowC,
+                            BlendRowsC,
+                            BoxPrefixRowC,
+                            ResolveRowC};
 
 #if defined(LB_ROW_AVX2)
-namespace {
-
-LB_ROW_AVX2 void GatherRowAvx2(const uint32_t* p, const KernelRow& k, uint32_t* acc, int32_t x0,
-                               int32_t x1) {
+LB_ROW_AVX2 void GatherRowCAvx2(const uint32_t* p, const KernelRow& k, uint32_t* acc, int32_t x0,
+                                int32_t x1) {
   GatherBody(p, k, acc, x0, x1);
 }
-
-LB_ROW_AVX2 void CompositeRowAvx2(int32_t* out, const int32_t* colour, const int32_t* alpha,
-                                  int32_t x0, int32_t x1) {
-  CompositeBody(out, colour, alpha, x0, x1);
+#endif
+#if defined(LB_ROW_NEON)
+LB_ROW_NEON void GatherRowCNeon(const uint32_t* p, const KernelRow& k, uint32_t* acc, int32_t x0,
+                                int32_t x1) {
+  GatherBody(p, k, acc, x0, x1);
 }
-
-}  // namespace
-
-const Kernels* Avx2Kernels() {
-  static constexpr Kernels kAvx2 = {GatherRowAvx2, CompositeRowAvx2};
-  return __builtin_cpu_supports("avx2") ? &kAvx2 : nullptr;
-}
-#else
-const Kernels* Avx2Kernels() { return nullptr; }
 #endif
 
 const Kernels& BestKernels() {
   static const Kernels* const best = [] {
     const Kernels* avx2 = Avx2Kernels();
-    return avx2 != nullptr ? avx2 : &kReference;
+    if (avx2 != nullptr) return avx2;
+#if defined(__ARM_NEON)
+    // NEON is in this build's baseline (always on aarch64).
+    return NeonKernels();
+#else
+    return &kReference;
+#endif
   }();
   return *best;
 }

@@ -1,8 +1,9 @@
-// The row kernels of layered compositing (layer_plane.h): each a plain C reference; the two
-// that run per kernel row and per layer row (gather, composite) also have an AVX2 variant on
-// x86-64, the same C source compiled for AVX2, picked once when a plane is carved (never per
-// row). Integer arithmetic only, so every variant gives the same bits as the reference; the
-// tests (tests/algo/render/layer_rows_test.cc) run each variant the CPU has against it.
+// The row kernels of layered compositing (layer_plane.h): each a plain C reference; those on the
+// per-pixel path also have SIMD twins, picked once when a plane is carved (never per row):
+// AVX2 on x86-64 and NEON on ARM (layer_rows_avx2.cc, layer_rows_neon.cc: intrinsics, ARMv7
+// ones so armhf builds them too; gather is the C source compiled for each). Integer
+// arithmetic only, so every variant gives the same bits as the reference; the tests
+// (tests/algo/render/layer_rows_test.cc) run each variant the CPU has against it.
 //
 // Formats, shared by the kernels (bounds from render_stage.cc and layer_plane.h):
 //   v       int16, a plane's value: Y * gain or (C - 128) * gain, gain <= 8: |v| <= 2040.
@@ -126,17 +127,51 @@ void BlendRowsC(const int32_t* a, const int32_t* b, int64_t fy, int32_t q0, int3
 void ResolveRowC(const int32_t* out, const int32_t* alpha, const int16_t* v, int32_t width,
                  int32_t bias, uint8_t* dst);
 
-// The kernels that have faster variants, as a table picked once.
+// The kernels that have faster variants, as a table picked once. The SIMD twins rely on the
+// formats above (Q16 values below 2^28, alpha 0..65536) where the references compute in int64:
+// they split the products into 32-bit parts whose sum is exact within those bounds.
 struct Kernels {
   void (*gather)(const uint32_t* p, const KernelRow& k, uint32_t* acc, int32_t x0, int32_t x1);
   void (*composite)(int32_t* out, const int32_t* colour, const int32_t* alpha, int32_t x0,
                     int32_t x1);
+  // LerpCompositeC<1> and <2>.
+  void (*lerp_composite[2])(const int32_t* col, ptrdiff_t stride, const uint8_t* frac,
+                            int32_t level, int32_t x0, int32_t x1, int32_t* out,
+                            ptrdiff_t out_stride);
+  // WeightedBoxRowC<1> and <2>, PureBoxRowC<1> and <2>.
+  void (*weighted_box[2])(const int16_t* const* v, const int16_t* s, const uint16_t* layer_of,
+                          int32_t offset, int32_t k, int32_t shift, int32_t level, int32_t x0,
+                          int32_t x1, int32_t* const* box);
+  void (*pure_box[2])(const int16_t* const* v, int32_t shift, int32_t level, int32_t x0, int32_t x1,
+                      int32_t* const* box);
+  void (*normalise_alpha)(const uint32_t* acc, uint64_t rec, int32_t x0, int32_t x1,
+                          int32_t* alpha);
+  void (*normalise_colour)(const uint32_t* acc, uint64_t rec, int32_t shift, int32_t x0, int32_t x1,
+                           int32_t* colour);
+  void (*blend)(const int32_t* a, const int32_t* b, int64_t fy, int32_t q0, int32_t q1,
+                int32_t* col);
+  void (*box_prefix)(const int32_t* box, int32_t level, int32_t q0, int32_t q1, uint32_t* p);
+  void (*resolve)(const int32_t* out, const int32_t* alpha, const int16_t* v, int32_t width,
+                  int32_t bias, uint8_t* dst);
 };
 
 extern const Kernels kReference;
+#if defined(__x86_64__)
+// GatherRowC's source compiled for AVX2 (the caller checks the CPU).
+void GatherRowCAvx2(const uint32_t* p, const KernelRow& k, uint32_t* acc, int32_t x0, int32_t x1);
+#endif
+#if defined(__ARM_NEON) || defined(__arm__)
+// GatherRowC's source compiled for NEON (on armhf the caller checks the CPU).
+void GatherRowCNeon(const uint32_t* p, const KernelRow& k, uint32_t* acc, int32_t x0, int32_t x1);
+#endif
 // The AVX2 variants (x86-64) when the processor has AVX2, else nullptr.
 const Kernels* Avx2Kernels();
+// The NEON variants on ARM (aarch64; armhf compiles them for NEON whatever its baseline, and
+// the caller must know the CPU has NEON), else nullptr.
+const Kernels* NeonKernels();
 // The fastest variants this processor has (decided on the first call, then the same table).
+// The one place that chooses: armhf takes NEON only when its baseline has it, until the CPU's
+// capabilities are read (in firmware/) and handed here.
 const Kernels& BestKernels();
 
 }  // namespace lb::layer_rows

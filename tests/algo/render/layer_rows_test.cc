@@ -13,6 +13,11 @@
 #include <random>
 #include <vector>
 
+#if defined(__arm__)
+#include <asm/hwcap.h>
+#include <sys/auxv.h>
+#endif
+
 namespace lb {
 namespace {
 
@@ -26,6 +31,14 @@ constexpr int32_t kMaxC = 2147483647 / (kCells * 256);  // |c| that keeps a kern
 std::vector<std::pair<const char*, const Kernels*>> Variants() {
   std::vector<std::pair<const char*, const Kernels*>> v = {{"C", &layer_rows::kReference}};
   if (const Kernels* k = layer_rows::Avx2Kernels()) v.emplace_back("AVX2", k);
+  if (const Kernels* k = layer_rows::NeonKernels()) {
+#if defined(__arm__)
+    // armhf builds the NEON twins whatever its baseline: run them only where the CPU has NEON.
+    if (getauxval(AT_HWCAP) & HWCAP_NEON) v.emplace_back("NEON", k);
+#else
+    v.emplace_back("NEON", k);
+#endif
+  }
   return v;
 }
 
@@ -414,15 +427,32 @@ TEST(LayerRows, PrefixRowsAddEachPixelsWeightedValue) {
   }
 }
 
+// A box row's case: a level, a layer, a shift, columns [x0, x1] from a box edge, and the rows
+// of a pixel mix and of a tile wholly in the layer.
+template <int C>
+struct BoxCase {
+  const int32_t level, n, k, shift;
+  const bool extreme;
+  const int32_t x0, x1, boxes;
+  const LayerInput<C> mixed, pure;
+  BoxCase(std::mt19937& rng, int32_t trial, int32_t max_n)
+      : level(1 + trial % 4),
+        n(1 + trial % max_n),
+        k(trial % 4),
+        shift(trial % 9),
+        extreme(trial % 3 == 0),
+        x0(static_cast<int32_t>(rng() % n) & ~((1 << level) - 1)),
+        x1(x0 + static_cast<int32_t>(rng() % (n - x0))),
+        boxes((n >> level) + 1),
+        mixed(rng, n, extreme),
+        pure(rng, n, extreme, true, k) {}
+};
+
 template <int C>
 void CheckBoxRows(std::mt19937& rng, int32_t trial) {
-  const int32_t level = 1 + trial % 4, n = 1 + trial % 90, k = trial % 4, shift = trial % 9;
-  const bool extreme = trial % 3 == 0;
-  const int32_t x0 = static_cast<int32_t>(rng() % n) & ~((1 << level) - 1);
-  const int32_t x1 = x0 + static_cast<int32_t>(rng() % (n - x0));
-  const int32_t boxes = (n >> level) + 1;
+  const BoxCase<C> bc(rng, trial, 90);
+  const auto& [level, n, k, shift, extreme, x0, x1, boxes, mixed, pure] = bc;
   // A whole box of rows (the largest sums), weighted; and a pure one both ways.
-  const LayerInput<C> mixed(rng, n, extreme), pure(rng, n, extreme, true, k);
   std::vector<std::vector<int32_t>> got(C + 1, std::vector<int32_t>(boxes, 0));
   std::vector<std::vector<int32_t>> want = got, pure_w = got, pure_p = got;
   int32_t* g[C + 1];
@@ -454,6 +484,42 @@ TEST(LayerRows, BoxRowsSumEachBoxAndThePureShortcutAgrees) {
   }
 }
 
+template <int C>
+void CheckBoxRowVariants(std::mt19937& rng, int32_t trial) {
+  const BoxCase<C> bc(rng, trial, 130);
+  const auto& [level, n, k, shift, extreme, x0, x1, boxes, mixed, pure] = bc;
+  std::vector<std::vector<int32_t>> start(C + 1, std::vector<int32_t>(boxes));
+  for (auto& plane : start) {
+    for (int32_t& b : plane) b = static_cast<int32_t>(rng() % 2000001) - 1000000;
+  }
+  const auto run = [&](const Kernels* kernels) {
+    std::vector<std::vector<int32_t>> w = start, p = start;
+    int32_t* pw[C + 1];
+    int32_t* pp[C + 1];
+    for (int32_t c = 0; c <= C; ++c) pw[c] = w[c].data(), pp[c] = p[c].data();
+    // A whole box of rows: the largest sums.
+    for (int32_t row = 0; row < (1 << level); ++row) {
+      kernels->weighted_box[C - 1](mixed.rows, mixed.s.data(), mixed.layer_of.data(),
+                                   LayerInput<C>::kOffset, k, shift, level, x0, x1, pw);
+      kernels->pure_box[C - 1](pure.rows, shift, level, x0, x1, pp);
+    }
+    return std::make_pair(w, p);
+  };
+  const auto want = run(&layer_rows::kReference);
+  for (const auto& [name, kernels] : Variants()) {
+    ASSERT_EQ(run(kernels), want) << name << " C " << C << " trial " << trial;
+  }
+}
+
+TEST(LayerRows, BoxRowVariantsEqualTheReference) {
+  SkipWithoutVariants();
+  std::mt19937 rng(35);
+  for (int32_t trial = 0; trial < 300; ++trial) {
+    CheckBoxRowVariants<1>(rng, trial);
+    CheckBoxRowVariants<2>(rng, trial);
+  }
+}
+
 TEST(LayerRows, BoxPrefixRowAddsTheRoundedMeans) {
   std::mt19937 rng(23);
   for (int32_t trial = 0; trial < 200; ++trial) {
@@ -470,6 +536,130 @@ TEST(LayerRows, BoxPrefixRowAddsTheRoundedMeans) {
     for (int32_t q = 0; q < n; ++q) {
       const double mean = std::floor(box[q] / static_cast<double>(1 << (2 * level)) + 0.5);
       ASSERT_EQ(static_cast<int32_t>(p[q + 1] - p[q]), static_cast<int32_t>(mean)) << trial;
+    }
+  }
+}
+
+TEST(LayerRows, LerpCompositeVariantsEqualTheReference) {
+  SkipWithoutVariants();
+  std::mt19937 rng(31);
+  for (int32_t trial = 0; trial < 300; ++trial) {
+    const int32_t level = 1 + trial % 4, f = 1 << level, planes = 2 + trial % 2;
+    const bool extreme = trial % 3 == 0;
+    const int32_t n = 1 + static_cast<int32_t>(rng() % 120);
+    // Exactly the taps the kernel may read, col[-1 .. ((n - 1 - f / 2) >> level) + 1], so an
+    // overread shows under ASan.
+    const int32_t low = ((n - 1 - f / 2) >> level) + 3;
+    std::vector<int32_t> col(static_cast<size_t>(planes) * low);
+    for (int32_t q = 0; q < low; ++q) {
+      const LayerRow r = MakeLayerRow(rng, planes - 1, extreme);
+      for (int32_t c = 0; c + 1 < planes; ++c) col[c * low + q] = r.colour[c];
+      col[(planes - 1) * low + q] = r.alpha[0];
+    }
+    std::vector<uint8_t> frac(n);
+    for (int32_t x = 0; x < n; ++x)
+      frac[x] = static_cast<uint8_t>((((2 * x + 1 - f) * 128) >> level) & 255);
+    const LayerRow behind = MakeLayerRow(rng, planes * n, extreme);
+    const int32_t x0 = static_cast<int32_t>(rng() % n);
+    std::vector<int32_t> want = behind.out;
+    layer_rows::kReference.lerp_composite[planes - 2](col.data() + 1, low, frac.data(), level, x0,
+                                                      n - 1, want.data(), n);
+    for (const auto& [name, kernels] : Variants()) {
+      std::vector<int32_t> got = behind.out;
+      kernels->lerp_composite[planes - 2](col.data() + 1, low, frac.data(), level, x0, n - 1,
+                                          got.data(), n);
+      ASSERT_EQ(got, want) << name << " trial " << trial << " level " << level;
+    }
+  }
+}
+
+TEST(LayerRows, NormaliseVariantsEqualTheReference) {
+  SkipWithoutVariants();
+  std::mt19937 rng(32);
+  for (int32_t trial = 0; trial < 400; ++trial) {
+    // Every reciprocal a kernel can have (total 256 .. 17 x 17 x 256, the twins' fallbacks
+    // included), and any accumulator: the variants must agree even beyond the bounds.
+    const uint32_t totals[] = {256, 257, 511, 512, 513, 256u * kCells};
+    const uint32_t total = trial % 2 ? totals[trial / 2 % 6]
+                                     : 256u + static_cast<uint32_t>(rng() % (256u * kCells - 255));
+    const uint64_t rec = (uint64_t{1} << 40) / total;
+    const int32_t shift = static_cast<int32_t>(rng() % 17), n = 1 + trial % 70;
+    const int32_t x0 = static_cast<int32_t>(rng() % n);
+    std::vector<uint32_t> acc(n);
+    for (uint32_t& a : acc) {
+      a = trial % 3 == 0 ? ((rng() & 1) ? total * 256 : static_cast<uint32_t>(INT32_MIN))
+                         : static_cast<uint32_t>(rng());
+    }
+    std::vector<int32_t> want_a(n, 7), want_c(n, 7);
+    layer_rows::kReference.normalise_alpha(acc.data(), rec, x0, n - 1, want_a.data());
+    layer_rows::kReference.normalise_colour(acc.data(), rec, shift, x0, n - 1, want_c.data());
+    for (const auto& [name, kernels] : Variants()) {
+      std::vector<int32_t> got_a(n, 7), got_c(n, 7);
+      kernels->normalise_alpha(acc.data(), rec, x0, n - 1, got_a.data());
+      kernels->normalise_colour(acc.data(), rec, shift, x0, n - 1, got_c.data());
+      ASSERT_EQ(got_a, want_a) << name << " trial " << trial;
+      ASSERT_EQ(got_c, want_c) << name << " trial " << trial;
+    }
+  }
+}
+
+TEST(LayerRows, BlendAndBoxPrefixVariantsEqualTheReference) {
+  SkipWithoutVariants();
+  std::mt19937 rng(33);
+  for (int32_t trial = 0; trial < 300; ++trial) {
+    const int32_t n = 1 + trial % 90, q0 = static_cast<int32_t>(rng() % n);
+    const LayerRow ra = MakeLayerRow(rng, n, trial % 2 == 0),
+                   rb = MakeLayerRow(rng, n, trial % 3 == 0);
+    const int64_t fy = trial % 5 == 0 ? 255 : static_cast<int64_t>(rng() % 256);
+    std::vector<int32_t> want(n + 2, 7);
+    layer_rows::kReference.blend(ra.colour.data(), rb.colour.data(), fy, q0, n - 1,
+                                 want.data() + 1);
+    // Box sums of up to 16 x 16 pixels of |c| <= kMaxV x 256, every level.
+    const int32_t level = 1 + trial % 4;
+    const int32_t max_box = (1 << (2 * level)) * kMaxV * 256;
+    std::vector<int32_t> box(n);
+    for (int32_t& b : box) {
+      b = trial % 3 == 0 ? ((rng() & 1) ? max_box : -max_box)
+                         : static_cast<int32_t>(rng() % (2 * uint32_t(max_box) + 1)) - max_box;
+    }
+    std::vector<uint32_t> want_p(n + 1, 7);
+    want_p[q0] = rng();
+    const std::vector<uint32_t> start = want_p;
+    layer_rows::kReference.box_prefix(box.data(), level, q0, n - 1, want_p.data());
+    for (const auto& [name, kernels] : Variants()) {
+      std::vector<int32_t> got(n + 2, 7);
+      kernels->blend(ra.colour.data(), rb.colour.data(), fy, q0, n - 1, got.data() + 1);
+      ASSERT_EQ(got, want) << name << " trial " << trial;
+      std::vector<uint32_t> got_p = start;
+      kernels->box_prefix(box.data(), level, q0, n - 1, got_p.data());
+      ASSERT_EQ(got_p, want_p) << name << " trial " << trial;
+    }
+  }
+}
+
+TEST(LayerRows, ResolveVariantsEqualTheReference) {
+  SkipWithoutVariants();
+  std::mt19937 rng(34);
+  for (int32_t trial = 0; trial < 300; ++trial) {
+    const int32_t n = 1 + trial % 100;
+    LayerRow r = MakeLayerRow(rng, n, trial % 3 == 0);
+    std::vector<int16_t> v(n);
+    for (int32_t x = 0; x < n; ++x) {
+      v[x] = static_cast<int16_t>(static_cast<int32_t>(rng() % (2 * kMaxV + 1)) - kMaxV);
+      // Mostly fully covered runs (the fast path), some partial and some empty pixels, and
+      // composited values up to the bound |out| < 2^31 - 2^16.
+      const uint32_t kind = rng() % 16;
+      if (kind < 12 && trial % 4 != 1) r.alpha[x] = 65536;
+      if (kind == 12) r.alpha[x] = 0;
+      if (kind == 13) r.colour[x] = (rng() & 1) ? INT32_MAX - 65536 : -(INT32_MAX - 65536);
+    }
+    const int32_t bias = trial % 2 == 0 ? 0 : 128;
+    std::vector<uint8_t> want(n);
+    layer_rows::kReference.resolve(r.colour.data(), r.alpha.data(), v.data(), n, bias, want.data());
+    for (const auto& [name, kernels] : Variants()) {
+      std::vector<uint8_t> got(n);
+      kernels->resolve(r.colour.data(), r.alpha.data(), v.data(), n, bias, got.data());
+      ASSERT_EQ(got, want) << name << " trial " << trial;
     }
   }
 }
