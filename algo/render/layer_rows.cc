@@ -4,6 +4,7 @@
 // the kernels they do not are written with intrinsics in layer_rows_avx2.cc / _neon.cc).
 #include "algo/render/layer_rows.h"
 
+#include "algo/core/cpu.h"
 #include "algo/core/int_math.h"
 
 #if defined(__x86_64__)
@@ -261,17 +262,11 @@ LB_ROW_NEON void GatherRowCNeon(const uint32_t* p, const KernelRow& k, uint32_t*
 #endif
 
 const Kernels& BestKernels() {
-  static const Kernels* const best = [] {
-    const Kernels* avx2 = Avx2Kernels();
-    if (avx2 != nullptr) return avx2;
-#if defined(__ARM_NEON)
-    // NEON is in this build's baseline (always on aarch64).
-    return NeonKernels();
-#else
-    return &kReference;
-#endif
-  }();
-  return *best;
+  // What the firmware read of this processor (algo/core/cpu.h): armhf's NEON only when the
+  // kernel says the core has it.
+  const CpuFeatures cpu = CurrentCpu();
+  const Kernels* simd = cpu.avx2 ? Avx2Kernels() : (cpu.neon ? NeonKernels() : nullptr);
+  return simd != nullptr ? *simd : kReference;
 }
 
 }  // namespace lb::layer_rows

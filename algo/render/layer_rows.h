@@ -169,9 +169,9 @@ const Kernels* Avx2Kernels();
 // The NEON variants on ARM (aarch64; armhf compiles them for NEON whatever its baseline, and
 // the caller must know the CPU has NEON), else nullptr.
 const Kernels* NeonKernels();
-// The fastest variants this processor has (decided on the first call, then the same table).
-// The one place that chooses: armhf takes NEON only when its baseline has it, until the CPU's
-// capabilities are read (in firmware/) and handed here.
+// The fastest variants this processor has, from the features the firmware read
+// (algo/core/cpu.h; armhf takes NEON only when HWCAP says the core has it). The one place that
+// chooses; a plane asks once, when it is carved.
 const Kernels& BestKernels();
 
 }  // namespace lb::layer_rows

@@ -4,6 +4,8 @@
 // the edges of the overflow bounds the header states.
 #include "algo/render/layer_rows.h"
 
+#include "algo/core/cpu.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -674,3 +676,24 @@ TEST(LayerRows, BestKernelsAreOneOfTheVariants) {
 
 }  // namespace
 }  // namespace lb
+
+namespace lb::layer_rows {
+namespace {
+
+// The table a plane is carved with follows what the firmware read of the processor
+// (algo/core/cpu.h): nothing read means the C reference, even where the build could do more.
+TEST(LayerRows, TheTableFollowsTheFeaturesHandedIn) {
+  const CpuFeatures before = CurrentCpu();
+  SetCpu(CpuFeatures{});
+  EXPECT_EQ(&BestKernels(), &kReference);
+  CpuFeatures simd;
+  simd.avx2 = Avx2Kernels() != nullptr;
+  simd.neon = !simd.avx2 && NeonKernels() != nullptr;
+  SetCpu(simd);
+  const Kernels* expected = simd.avx2 ? Avx2Kernels() : (simd.neon ? NeonKernels() : &kReference);
+  EXPECT_EQ(&BestKernels(), expected);
+  SetCpu(before);
+}
+
+}  // namespace
+}  // namespace lb::layer_rows
