@@ -88,7 +88,7 @@ void DataTerm::PixelCostRow(int32_t view, int32_t y, int32_t disp_q8, int32_t x0
   const int32_t w = width_;
   if (planes_ != nullptr) {
     const WarpSource src{images_[reference_], images_[view], census_[reference_], census_[view]};
-    PlaneCostRow(planes_[view], src, y, params_, invalid_cost_, x0, x1, out);
+    PlaneCostRow(planes_[view], src, y, params_, invalid_cost_, x0, x1, out, kernels_->plane);
     return;
   }
   // Sample position in the view: x * 256 + shift_q8, the same fraction for every pixel.

@@ -1,14 +1,17 @@
-// The data term's row kernels (data_term.h): a plain C reference (data_term_ref.cc) and SIMD
-// twins that give the same bits (data_term_avx2.cc on x86-64, data_term_neon.cc on ARM), picked
-// once when the data term is carved. On x86-64 the C cost kernel is also compiled for SSSE3 (the
-// table of a CPU without AVX2) and for AVX2 (the AVX2 kernel's short rows). Every table is run
-// against the reference by tests/algo/depth/data_term_kernels_test.cc. Internal to algo/depth.
+// The data term's row kernels (data_term.h) and the plane sweep's span kernel (warp_cost.h): a
+// plain C reference (data_term_ref.cc, warp_cost.cc) and SIMD twins that give the same bits
+// (data_term_avx2.cc and warp_cost_avx2.cc on x86-64, data_term_neon.cc and warp_cost_neon.cc on
+// ARM), picked once when the data term is carved (SimdKernels, the one place that chooses). On
+// x86-64 the C cost kernel is also compiled for SSSE3 (the table of a CPU without AVX2) and for
+// AVX2 (the AVX2 kernel's short rows). Every table is run against the reference by
+// tests/algo/depth/data_term_kernels_test.cc. Internal to algo/depth.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 
 #include "algo/depth/data_term.h"
+#include "algo/depth/warp_cost.h"
 
 namespace lb {
 
@@ -19,6 +22,7 @@ struct DataTerm::Kernels {
   void (*hsum)(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum);
   void (*select)(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
                  uint16_t* out);
+  PlaneSpanFn plane;  // the plane sweep's pixel costs, one span (warp_cost.h)
 };
 
 namespace dtk {
@@ -49,6 +53,15 @@ void CostRowCSsse3(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, 
                    ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc, int32_t cw, uint8_t* out);
 void CostRowCAvx2(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, const uint8_t* cimg,
                   ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc, int32_t cw, uint8_t* out);
+#endif
+// The plane sweep's span kernels: the C reference (warp_cost.cc), AVX2 (warp_cost_avx2.cc, the
+// caller checks the CPU) and NEON (warp_cost_neon.cc).
+void PlaneSpanC(const WarpRow& row, const WarpSpanJob& job, uint8_t* out);
+#if defined(__x86_64__)
+void PlaneSpanAvx2(const WarpRow& row, const WarpSpanJob& job, uint8_t* out);
+#endif
+#if defined(__ARM_NEON)
+void PlaneSpanNeon(const WarpRow& row, const WarpSpanJob& job, uint8_t* out);
 #endif
 void HSumRowC(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum);
 void SelectRowC(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1, uint16_t* out);

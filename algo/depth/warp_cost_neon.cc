@@ -1,0 +1,1 @@
+#include "algo/depth/data_term_kernels.h"
