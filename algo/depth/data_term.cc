@@ -123,10 +123,11 @@ void DataTerm::WindowRow(const Scratch& s, int32_t view, int32_t y, int32_t disp
 void DataTerm::ComputeRect(int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0, int32_t y1,
                            uint16_t* out, ptrdiff_t stride) {
   // A band's first two rows of 3-sums are its overhead, and a task costs a wake-up: bands of
-  // at least kMinBandRows rows and kMinBandPixels pixels, a few per worker to even out the load.
+  // at least kMinBandRows rows and kMinBandPixels pixels, a few per worker to even out the load,
+  // and one band on a single worker (more would only add their overhead).
   constexpr int32_t kMinBandRows = 8, kMinBandPixels = 8192, kBandsPerWorker = 4;
   const int32_t rows = y1 - y0, cols = x1 - x0;
-  int32_t bands = runner_->workers() * kBandsPerWorker;
+  int32_t bands = runner_->workers() > 1 ? runner_->workers() * kBandsPerWorker : 1;
   bands = Min(bands, rows / kMinBandRows);
   bands = Min(bands, static_cast<int32_t>(int64_t{rows} * cols / kMinBandPixels));
   if (bands <= 1) {

@@ -22,7 +22,7 @@ struct DataTerm::Kernels {
   void (*hsum)(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum);
   void (*select)(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
                  uint16_t* out);
-  PlaneSpanFn plane;  // the plane sweep's pixel costs, one span (warp_cost.h)
+  PlaneSpanFn plane;  // the plane sweep's pixel costs, a batch of spans (warp_cost.h)
 };
 
 namespace dtk {
@@ -56,12 +56,12 @@ void CostRowCAvx2(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, c
 #endif
 // The plane sweep's span kernels: the C reference (warp_cost.cc), AVX2 (warp_cost_avx2.cc, the
 // caller checks the CPU) and NEON (warp_cost_neon.cc).
-void PlaneSpanC(const WarpRow& row, const WarpSpanJob& job, uint8_t* out);
+void PlaneSpansC(const WarpRow& row, const WarpSpanJob* jobs, int32_t count, uint8_t* out);
 #if defined(__x86_64__)
-void PlaneSpanAvx2(const WarpRow& row, const WarpSpanJob& job, uint8_t* out);
+void PlaneSpansAvx2(const WarpRow& row, const WarpSpanJob* jobs, int32_t count, uint8_t* out);
 #endif
 #if defined(__ARM_NEON)
-void PlaneSpanNeon(const WarpRow& row, const WarpSpanJob& job, uint8_t* out);
+void PlaneSpansNeon(const WarpRow& row, const WarpSpanJob* jobs, int32_t count, uint8_t* out);
 #endif
 void HSumRowC(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum);
 void SelectRowC(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1, uint16_t* out);

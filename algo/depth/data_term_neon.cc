@@ -149,7 +149,7 @@ constexpr SelectRowFn kNeonByKeep[kMaxBest] = {
 
 const DataTerm::Kernels* NeonKernels() {
   static constexpr DataTerm::Kernels kNeon = {CensusRowNeon, CostRowNeon, HSumRowNeon,
-                                              SelectByKeep<kNeonByKeep>, PlaneSpanNeon};
+                                              SelectByKeep<kNeonByKeep>, PlaneSpansNeon};
   return &kNeon;
 }
 

@@ -86,12 +86,14 @@ bool SpanOutsideView(const WarpRow& r, int32_t ax, int32_t ay, int32_t bx, int32
 
 namespace dtk {
 
-void PlaneSpanC(const WarpRow& row, const WarpSpanJob& job, uint8_t* out) {
-  int32_t xq[kAnchorStep + 1], yq[kAnchorStep + 1];
-  SpanPositions(job.ax, job.ay, job.bx, job.by, job.n, xq, yq);
-  for (int32_t x = job.lo; x < job.hi; ++x) {
-    out[x] = SampleCost(row, row.ref + 3 * x, Census(row.cref, row.width, x), xq[x - job.x0],
-                        yq[x - job.x0]);
+void PlaneSpansC(const WarpRow& row, const WarpSpanJob* jobs, int32_t count, uint8_t* out) {
+  for (const WarpSpanJob* job = jobs; job < jobs + count; ++job) {
+    int32_t xq[kAnchorStep + 1], yq[kAnchorStep + 1];
+    SpanPositions(job->ax, job->ay, job->bx, job->by, job->n, xq, yq);
+    for (int32_t x = job->lo; x < job->hi; ++x) {
+      out[x] = SampleCost(row, row.ref + 3 * x, Census(row.cref, row.width, x), xq[x - job->x0],
+                          yq[x - job->x0]);
+    }
   }
 }
 
@@ -108,7 +110,7 @@ bool WarpSpan(const PlaneHomography& h, int32_t x0, int32_t x1, int32_t y, int32
 void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
                   const DataTermParams& params, int32_t invalid_cost, int32_t x_begin,
                   int32_t x_end, uint8_t* out, PlaneSpanFn span) {
-  if (span == nullptr) span = dtk::PlaneSpanC;
+  if (span == nullptr) span = dtk::PlaneSpansC;
   const int32_t w = src.ref.width;
   const ptrdiff_t census_row = static_cast<ptrdiff_t>(y) * 3 * w;
   const WarpRow row{src.view.data,
@@ -126,6 +128,8 @@ void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
   // A span's end anchor is the next one's start: one Map per span.
   int32_t ax = 0, ay = 0;
   bool a_ok = h.Map(first, y, &ax, &ay);
+  WarpSpanJob batch[kSpanBatch];
+  int32_t batched = 0;
   for (int32_t x0 = first, end = 0; x0 < x_end; x0 = end) {
     const int32_t x1 = x0 + kAnchorStep < w - 1 ? x0 + kAnchorStep : w - 1;
     end = x1 == w - 1 ? w : x1;  // the last span keeps its end anchor
@@ -133,7 +137,11 @@ void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
     int32_t bx = ax, by = ay;
     const bool b_ok = x1 == x0 ? a_ok : h.Map(x1, y, &bx, &by);
     if (a_ok && b_ok && !SpanOutsideView(row, ax, ay, bx, by)) {
-      span(row, WarpSpanJob{x0, x1 - x0, ax, ay, bx, by, lo, hi}, out);
+      batch[batched++] = WarpSpanJob{x0, x1 - x0, ax, ay, bx, by, lo, hi};
+      if (batched == kSpanBatch) {
+        span(row, batch, batched, out);
+        batched = 0;
+      }
     } else {
       for (int32_t x = lo; x < hi; ++x) out[x] = row.invalid;
     }
@@ -141,6 +149,7 @@ void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
     ay = by;
     a_ok = b_ok;
   }
+  if (batched > 0) span(row, batch, batched, out);
 }
 
 }  // namespace lb

@@ -54,10 +54,15 @@ struct WarpSpanJob {
   int32_t x0, n, ax, ay, bx, by, lo, hi;
 };
 
-// A span kernel: the pixel costs of columns lo..hi-1 into out (indexed by x). The C reference is
-// dtk::PlaneSpanC (warp_cost.cc); the SIMD twins (warp_cost_avx2.cc, warp_cost_neon.cc) give the
-// same bytes, and the data term picks one through its kernel table (data_term_kernels.h).
-using PlaneSpanFn = void (*)(const WarpRow& row, const WarpSpanJob& job, uint8_t* out);
+// Spans are handed to a kernel in batches of up to kSpanBatch (its set-up paid once per batch).
+inline constexpr int32_t kSpanBatch = 16;
+
+// A span kernel: the pixel costs of columns lo..hi-1 of each of `count` spans into out (indexed
+// by x). The C reference is dtk::PlaneSpansC (warp_cost.cc); the SIMD twins (warp_cost_avx2.cc,
+// warp_cost_neon.cc) give the same bytes, and the data term picks one through its kernel table
+// (data_term_kernels.h).
+using PlaneSpanFn = void (*)(const WarpRow& row, const WarpSpanJob* jobs, int32_t count,
+                             uint8_t* out);
 
 // Pixel costs 0..255 of columns x0..x1-1 of reference row y (out indexed by x) against the view
 // seen through h (invalid_cost where a sample needs a pixel outside the view, or the plane has no
