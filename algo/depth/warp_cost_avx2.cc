@@ -40,6 +40,24 @@ struct Masks {
 };
 constexpr Masks kMasks;
 
+// Broadcast constants as tables, so the loop reads them as memory operands instead of rebuilding
+// them in registers it has too few of.
+struct Dup {
+  alignas(32) int32_t v[8];
+  constexpr explicit Dup(uint32_t x) : v() {
+    for (int32_t& e : v) e = static_cast<int32_t>(x);
+  }
+};
+struct Constants {
+  Dup q8_half{128}, near{127}, one{256}, half{32768}, max_cost{255};
+  Dup bytes15{0x0f0f0f0fu}, ones8{0x01010101u}, ones16{0x00010001u};
+  // Pair indices per channel: bytes [c, zero, c + 3, zero] (added to 3 x - start in both
+  // halves); census indices per plane: the byte in place, the others zero.
+  Dup pair_idx[3] = {Dup{0x80038000u}, Dup{0x80048001u}, Dup{0x80058002u}};
+  Dup census_idx[3] = {Dup{0x80008080u}, Dup{0x80800080u}, Dup{0x80808000u}};
+};
+constexpr Constants kC;
+
 LB_AVX2 inline __m256i Load(const void* p) {
   return _mm256_load_si256(static_cast<const __m256i*>(p));
 }
@@ -122,7 +140,7 @@ LB_AVX2 void ScalarTaps(const WarpRow& r, const Consts& k, __m256i xb, __m256i y
 
 // Bytes idx (0..31; bit 7 set: zero) of the 32-byte table lo:hi.
 LB_AVX2 inline __m256i Lookup32(__m256i lo, __m256i hi, __m256i idx) {
-  const __m256i upper = _mm256_cmpgt_epi8(idx, _mm256_set1_epi8(15));
+  const __m256i upper = _mm256_cmpgt_epi8(idx, Load(kC.bytes15.v));
   return _mm256_blendv_epi8(_mm256_shuffle_epi8(lo, idx), _mm256_shuffle_epi8(hi, idx), upper);
 }
 
@@ -147,8 +165,7 @@ LB_AVX2 inline __attribute__((always_inline)) void WindowTaps(const WarpRow& r, 
   const __m256i bottom_hi = Broadcast16(top + r.stride + 16);
   for (int32_t c = 0; c < 3; ++c) {
     // Bytes [d + c, zero, d + c + 3, zero].
-    const __m256i idx = _mm256_add_epi32(
-        d2, _mm256_set1_epi32(static_cast<int32_t>(0x80008000u + c + ((c + 3) << 16))));
+    const __m256i idx = _mm256_add_epi32(d2, Load(kC.pair_idx[c].v));
     t->top[c] = Lookup32(top_lo, top_hi, idx);
     t->bottom[c] = Lookup32(bottom_lo, bottom_hi, idx);
   }
@@ -157,9 +174,7 @@ LB_AVX2 inline __attribute__((always_inline)) void WindowTaps(const WarpRow& r, 
   __m256i bits = _mm256_setzero_si256();
   for (int32_t p = 0; p < 3; ++p) {
     const int32_t shift = 8 * (2 - p);  // plane 0 holds the top byte
-    const __m256i idx =
-        _mm256_or_si256(_mm256_slli_epi32(e, shift),
-                        _mm256_set1_epi32(static_cast<int32_t>(0x80808080u & ~(0xffu << shift))));
+    const __m256i idx = _mm256_or_si256(_mm256_slli_epi32(e, shift), Load(kC.census_idx[p].v));
     bits =
         _mm256_or_si256(bits, _mm256_shuffle_epi8(Broadcast16(crow + p * r.width + cstart), idx));
   }
@@ -179,7 +194,7 @@ LB_AVX2 inline __attribute__((always_inline)) __m256i Cost(const WarpRow& r, con
     const __m256i bottom = _mm256_madd_epi16(t.bottom[c], wx);
     const __m256i s = _mm256_add_epi32(_mm256_slli_epi32(top, 8),
                                        _mm256_mullo_epi32(_mm256_sub_epi32(bottom, top), fy));
-    const __m256i v = _mm256_srai_epi32(_mm256_add_epi32(s, _mm256_set1_epi32(32768)), 16);
+    const __m256i v = _mm256_srai_epi32(_mm256_add_epi32(s, Load(kC.half.v)), 16);
     const __m256i rc = _mm256_shuffle_epi8(ref, Load(kMasks.ref[c]));
     ad = _mm256_add_epi32(ad, _mm256_abs_epi32(_mm256_sub_epi32(rc, v)));
   }
@@ -189,13 +204,13 @@ LB_AVX2 inline __attribute__((always_inline)) __m256i Cost(const WarpRow& r, con
                                       _mm256_slli_epi32(Widen8(r.cref + r.width + x), 8)),
                       Widen8(r.cref + 2 * r.width + x));
   const __m256i bits = _mm256_xor_si256(t.census, ref_bits);
-  const __m256i nib = _mm256_set1_epi8(0x0f);
+  const __m256i nib = Load(kC.bytes15.v);
   const __m256i count8 = _mm256_add_epi8(
       _mm256_shuffle_epi8(k.lut, _mm256_and_si256(bits, nib)),
       _mm256_shuffle_epi8(k.lut, _mm256_and_si256(_mm256_srli_epi16(bits, 4), nib)));
   const __m256i ham =
-      _mm256_madd_epi16(_mm256_maddubs_epi16(count8, _mm256_set1_epi8(1)), _mm256_set1_epi16(1));
-  return _mm256_min_epi32(_mm256_add_epi32(ad, ham), _mm256_set1_epi32(255));
+      _mm256_madd_epi16(_mm256_maddubs_epi16(count8, Load(kC.ones8.v)), Load(kC.ones16.v));
+  return _mm256_min_epi32(_mm256_add_epi32(ad, ham), Load(kC.max_cost.v));
 }
 
 // 8 costs 0..255: two packs leave pixels 0-3 in dword 0 and 4-7 in dword 4.
@@ -213,8 +228,8 @@ LB_AVX2 inline void Store8(uint8_t* out, __m256i cost) {
 LB_AVX2 void Step(const WarpRow& r, const Consts& k, int32_t x, __m256i xq, __m256i yq,
                   uint8_t* dst) {
   const __m256i zero = _mm256_setzero_si256();
-  const __m256i xs = _mm256_srai_epi32(_mm256_add_epi32(xq, _mm256_set1_epi32(128)), 8);
-  const __m256i ys = _mm256_srai_epi32(_mm256_add_epi32(yq, _mm256_set1_epi32(128)), 8);
+  const __m256i xs = _mm256_srai_epi32(_mm256_add_epi32(xq, Load(kC.q8_half.v)), 8);
+  const __m256i ys = _mm256_srai_epi32(_mm256_add_epi32(yq, Load(kC.q8_half.v)), 8);
   const __m256i bad = _mm256_or_si256(
       _mm256_or_si256(_mm256_cmpgt_epi32(zero, xs), _mm256_cmpgt_epi32(xs, k.xmax)),
       _mm256_or_si256(_mm256_cmpgt_epi32(zero, ys), _mm256_cmpgt_epi32(ys, k.ymax)));
@@ -225,7 +240,7 @@ LB_AVX2 void Step(const WarpRow& r, const Consts& k, int32_t x, __m256i xq, __m2
   const __m256i fx = _mm256_sub_epi32(xc, _mm256_slli_epi32(xb, 8));
   const __m256i fy = _mm256_sub_epi32(yc, _mm256_slli_epi32(yb, 8));
   // The nearest tap: the right (lower) one from a fraction of 128 on.
-  const __m256i c127 = _mm256_set1_epi32(127);
+  const __m256i c127 = Load(kC.near.v);
   const __m256i nx = _mm256_sub_epi32(xb, _mm256_cmpgt_epi32(fx, c127));
   const __m256i ny = _mm256_sub_epi32(yb, _mm256_cmpgt_epi32(fy, c127));
   // The positions are monotone along a step (WarpSpan's lie between its anchors), so the first
@@ -255,7 +270,7 @@ LB_AVX2 void Step(const WarpRow& r, const Consts& k, int32_t x, __m256i xq, __m2
     ScalarTaps(r, k, xb, yb, nx, ny, &t);
   }
   const __m256i wx =
-      _mm256_add_epi32(_mm256_sub_epi32(_mm256_set1_epi32(256), fx), _mm256_slli_epi32(fx, 16));
+      _mm256_add_epi32(_mm256_sub_epi32(Load(kC.one.v), fx), _mm256_slli_epi32(fx, 16));
   Store8(dst, _mm256_blendv_epi8(Cost(r, k, x, t, wx, fy), k.invalid, bad));
 }
 
@@ -293,17 +308,17 @@ bool BandOf(const WarpRow& r, const WarpSpanJob& job, Band* band) {
 LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, const Consts& k,
                                                             const Band& band, int32_t x, __m256i xq,
                                                             __m256i yq, uint8_t* dst) {
-  const __m256i xs = _mm256_srai_epi32(_mm256_add_epi32(xq, _mm256_set1_epi32(128)), 8);
-  const __m256i ys = _mm256_srai_epi32(_mm256_add_epi32(yq, _mm256_set1_epi32(128)), 8);
+  const __m256i xs = _mm256_srai_epi32(_mm256_add_epi32(xq, Load(kC.q8_half.v)), 8);
+  const __m256i ys = _mm256_srai_epi32(_mm256_add_epi32(yq, Load(kC.q8_half.v)), 8);
   const __m256i xb = _mm256_min_epi32(_mm256_srai_epi32(xs, 8), k.wm2);
   const __m256i fx = _mm256_sub_epi32(xs, _mm256_slli_epi32(xb, 8));
   const __m256i fy = _mm256_sub_epi32(ys, _mm256_set1_epi32(band.y256));
-  const __m256i nx = _mm256_sub_epi32(xb, _mm256_cmpgt_epi32(fx, _mm256_set1_epi32(127)));
+  const __m256i nx = _mm256_sub_epi32(xb, _mm256_cmpgt_epi32(fx, Load(kC.near.v)));
   Taps t;
   WindowTaps(r, band.row, band.crow, Min(_mm256_cvtsi256_si32(xb), _mm256_extract_epi32(xb, 7)), xb,
              nx, &t);
   const __m256i wx =
-      _mm256_add_epi32(_mm256_sub_epi32(_mm256_set1_epi32(256), fx), _mm256_slli_epi32(fx, 16));
+      _mm256_add_epi32(_mm256_sub_epi32(Load(kC.one.v), fx), _mm256_slli_epi32(fx, 16));
   Store8(dst, Cost(r, k, x, t, wx, fy));
 }
 

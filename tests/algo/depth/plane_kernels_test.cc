@@ -16,20 +16,12 @@
 #include "algo/depth/data_term_kernels.h"
 #include "algo/depth/warp_cost.h"
 #include "algo/motion/plane_homography.h"
+#include "tests/algo/depth/kernel_variants.h"
 
 namespace lb {
 namespace {
 
-std::vector<dtk::Variant> Others() {
-  dtk::Variant v[dtk::kMaxVariants];
-  const int32_t n = dtk::Variants(v);
-  return std::vector<dtk::Variant>(v + 1, v + n);  // v[0] is the reference
-}
-
-#define LB_SKIP_WITHOUT_VARIANTS()                                                  \
-  if (Others().empty()) {                                                           \
-    GTEST_SKIP() << "this processor runs no data term kernels but the C reference"; \
-  }
+using kerneltest::Others;
 
 // A reference and a view of one size (the view's rows padded by `pad` bytes), their censuses,
 // filled with random bytes (kind 0), a noisy ramp (1) or black and white (2).
