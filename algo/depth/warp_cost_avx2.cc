@@ -282,6 +282,7 @@ struct Band {
   const uint8_t* row;   // top tap row
   const uint8_t* crow;  // census row
   int32_t y256;         // the top row, Q8
+  bool rising;          // positions rise along the span: a step's first lane has its least column
 };
 
 bool BandOf(const WarpRow& r, const WarpSpanJob& job, Band* band) {
@@ -301,6 +302,7 @@ bool BandOf(const WarpRow& r, const WarpSpanJob& job, Band* band) {
   band->row = r.view + row_a * r.stride;
   band->crow = r.census_view + static_cast<ptrdiff_t>(near_a) * 3 * r.width;
   band->y256 = row_a * 256;
+  band->rising = dx >= 0;
   return true;
 }
 
@@ -315,8 +317,8 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
   const __m256i fy = _mm256_sub_epi32(ys, _mm256_set1_epi32(band.y256));
   const __m256i nx = _mm256_sub_epi32(xb, _mm256_cmpgt_epi32(fx, Load(kC.near.v)));
   Taps t;
-  WindowTaps(r, band.row, band.crow, Min(_mm256_cvtsi256_si32(xb), _mm256_extract_epi32(xb, 7)), xb,
-             nx, &t);
+  const int32_t x_min = band.rising ? _mm256_cvtsi256_si32(xb) : _mm256_extract_epi32(xb, 7);
+  WindowTaps(r, band.row, band.crow, x_min, xb, nx, &t);
   const __m256i wx =
       _mm256_add_epi32(_mm256_sub_epi32(Load(kC.one.v), fx), _mm256_slli_epi32(fx, 16));
   Store8(dst, Cost(r, k, x, t, wx, fy));
@@ -358,21 +360,25 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpSpanJob* jobs, int32_t c
     const __m256i qy = _mm256_set1_epi32(static_cast<int32_t>(sy >> 16));
     const __m256i rx = _mm256_set1_epi32(static_cast<int32_t>(sx & 0xffff));
     const __m256i ry = _mm256_set1_epi32(static_cast<int32_t>(sy & 0xffff));
-    // Lanes off the span (short ranges only) repeat its end pixels, so a step stays monotone.
+    // Lanes off the span (short ranges only) repeat its end pixels, so a step stays monotone;
+    // only a step reaching the span's end needs its end anchor put in.
     auto positions = [&](int32_t x, __m256i* xq, __m256i* yq) LB_AVX2 {
-      const __m256i i =
-          _mm256_min_epi32(_mm256_max_epi32(_mm256_add_epi32(_mm256_set1_epi32(x - job->x0), iota),
-                                            _mm256_setzero_si256()),
-                           _mm256_set1_epi32(n));
-      const __m256i at_end = _mm256_cmpeq_epi32(i, _mm256_set1_epi32(n));
+      __m256i i = _mm256_add_epi32(_mm256_set1_epi32(x - job->x0), iota);
+      const bool at_ends = x < job->x0 || x + kLanes > job->x0 + n;
+      if (at_ends) {
+        i = _mm256_min_epi32(_mm256_max_epi32(i, _mm256_setzero_si256()), _mm256_set1_epi32(n));
+      }
       *xq = _mm256_add_epi32(
           _mm256_add_epi32(_mm256_set1_epi32(job->ax), _mm256_mullo_epi32(i, qx)),
           _mm256_srli_epi32(_mm256_add_epi32(half, _mm256_mullo_epi32(i, rx)), 16));
       *yq = _mm256_add_epi32(
           _mm256_add_epi32(_mm256_set1_epi32(job->ay), _mm256_mullo_epi32(i, qy)),
           _mm256_srli_epi32(_mm256_add_epi32(half, _mm256_mullo_epi32(i, ry)), 16));
-      *xq = _mm256_blendv_epi8(*xq, _mm256_set1_epi32(job->bx), at_end);
-      *yq = _mm256_blendv_epi8(*yq, _mm256_set1_epi32(job->by), at_end);
+      if (at_ends) {
+        const __m256i at_end = _mm256_cmpeq_epi32(i, _mm256_set1_epi32(n));
+        *xq = _mm256_blendv_epi8(*xq, _mm256_set1_epi32(job->bx), at_end);
+        *yq = _mm256_blendv_epi8(*yq, _mm256_set1_epi32(job->by), at_end);
+      }
     };
     __m256i xq, yq;
     if (job->hi - job->lo < kLanes) {
@@ -384,7 +390,7 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpSpanJob* jobs, int32_t c
       std::memcpy(out + job->lo, costs + (job->lo - x), static_cast<size_t>(job->hi - job->lo));
       continue;
     }
-    Band band;
+    Band band{};
     const bool in_band = BandOf(r, *job, &band);
     for (int32_t step = job->lo; step < job->hi; step += kLanes) {
       // The last step overlaps the one before: the same bytes again.
