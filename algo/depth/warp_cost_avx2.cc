@@ -274,14 +274,17 @@ LB_AVX2 void Step(const WarpRow& r, const Consts& k, int32_t x, __m256i xq, __m2
   Store8(dst, _mm256_blendv_epi8(Cost(r, k, x, t, wx, fy), k.invalid, bad));
 }
 
-// A span whose every tap lies inside the view, in one pair of rows (and one census row), and
-// whose positions advance at most 9/8 px per pixel, so that any 8 consecutive pixels' pairs lie
-// within 8 columns (7 * 9/8 + 2/256 < 8): checked once at its anchors, since its positions lie
-// between them and each test is monotone along it.
+// A span whose every tap lies inside the view, its tap rows in one pair of rows or two
+// neighbouring ones (its census rows likewise), and whose positions advance at most 9/8 px per
+// pixel, so that any 8 consecutive pixels' pairs lie within 8 columns (7 * 9/8 + 2/256 < 8):
+// checked once at its anchors, since its positions lie between them and each test is monotone
+// along it.
 struct Band {
-  const uint8_t* row;   // top tap row
-  const uint8_t* crow;  // census row
-  int32_t y256;         // the top row, Q8
+  const uint8_t* row;   // the upper top tap row
+  const uint8_t* crow;  // the upper census row
+  int32_t y, cy;        // their indices
+  bool two_rows;        // some pixels' tap rows are one lower
+  bool two_census;      // some pixels' census rows are one lower
   bool rising;          // positions rise along the span: a step's first lane has its least column
 };
 
@@ -298,27 +301,46 @@ bool BandOf(const WarpRow& r, const WarpSpanJob& job, Band* band) {
   const int32_t row_a = Min(ya >> 8, r.height - 2), row_b = Min(yb >> 8, r.height - 2);
   const int32_t near_a = row_a + (ya - row_a * 256 >= 128 ? 1 : 0);
   const int32_t near_b = row_b + (yb - row_b * 256 >= 128 ? 1 : 0);
-  if (row_a != row_b || near_a != near_b) return false;
-  band->row = r.view + row_a * r.stride;
-  band->crow = r.census_view + static_cast<ptrdiff_t>(near_a) * 3 * r.width;
-  band->y256 = row_a * 256;
+  if (Abs(row_a - row_b) > 1 || Abs(near_a - near_b) > 1) return false;
+  band->y = Min(row_a, row_b);
+  band->cy = Min(near_a, near_b);
+  band->row = r.view + band->y * r.stride;
+  band->crow = r.census_view + static_cast<ptrdiff_t>(band->cy) * 3 * r.width;
+  band->two_rows = row_a != row_b;
+  band->two_census = near_a != near_b;
   band->rising = dx >= 0;
   return true;
 }
 
-// A step of such a span: no clamps, no checks.
+// A step of such a span: no clamps, no checks; the second rows' windows only where the span
+// reaches them (rows y + 1 <= h - 2 and cy + 1 <= h - 1, both some pixel's own).
 LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, const Consts& k,
                                                             const Band& band, int32_t x, __m256i xq,
                                                             __m256i yq, uint8_t* dst) {
   const __m256i xs = _mm256_srai_epi32(_mm256_add_epi32(xq, Load(kC.q8_half.v)), 8);
   const __m256i ys = _mm256_srai_epi32(_mm256_add_epi32(yq, Load(kC.q8_half.v)), 8);
   const __m256i xb = _mm256_min_epi32(_mm256_srai_epi32(xs, 8), k.wm2);
+  const __m256i yb = _mm256_min_epi32(_mm256_srai_epi32(ys, 8), k.hm2);
   const __m256i fx = _mm256_sub_epi32(xs, _mm256_slli_epi32(xb, 8));
-  const __m256i fy = _mm256_sub_epi32(ys, _mm256_set1_epi32(band.y256));
+  const __m256i fy = _mm256_sub_epi32(ys, _mm256_slli_epi32(yb, 8));
   const __m256i nx = _mm256_sub_epi32(xb, _mm256_cmpgt_epi32(fx, Load(kC.near.v)));
   Taps t;
   const int32_t x_min = band.rising ? _mm256_cvtsi256_si32(xb) : _mm256_extract_epi32(xb, 7);
   WindowTaps(r, band.row, band.crow, x_min, xb, nx, &t);
+  if (band.two_rows || band.two_census) {
+    Taps u;
+    WindowTaps(r, band.two_rows ? band.row + r.stride : band.row,
+               band.two_census ? band.crow + static_cast<ptrdiff_t>(3) * r.width : band.crow, x_min,
+               xb, nx, &u);
+    const __m256i lower = _mm256_cmpeq_epi32(yb, _mm256_set1_epi32(band.y + 1));
+    for (int32_t c = 0; c < 3; ++c) {
+      t.top[c] = _mm256_blendv_epi8(t.top[c], u.top[c], lower);
+      t.bottom[c] = _mm256_blendv_epi8(t.bottom[c], u.bottom[c], lower);
+    }
+    const __m256i ny = _mm256_sub_epi32(yb, _mm256_cmpgt_epi32(fy, Load(kC.near.v)));
+    t.census = _mm256_blendv_epi8(t.census, u.census,
+                                  _mm256_cmpeq_epi32(ny, _mm256_set1_epi32(band.cy + 1)));
+  }
   const __m256i wx =
       _mm256_add_epi32(_mm256_sub_epi32(Load(kC.one.v), fx), _mm256_slli_epi32(fx, 16));
   Store8(dst, Cost(r, k, x, t, wx, fy));
@@ -381,17 +403,21 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpSpanJob* jobs, int32_t c
       }
     };
     __m256i xq, yq;
+    Band band{};
+    const bool in_band = BandOf(r, *job, &band);
     if (job->hi - job->lo < kLanes) {
       // A short range: one step over 8 pixels of the row that hold it, into a buffer.
       const int32_t x = Min(job->lo, r.width - kLanes);
       positions(x, &xq, &yq);
       uint8_t costs[kLanes];
-      Step(r, k, x, xq, yq, costs);
+      if (in_band) {
+        BandStep(r, k, band, x, xq, yq, costs);
+      } else {
+        Step(r, k, x, xq, yq, costs);
+      }
       std::memcpy(out + job->lo, costs + (job->lo - x), static_cast<size_t>(job->hi - job->lo));
       continue;
     }
-    Band band{};
-    const bool in_band = BandOf(r, *job, &band);
     for (int32_t step = job->lo; step < job->hi; step += kLanes) {
       // The last step overlaps the one before: the same bytes again.
       const int32_t x = step + kLanes <= job->hi ? step : job->hi - kLanes;
