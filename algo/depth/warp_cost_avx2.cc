@@ -1,4 +1,4 @@
-// The plane sweep's span kernel for AVX2 (warp_cost.h; the C reference is dtk::PlaneSpanC in
+// The plane sweep's span kernel for AVX2 (warp_cost.h; the C reference is dtk::PlaneSpansC in
 // warp_cost.cc): 8 pixels a step in 32-bit lanes. The view's taps come from byte shuffles of
 // 32-byte windows of the two rows when a step's taps share them (most steps: the positions
 // advance about one pixel per pixel), else from scalar loads (AVX2 gathers are slower than those
@@ -19,10 +19,11 @@ namespace {
 
 constexpr int32_t kLanes = 8;
 
-// Byte shuffles, per 32-bit lane: kPair puts bytes 0 and 3 of a gathered RGBR / BRGB word in the
-// two 16-bit halves (the same channel of two neighbouring pixels); kPairG does so for bytes 1
-// and 2 (the green pair, after a blend of the two words). kRef[c] picks channel c of pixels 0-3
-// from the low half of 24 reference bytes loaded as bytes 0-15 and 8-23.
+// Byte shuffles, per 32-bit lane: `pair` puts bytes 0 and 3 of a loaded RGBR / BRGB word in the
+// two 16-bit halves (the same channel of two neighbouring pixels); `pair_g` does so for bytes 1
+// and 2 (the green pair, after a blend of the two words). ref[c] picks channel c of pixels 0-3
+// from the low half of 24 reference bytes loaded as bytes 0-15 and 8-23 (pixels 4-7 from the
+// high half). nibble_bits: the bit count of each nibble.
 struct Masks {
   alignas(32) int8_t pair[32], pair_g[32], ref[3][32], nibble_bits[32];
   constexpr Masks() : pair(), pair_g(), ref(), nibble_bits() {
@@ -89,7 +90,7 @@ struct Taps {
   __m256i top[3], bottom[3], census;
 };
 
-// The pairs from dwords gathered as ab0 = [aR aG aB bR] and ab2 = [aB bR bG bB].
+// The pairs from dwords loaded as ab0 = [aR aG aB bR] and ab2 = [aB bR bG bB].
 LB_AVX2 inline void Pairs(__m256i ab0, __m256i ab2, __m256i* pairs) {
   const __m256i pair = Load(kMasks.pair);
   pairs[0] = _mm256_shuffle_epi8(ab0, pair);
@@ -97,7 +98,7 @@ LB_AVX2 inline void Pairs(__m256i ab0, __m256i ab2, __m256i* pairs) {
   pairs[2] = _mm256_shuffle_epi8(ab2, pair);
 }
 
-// Format of each step (per lane, as dtk::PlaneSpanC): positions Q16 (|.| < 2^30), rounded to Q8
+// Format of each step (per lane, as dtk::PlaneSpansC): positions Q16 (|.| < 2^30), rounded to Q8
 // and clamped to the view so every load stays inside it (lanes outside take `invalid` at the
 // end). The tap pair's left column is at most width - 2 with a weight of up to 256 on the right
 // one (and likewise for rows): (w-1, f 0) becomes (w-2, f 256), the same sum. Colour:
