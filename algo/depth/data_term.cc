@@ -88,7 +88,7 @@ void DataTerm::PixelCostRow(int32_t view, int32_t y, int32_t disp_q8, int32_t x0
   const int32_t w = width_;
   if (planes_ != nullptr) {
     const WarpSource src{images_[reference_], images_[view], census_[reference_], census_[view]};
-    PlaneCostRow(planes_[view], src, y, params_, invalid_cost_, x0, x1, out);
+    PlaneCostRow(planes_[view], src, y, params_, invalid_cost_, x0, x1, out, kernels_->plane);
     return;
   }
   // Sample position in the view: x * 256 + shift_q8, the same fraction for every pixel.
@@ -123,10 +123,11 @@ void DataTerm::WindowRow(const Scratch& s, int32_t view, int32_t y, int32_t disp
 void DataTerm::ComputeRect(int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0, int32_t y1,
                            uint16_t* out, ptrdiff_t stride) {
   // A band's first two rows of 3-sums are its overhead, and a task costs a wake-up: bands of
-  // at least kMinBandRows rows and kMinBandPixels pixels, a few per worker to even out the load.
+  // at least kMinBandRows rows and kMinBandPixels pixels, a few per worker to even out the load,
+  // and one band on a single worker (more would only add their overhead).
   constexpr int32_t kMinBandRows = 8, kMinBandPixels = 8192, kBandsPerWorker = 4;
   const int32_t rows = y1 - y0, cols = x1 - x0;
-  int32_t bands = runner_->workers() * kBandsPerWorker;
+  int32_t bands = runner_->workers() > 1 ? runner_->workers() * kBandsPerWorker : 1;
   bands = Min(bands, rows / kMinBandRows);
   bands = Min(bands, static_cast<int32_t>(int64_t{rows} * cols / kMinBandPixels));
   if (bands <= 1) {

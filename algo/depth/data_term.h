@@ -13,11 +13,13 @@
 // Threads: a large request is cut into bands of rows, one task each (task_runner.h); a band
 // starts its ring one row above itself, so every row's D is the same whoever computes it.
 //
-// Every kernel has a plain C reference (data_term_ref.cc); SIMD twins give the same bits: AVX2
-// on x86-64 (data_term_avx2.cc, when the CPU has it, else the C cost kernel compiled for SSSE3)
-// and NEON on ARM (data_term_neon.cc), chosen once in Carve (data_term_kernels.h). Each twin the
-// CPU has is forced and compared with the reference kernel by kernel by
-// tests/algo/depth/data_term_kernels_test.cc, and as a whole by data_term_test.cc.
+// Every kernel has a plain C reference (data_term_ref.cc, and warp_cost.cc for the plane
+// sweep's pixel costs); SIMD twins give the same bits: AVX2 on x86-64 (data_term_avx2.cc and
+// warp_cost_avx2.cc, when the CPU has it, else the C cost kernel compiled for SSSE3) and NEON on
+// ARM (data_term_neon.cc, warp_cost_neon.cc), chosen once in Carve (data_term_kernels.h). Each
+// twin the CPU has is forced and compared with the reference kernel by kernel by
+// tests/algo/depth/data_term_kernels_test.cc and plane_kernels_test.cc, and as a whole by
+// data_term_test.cc.
 #pragma once
 
 #include <cstddef>

@@ -1,7 +1,15 @@
 #include "algo/depth/data_term_kernels.h"
 
-#if defined(__ARM_NEON)
+#if defined(__ARM_NEON) || defined(__arm__)
 #include <arm_neon.h>
+
+// armhf's baseline has no NEON: this file's functions alone are compiled for it (after every
+// include, so no inline function of a shared header is), and SimdKernels() takes them only
+// where the firmware read that the core has NEON.
+#if defined(__arm__)
+#pragma GCC push_options
+#pragma GCC target("fpu=neon")
+#endif
 
 namespace lb::dtk {
 namespace {
@@ -149,11 +157,14 @@ constexpr SelectRowFn kNeonByKeep[kMaxBest] = {
 
 const DataTerm::Kernels* NeonKernels() {
   static constexpr DataTerm::Kernels kNeon = {CensusRowNeon, CostRowNeon, HSumRowNeon,
-                                              SelectByKeep<kNeonByKeep>};
+                                              SelectByKeep<kNeonByKeep>, PlaneSpansNeon};
   return &kNeon;
 }
 
 }  // namespace lb::dtk
+#if defined(__arm__)
+#pragma GCC pop_options
+#endif
 #else
 namespace lb::dtk {
 const DataTerm::Kernels* NeonKernels() { return nullptr; }

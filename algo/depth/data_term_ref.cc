@@ -3,6 +3,8 @@
 
 #include <initializer_list>
 
+#include "algo/core/cpu.h"
+
 namespace lb::dtk {
 namespace {
 
@@ -154,11 +156,12 @@ void SelectRowC(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t
   }
 }
 
-const DataTerm::Kernels kReference = {CensusRowC, CostRowC, HSumRowC, SelectRowC};
+const DataTerm::Kernels kReference = {CensusRowC, CostRowC, HSumRowC, SelectRowC, PlaneSpansC};
 
 const DataTerm::Kernels* Ssse3Kernels() {
 #if defined(__x86_64__)
-  static constexpr DataTerm::Kernels kSsse3 = {CensusRowC, CostRowCSsse3, HSumRowC, SelectRowC};
+  static constexpr DataTerm::Kernels kSsse3 = {CensusRowC, CostRowCSsse3, HSumRowC, SelectRowC,
+                                               PlaneSpansC};
   return __builtin_cpu_supports("ssse3") ? &kSsse3 : nullptr;
 #else
   return nullptr;
@@ -166,13 +169,12 @@ const DataTerm::Kernels* Ssse3Kernels() {
 }
 
 const DataTerm::Kernels* SimdKernels() {
-  static const DataTerm::Kernels* const best = [] {
-    for (const DataTerm::Kernels* k : {Avx2Kernels(), NeonKernels(), Ssse3Kernels()}) {
-      if (k != nullptr) return k;
-    }
-    return static_cast<const DataTerm::Kernels*>(nullptr);
-  }();
-  return best;
+  // What the firmware read of this processor (algo/core/cpu.h): armhf's NEON only where the
+  // kernel says the core has it.
+  const CpuFeatures cpu = CurrentCpu();
+  if (const DataTerm::Kernels* k = cpu.avx2 ? Avx2Kernels() : nullptr) return k;
+  if (const DataTerm::Kernels* k = cpu.neon ? NeonKernels() : nullptr) return k;
+  return cpu.ssse3 ? Ssse3Kernels() : nullptr;
 }
 
 int32_t Variants(Variant* out) {
@@ -180,7 +182,9 @@ int32_t Variants(Variant* out) {
   out[n++] = {"C", &kReference};
   if (const DataTerm::Kernels* k = Ssse3Kernels()) out[n++] = {"C for SSSE3", k};
   if (const DataTerm::Kernels* k = Avx2Kernels()) out[n++] = {"AVX2", k};
-  if (const DataTerm::Kernels* k = NeonKernels()) out[n++] = {"NEON", k};
+  if (const DataTerm::Kernels* k = CurrentCpu().neon ? NeonKernels() : nullptr) {
+    out[n++] = {"NEON", k};
+  }
   return n;
 }
 

@@ -1,5 +1,7 @@
 #include "algo/depth/warp_cost.h"
 
+#include "algo/depth/data_term_kernels.h"
+
 namespace lb {
 namespace {
 
@@ -13,11 +15,6 @@ inline int32_t BitCount(uint32_t v) {
   return static_cast<int32_t>(v & 0x3fu);
 }
 
-struct CostParams {
-  int32_t width, height, trunc, cw;
-  uint8_t invalid;
-};
-
 // The 24-bit census of pixel x of a census row (three planes of `width` bytes).
 inline uint32_t Census(const uint8_t* row, int32_t width, int32_t x) {
   return (uint32_t{row[x]} << 16) | (uint32_t{row[width + x]} << 8) | row[2 * width + x];
@@ -28,43 +25,39 @@ inline uint32_t Census(const uint8_t* row, int32_t width, int32_t x) {
 // etc. are Q16 and sum to 65536, so a colour sum is <= 255 * 65536 (int32), rounded half up to
 // Q0. The census tap is the nearest (fractions of 128/256 round up). Cost 0..255 as in
 // data_term.cc: min(|dRGB|, trunc) + 24 bits * weight <= 765 + 240, capped.
-inline uint8_t SampleCost(const WarpSource& s, const CostParams& p, const uint8_t* ref_rgb,
-                          uint32_t cref, int32_t x_q16, int32_t y_q16) {
+inline uint8_t SampleCost(const WarpRow& r, const uint8_t* ref_rgb, uint32_t cref, int32_t x_q16,
+                          int32_t y_q16) {
   const int32_t xs = (x_q16 + 128) >> 8, ys = (y_q16 + 128) >> 8;  // |q16| < 2^30: no overflow
   const int32_t x0 = xs >> 8, y0 = ys >> 8, fx = xs & 255, fy = ys & 255;
   // A tap of weight zero may sit outside the view, as in the rectified kernel.
   const int32_t x1 = x0 + (fx != 0 ? 1 : 0), y1 = y0 + (fy != 0 ? 1 : 0);
-  if (x0 < 0 || y0 < 0 || x1 >= p.width || y1 >= p.height) return p.invalid;
+  if (x0 < 0 || y0 < 0 || x1 >= r.width || y1 >= r.height) return r.invalid;
   const int32_t w00 = (256 - fx) * (256 - fy), w01 = fx * (256 - fy);
   const int32_t w10 = (256 - fx) * fy, w11 = fx * fy;
-  const uint8_t* a = s.view.At(x0, y0);
-  const uint8_t* b = s.view.At(x1, y0);
-  const uint8_t* c = s.view.At(x0, y1);
-  const uint8_t* d = s.view.At(x1, y1);
+  const uint8_t* a = r.view + y0 * r.stride + 3 * x0;
+  const uint8_t* b = r.view + y0 * r.stride + 3 * x1;
+  const uint8_t* c = r.view + y1 * r.stride + 3 * x0;
+  const uint8_t* d = r.view + y1 * r.stride + 3 * x1;
   int32_t ad = 0;
   for (int32_t ch = 0; ch < 3; ++ch) {
     const int32_t v = (a[ch] * w00 + b[ch] * w01 + c[ch] * w10 + d[ch] * w11 + 32768) >> 16;
     const int32_t diff = ref_rgb[ch] - v;
     ad += diff < 0 ? -diff : diff;
   }
-  ad = ad < p.trunc ? ad : p.trunc;
+  ad = ad < r.trunc ? ad : r.trunc;
   const int32_t nx = fx >= 128 ? x1 : x0, ny = fy >= 128 ? y1 : y0;
-  const uint8_t* crow = s.census_view + static_cast<ptrdiff_t>(ny) * 3 * p.width;
-  const int32_t ham = BitCount(cref ^ Census(crow, p.width, nx));
-  const int32_t cost = ad + ham * p.cw;
+  const uint8_t* crow = r.census_view + static_cast<ptrdiff_t>(ny) * 3 * r.width;
+  const int32_t ham = BitCount(cref ^ Census(crow, r.width, nx));
+  const int32_t cost = ad + ham * r.cw;
   return static_cast<uint8_t>(cost > 255 ? 255 : cost);
 }
 
-}  // namespace
-
-bool WarpSpan(const PlaneHomography& h, int32_t x0, int32_t x1, int32_t y, int32_t* x_q16,
-              int32_t* y_q16) {
-  int32_t ax = 0, ay = 0, bx = 0, by = 0;
-  if (!h.Map(x0, y, &ax, &ay) || !h.Map(x1, y, &bx, &by)) return false;
-  const int32_t n = x1 - x0;
+// Positions 0..n of a span from its anchors (WarpSpan).
+void SpanPositions(int32_t ax, int32_t ay, int32_t bx, int32_t by, int32_t n, int32_t* x_q16,
+                   int32_t* y_q16) {
   x_q16[0] = ax;
   y_q16[0] = ay;
-  if (n == 0) return true;
+  if (n == 0) return;
   // Q32 accumulators, started half a Q16 step up so the shift rounds; the truncated steps lose
   // under n * 2^-32 px over the span.
   const int64_t sx = (int64_t{bx} - ax) * 65536 / n, sy = (int64_t{by} - ay) * 65536 / n;
@@ -77,32 +70,86 @@ bool WarpSpan(const PlaneHomography& h, int32_t x0, int32_t x1, int32_t y, int32
   }
   x_q16[n] = bx;
   y_q16[n] = by;
+}
+
+// True when no position between anchors a and b samples inside the view. WarpSpan's positions
+// lie between its anchors (its steps are truncated toward zero), and a position is valid when
+// its Q8 rounding lies in 0 .. (size - 1) * 256 on both axes, a test monotone in each axis.
+bool SpanOutsideView(const WarpRow& r, int32_t ax, int32_t ay, int32_t bx, int32_t by) {
+  const int32_t xmax = (r.width - 1) * 256, ymax = (r.height - 1) * 256;
+  auto q8 = [](int32_t q16) { return (q16 + 128) >> 8; };
+  return q8(ax > bx ? ax : bx) < 0 || q8(ax < bx ? ax : bx) > xmax || q8(ay > by ? ay : by) < 0 ||
+         q8(ay < by ? ay : by) > ymax;
+}
+
+}  // namespace
+
+namespace dtk {
+
+void PlaneSpansC(const WarpRow& row, const WarpSpanJob* jobs, int32_t count, uint8_t* out) {
+  for (const WarpSpanJob* job = jobs; job < jobs + count; ++job) {
+    int32_t xq[kAnchorStep + 1], yq[kAnchorStep + 1];
+    SpanPositions(job->ax, job->ay, job->bx, job->by, job->n, xq, yq);
+    for (int32_t x = job->lo; x < job->hi; ++x) {
+      out[x] = SampleCost(row, row.ref + 3 * x, Census(row.cref, row.width, x), xq[x - job->x0],
+                          yq[x - job->x0]);
+    }
+  }
+}
+
+}  // namespace dtk
+
+bool WarpSpan(const PlaneHomography& h, int32_t x0, int32_t x1, int32_t y, int32_t* x_q16,
+              int32_t* y_q16) {
+  int32_t ax = 0, ay = 0, bx = 0, by = 0;
+  if (!h.Map(x0, y, &ax, &ay) || !h.Map(x1, y, &bx, &by)) return false;
+  SpanPositions(ax, ay, bx, by, x1 - x0, x_q16, y_q16);
   return true;
 }
 
 void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
                   const DataTermParams& params, int32_t invalid_cost, int32_t x_begin,
-                  int32_t x_end, uint8_t* out) {
+                  int32_t x_end, uint8_t* out, PlaneSpanFn span) {
+  if (span == nullptr) span = dtk::PlaneSpansC;
   const int32_t w = src.ref.width;
-  const CostParams p{w, src.ref.height, params.color_trunc, params.census_weight,
-                     static_cast<uint8_t>(invalid_cost)};
-  const uint8_t* ref = src.ref.Row(y);
-  const uint8_t* cref = src.census_ref + static_cast<ptrdiff_t>(y) * 3 * w;
-  int32_t xq[kAnchorStep + 1], yq[kAnchorStep + 1];
+  const ptrdiff_t census_row = static_cast<ptrdiff_t>(y) * 3 * w;
+  const WarpRow row{src.view.data,
+                    src.view.stride,
+                    src.census_view,
+                    src.ref.Row(y),
+                    src.census_ref + census_row,
+                    w,
+                    src.ref.height,
+                    params.color_trunc,
+                    params.census_weight,
+                    static_cast<uint8_t>(invalid_cost)};
   int32_t first = x_begin - x_begin % kAnchorStep;
   if (first == w - 1 && first > 0) first -= kAnchorStep;  // w - 1 ends the span before it
+  // A span's end anchor is the next one's start: one Map per span.
+  int32_t ax = 0, ay = 0;
+  bool a_ok = h.Map(first, y, &ax, &ay);
+  WarpSpanJob batch[kSpanBatch];
+  int32_t batched = 0;
   for (int32_t x0 = first, end = 0; x0 < x_end; x0 = end) {
     const int32_t x1 = x0 + kAnchorStep < w - 1 ? x0 + kAnchorStep : w - 1;
     end = x1 == w - 1 ? w : x1;  // the last span keeps its end anchor
     const int32_t lo = x0 > x_begin ? x0 : x_begin, hi = end < x_end ? end : x_end;
-    if (!WarpSpan(h, x0, x1, y, xq, yq)) {
-      for (int32_t x = lo; x < hi; ++x) out[x] = p.invalid;
-      continue;
+    int32_t bx = ax, by = ay;
+    const bool b_ok = x1 == x0 ? a_ok : h.Map(x1, y, &bx, &by);
+    if (a_ok && b_ok && !SpanOutsideView(row, ax, ay, bx, by)) {
+      batch[batched++] = WarpSpanJob{x0, x1 - x0, ax, ay, bx, by, lo, hi};
+      if (batched == kSpanBatch) {
+        span(row, batch, batched, out);
+        batched = 0;
+      }
+    } else {
+      for (int32_t x = lo; x < hi; ++x) out[x] = row.invalid;
     }
-    for (int32_t x = lo; x < hi; ++x) {
-      out[x] = SampleCost(src, p, ref + 3 * x, Census(cref, w, x), xq[x - x0], yq[x - x0]);
-    }
+    ax = bx;
+    ay = by;
+    a_ok = b_ok;
   }
+  if (batched > 0) span(row, batch, batched, out);
 }
 
 }  // namespace lb

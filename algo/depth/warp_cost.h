@@ -12,6 +12,7 @@
 // 32 * 2 * 0.035 / 500 / 0.97 ~ 1/215 px, a quarter of 1/64 (tested in warp_cost_test.cc).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 #include "algo/core/image.h"
@@ -35,12 +36,40 @@ struct WarpSource {
 bool WarpSpan(const PlaneHomography& h, int32_t x0, int32_t x1, int32_t y, int32_t* x_q16,
               int32_t* y_q16);
 
+// One reference row against one view, as the span kernels read it.
+struct WarpRow {
+  const uint8_t* view = nullptr;  // RGB8, rows `stride` bytes apart
+  ptrdiff_t stride = 0;
+  const uint8_t* census_view = nullptr;  // per row, three planes of `width` bytes
+  const uint8_t* ref = nullptr;          // the reference row, RGB8, indexed by x
+  const uint8_t* cref = nullptr;         // its census: three planes of `width` bytes
+  int32_t width = 0, height = 0, trunc = 0, cw = 0;
+  uint8_t invalid = 255;
+};
+
+// The view positions of one span and the columns wanted from it: pixels x0 .. x0 + n (n <=
+// kAnchorStep) have their positions interpolated between the anchors a = Map(x0) and b =
+// Map(x0 + n) as WarpSpan does; lo..hi-1 (x0 <= lo < hi <= x0 + n + 1) are computed.
+struct WarpSpanJob {
+  int32_t x0, n, ax, ay, bx, by, lo, hi;
+};
+
+// Spans are handed to a kernel in batches of up to kSpanBatch (its set-up paid once per batch).
+inline constexpr int32_t kSpanBatch = 16;
+
+// A span kernel: the pixel costs of columns lo..hi-1 of each of `count` spans into out (indexed
+// by x). The C reference is dtk::PlaneSpansC (warp_cost.cc); the SIMD twins (warp_cost_avx2.cc,
+// warp_cost_neon.cc) give the same bytes, and the data term picks one through its kernel table
+// (data_term_kernels.h).
+using PlaneSpanFn = void (*)(const WarpRow& row, const WarpSpanJob* jobs, int32_t count,
+                             uint8_t* out);
+
 // Pixel costs 0..255 of columns x0..x1-1 of reference row y (out indexed by x) against the view
 // seen through h (invalid_cost where a sample needs a pixel outside the view, or the plane has no
 // map there). The anchors stay at multiples of kAnchorStep, so a column's cost does not depend on
-// the range asked for.
+// the range asked for. `span` is the kernel (nullptr: the C reference).
 void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
                   const DataTermParams& params, int32_t invalid_cost, int32_t x0, int32_t x1,
-                  uint8_t* out);
+                  uint8_t* out, PlaneSpanFn span = nullptr);
 
 }  // namespace lb

@@ -10,22 +10,14 @@
 #include <vector>
 
 #include "algo/depth/data_term_kernels.h"
+#include "tests/algo/depth/kernel_variants.h"
 
 namespace lb {
 namespace {
 
 const int32_t kWidths[] = {1, 2, 7, 15, 16, 17, 31, 32, 33, 47, 63, 64, 65, 97, 130};
 
-std::vector<dtk::Variant> Others() {
-  dtk::Variant v[dtk::kMaxVariants];
-  const int32_t n = dtk::Variants(v);
-  return std::vector<dtk::Variant>(v + 1, v + n);  // v[0] is the reference
-}
-
-#define LB_SKIP_WITHOUT_VARIANTS()                                                  \
-  if (Others().empty()) {                                                           \
-    GTEST_SKIP() << "this processor runs no data term kernels but the C reference"; \
-  }
+using kerneltest::Others;
 
 // Random bytes (kind 0), a smooth ramp with noise (1), or black and white (2: the extremes).
 std::vector<uint8_t> Bytes(std::mt19937& rng, size_t n, int32_t kind) {

@@ -1,6 +1,8 @@
 // The depth stage on Middlebury teddy (9 views, 450x375, 64 quarter-pixel labels), one thread,
 // and - when OpenCV is installed - OpenCV's StereoSGBM on the same set's im2/im6 pair, so the
 // ratio is measured side by side on the same machine.
+// And the plane sweep against the rectified shifts on a synthetic handheld burst (the case
+// depth_planes_accuracy_test prints), in CPU time.
 //   build/host/tests/bench/depth/depth_bench --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
 
@@ -8,6 +10,7 @@
 #include <vector>
 
 #include "algo/depth/depth_stage.h"
+#include "tests/algo/depth/handheld.h"
 #include "tests/algo/depth/middlebury.h"
 
 #ifdef LB_HAVE_OPENCV
@@ -119,6 +122,33 @@ void BM_DepthStage640x480(benchmark::State& state) {
   state.counters["arena_MiB"] = static_cast<double>(bytes) / (1 << 20);
 }
 BENCHMARK(BM_DepthStage640x480)->Unit(benchmark::kMillisecond)->MinTime(3.0);
+
+// A synthetic handheld burst at 640x480, 7 views, with its true poses and 33 labels (as
+// depth_planes_accuracy_test's speed case): range(0) 1 for the plane sweep, 0 for the rectified
+// shifts over the same labels.
+void BM_HandheldDepth640x480(benchmark::State& state) {
+  static motiontest::Burst burst;
+  static const bool made = motiontest::MakeBurst(motiontest::Handheld(1), 640, 480, 7, &burst);
+  if (!made) return state.SkipWithError("no synthetic burst");
+  const handheld::Labels l = handheld::HandheldLabels(burst, 0.1);
+  DepthConfig c = l.config;
+  const bool planes = state.range(0) != 0;
+  c.geometry = planes ? ViewGeometry::kKnownPoses : ViewGeometry::kRectified;
+  handheld::Stage s;
+  if (!s.Configure(c).ok()) return state.SkipWithError("configure failed");
+  const std::vector<PlaneHomography> homographies = handheld::Planes(burst, l);
+  for (auto _ : state) {
+    if (planes && !s.depth.SetPlanes(homographies.data()).ok()) state.SkipWithError("planes");
+    if (!s.Compute(burst.views.data()).ok()) state.SkipWithError("compute failed");
+  }
+  state.counters["labels"] = c.labels;
+}
+BENCHMARK(BM_HandheldDepth640x480)
+    ->ArgName("planes")
+    ->Arg(1)
+    ->Arg(0)
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
 
 #ifdef LB_HAVE_OPENCV
 // Two-view SGBM on im2/im6 (disparities 0..63 px over 4 view steps, the same depth range as the

@@ -1,0 +1,215 @@
+// The plane sweep's span kernels (warp_cost.h, in the data term's tables): every table this
+// processor runs (AVX2, NEON), forced rather than chosen, against the C reference, bit for bit:
+// single spans with random anchors (inside the view, leaving it on any side, crossing rows, on
+// whole pixels and half pixels, at the last column and row, steep and reversed), short column
+// ranges, the extremes of the parameters; and whole rows through PlaneCostRow with random
+// homographies, random column ranges (the w - 1 anchor) and planes without a map over part of
+// the row.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "algo/depth/data_term_kernels.h"
+#include "algo/depth/warp_cost.h"
+#include "algo/motion/plane_homography.h"
+#include "tests/algo/depth/kernel_variants.h"
+
+namespace lb {
+namespace {
+
+using kerneltest::Others;
+
+// A reference and a view of one size (the view's rows padded by `pad` bytes), their censuses,
+// filled with random bytes (kind 0), a noisy ramp (1) or black and white (2).
+struct Views {
+  int32_t width = 0, height = 0;
+  std::vector<uint8_t> ref, view, census_ref, census_view;
+  ptrdiff_t stride = 0;
+
+  Views(std::mt19937& rng, int32_t w, int32_t h, int32_t pad, int32_t kind)
+      : width(w), height(h), stride(3 * w + pad) {
+    auto fill = [&](std::vector<uint8_t>& b, size_t n, int32_t k) {
+      b.resize(n);
+      for (size_t i = 0; i < n; ++i) {
+        const uint32_t r = rng();
+        b[i] = static_cast<uint8_t>(k == 0 ? r : k == 1 ? (i * 7 + (r & 31)) : (r & 1) * 255);
+      }
+    };
+    fill(ref, static_cast<size_t>(3) * w * h, kind);
+    // The view exactly as large as its rows need: a read past its end is caught by ASan.
+    fill(view, static_cast<size_t>(stride) * (h - 1) + 3 * w, kind);
+    fill(census_ref, static_cast<size_t>(3) * w * h, kind == 2 ? 2 : 0);
+    fill(census_view, static_cast<size_t>(3) * w * h, kind == 2 ? 2 : 0);
+  }
+
+  WarpRow Row(int32_t y, int32_t trunc, int32_t cw, int32_t invalid) const {
+    WarpRow r;
+    r.view = view.data();
+    r.stride = stride;
+    r.census_view = census_view.data();
+    r.ref = ref.data() + static_cast<ptrdiff_t>(3) * width * y;
+    r.cref = census_ref.data() + static_cast<ptrdiff_t>(3) * width * y;
+    r.width = width;
+    r.height = height;
+    r.trunc = trunc;
+    r.cw = cw;
+    r.invalid = static_cast<uint8_t>(invalid);
+    return r;
+  }
+
+  WarpSource Source() const {
+    return {ConstImageU8{ref.data(), width, height, 3, 3 * width},
+            ConstImageU8{view.data(), width, height, 3, stride}, census_ref.data(),
+            census_view.data()};
+  }
+};
+
+// The end anchors of a span of n pixels starting at x0: the view position of x0 in Q16 and the
+// step per pixel, by `kind`: 0 a handheld-like warp (about one pixel per pixel, a small slope in
+// y) anywhere in or around the view, 1 random ends far and wide (steep, reversed, outside), 2 on
+// whole pixels (fractions 0, up to the last column and row), 3 on half pixels (the nearest tap's
+// rounding), 4 the same row for every pixel.
+WarpSpanJob RandomSpan(std::mt19937& rng, int32_t w, int32_t h, int32_t x0, int32_t n,
+                       int32_t kind) {
+  std::uniform_real_distribution<double> u(0, 1);
+  auto q16 = [](double px) { return static_cast<int32_t>(std::lround(px * 65536)); };
+  double ax = 0, ay = 0, bx = 0, by = 0;
+  switch (kind) {
+    case 0: {
+      ax = x0 + (u(rng) - 0.5) * 12;
+      ay = (u(rng) * 1.2 - 0.1) * (h - 1);
+      const double scale = 0.9 + 0.25 * u(rng), slope = (u(rng) - 0.5) * 0.2;
+      bx = ax + n * scale;
+      by = ay + n * slope;
+      break;
+    }
+    case 1:
+      ax = (u(rng) * 3 - 1) * w;
+      bx = (u(rng) * 3 - 1) * w;
+      ay = (u(rng) * 3 - 1) * h;
+      by = (u(rng) * 3 - 1) * h;
+      break;
+    case 2: {
+      ax = static_cast<double>(rng() % w);
+      ay = static_cast<double>(rng() % h);
+      const int32_t step = static_cast<int32_t>(rng() % 3) - 1;  // -1, 0, +1 px per pixel
+      bx = ax + n * (step == 0 ? 1 : step);
+      by = ay + (rng() % 2 == 0 ? 0 : n);
+      if (rng() % 2 == 0) bx = w - 1, ax = bx - n;  // ends on the last column
+      if (rng() % 2 == 0) ay = by = h - 1;          // the last row
+      break;
+    }
+    case 3:
+      ax = static_cast<double>(rng() % w) + 0.5;
+      ay = static_cast<double>(rng() % h) - 0.5;
+      bx = ax + n;
+      by = ay;
+      break;
+    default:
+      ax = x0 + u(rng) * 4 - 2;
+      ay = by = u(rng) * (h - 1);
+      bx = ax + n;
+      break;
+  }
+  const int32_t lo = x0 + static_cast<int32_t>(rng() % (n + 1));
+  const int32_t hi = std::min(w, lo + 1 + static_cast<int32_t>(rng() % (x0 + n + 1 - lo)));
+  return WarpSpanJob{x0, n, q16(ax), q16(ay), q16(bx), q16(by), lo, std::max(hi, lo + 1)};
+}
+
+TEST(PlaneKernels, SpanVariantsEqualTheReference) {
+  LB_SKIP_WITHOUT_VARIANTS();
+  std::mt19937 rng(21);
+  const int32_t truncs[] = {0, 1, 45, 254, 255, 256, 765};
+  for (const int32_t w : {8, 9, 15, 16, 17, 24, 31, 33, 40, 64, 97}) {
+    for (int32_t kind = 0; kind < 3; ++kind) {
+      const int32_t h = 2 + static_cast<int32_t>(rng() % 20);
+      const Views v(rng, w, h, kind == 1 ? 5 : 0, kind);
+      for (int32_t trial = 0; trial < 300; ++trial) {
+        const int32_t y = static_cast<int32_t>(rng() % h);
+        const int32_t trunc = truncs[rng() % 7];
+        const int32_t cw = kind == 2 ? 10 : static_cast<int32_t>(rng() % 11);
+        const int32_t invalid = std::min(255, trunc + 24 * cw);
+        const WarpRow row = v.Row(y, trunc, cw, invalid);
+        // A batch of spans along the row, as PlaneCostRow hands them over.
+        WarpSpanJob jobs[kSpanBatch];
+        int32_t count = 0;
+        for (int32_t x0 = 0; x0 < w - 1 && count < kSpanBatch; x0 += kAnchorStep) {
+          const int32_t n = std::min(kAnchorStep, w - 1 - x0);
+          const WarpSpanJob job = RandomSpan(rng, w, h, x0, n, static_cast<int32_t>(rng() % 5));
+          if (job.lo < w) jobs[count++] = job;
+        }
+        std::vector<uint8_t> want(w, 0xa5);
+        dtk::kReference.plane(row, jobs, count, want.data());
+        for (const dtk::Variant& var : Others()) {
+          std::vector<uint8_t> got(w, 0xa5);
+          var.kernels->plane(row, jobs, count, got.data());
+          ASSERT_EQ(got, want) << var.name << " w " << w << " h " << h << " y " << y << " kind "
+                               << kind << " trunc " << trunc << " cw " << cw << " first span "
+                               << jobs[0].ax << "," << jobs[0].ay << " -> " << jobs[0].bx << ","
+                               << jobs[0].by << " [" << jobs[0].lo << "," << jobs[0].hi << ")";
+        }
+      }
+    }
+  }
+}
+
+// A homography from a random small rotation (up to `deg`) and translation, at inverse depth rho.
+PlaneHomography RandomPlane(std::mt19937& rng, int32_t w, int32_t h, double deg, double rho) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double a = deg * M_PI / 180 * u(rng), b = deg * M_PI / 180 * u(rng);
+  const double c = deg * M_PI / 180 * u(rng);
+  ViewMotion m;
+  // Small-angle rotation, re-orthogonalised enough for a test (Rodrigues' first order).
+  const double r[3][3] = {{1, -c, b}, {c, 1, -a}, {-b, a, 1}};
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) m.rotation[i][j] = r[i][j];
+  }
+  m.translation[0] = 0.05 * u(rng);
+  m.translation[1] = 0.05 * u(rng);
+  m.translation[2] = 0.02 * u(rng);
+  const double f = 0.8 * w;
+  return MakePlaneHomography(CameraIntrinsics{f, f, w / 2.0, h / 2.0}, m, rho);
+}
+
+TEST(PlaneKernels, RowsThroughRandomHomographiesEqualTheReference) {
+  LB_SKIP_WITHOUT_VARIANTS();
+  std::mt19937 rng(22);
+  for (const int32_t w : {8, 17, 33, 48, 49, 64, 161}) {
+    const int32_t h = 24;
+    const Views v(rng, w, h, 3, static_cast<int32_t>(rng() % 3));
+    for (int32_t trial = 0; trial < 40; ++trial) {
+      PlaneHomography hom =
+          RandomPlane(rng, w, h, trial < 20 ? 2.0 : 12.0, 0.2 + 0.8 * (trial % 5));
+      if (trial % 7 == 6) {
+        // No map over the right part of every row: the denominator falls below its minimum.
+        hom.m[6] = -(int64_t{1} << 30) / (w / 2 + 1);
+      }
+      const DataTermParams params{45 + static_cast<int32_t>(rng() % 200),
+                                  static_cast<int32_t>(rng() % 11)};
+      const int32_t invalid = std::min(255, params.color_trunc + 24 * params.census_weight);
+      for (int32_t y = 0; y < h; y += 5) {
+        const int32_t x0 = static_cast<int32_t>(rng() % w);
+        for (const int32_t x1 : {w, std::min(w, x0 + 1 + static_cast<int32_t>(rng() % 20))}) {
+          const int32_t begin = x1 == w ? 0 : x0;
+          std::vector<uint8_t> want(w, 0x5a);
+          PlaneCostRow(hom, v.Source(), y, params, invalid, begin, x1, want.data(),
+                       dtk::kReference.plane);
+          for (const dtk::Variant& var : Others()) {
+            std::vector<uint8_t> got(w, 0x5a);
+            PlaneCostRow(hom, v.Source(), y, params, invalid, begin, x1, got.data(),
+                         var.kernels->plane);
+            ASSERT_EQ(got, want) << var.name << " w " << w << " y " << y << " [" << begin << ", "
+                                 << x1 << ") trial " << trial;
+          }
+        }
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace lb
