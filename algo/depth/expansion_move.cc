@@ -236,7 +236,9 @@ bool DepthStage::Expand(int32_t alpha) {
   int64_t delta = 0;
   for (int32_t i = 0; i < count; ++i) {
     const Rect& r = g.rects[i];
-    if (on_coarse_) {
+    if (on_coarse_ && block_costs_ != nullptr) {
+      g.cost_alpha = CoarseCosts(alpha);  // the whole grid, from the winner-take-all
+    } else if (on_coarse_) {
       BlockCosts(alpha, r, g.cost_alpha);
     } else {
       data_.ComputeRect(disp_q8, r.x0, r.x1, r.y0, r.y1, g.cost_alpha + r.y0 * g.width, g.width);

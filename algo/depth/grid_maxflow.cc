@@ -20,6 +20,14 @@ void GridMaxflow::Carve(Arena& arena, int32_t max_width, int32_t max_height) {
   queue_ = arena.Allocate<int32_t>(static_cast<size_t>(max_nodes_));
 }
 
+uint8_t* GridMaxflow::Spare(int32_t width, int32_t height, size_t* bytes) const {
+  const int64_t used = int64_t{width} * height + 2 * int64_t{width};
+  const int64_t total = int64_t{max_nodes_} + 2 * int64_t{max_width_};
+  *bytes =
+      storage_ != nullptr && used < total ? sizeof(Node) * static_cast<size_t>(total - used) : 0;
+  return *bytes > 0 ? reinterpret_cast<uint8_t*>(storage_ + used) : nullptr;
+}
+
 void GridMaxflow::Start(int32_t width, int32_t height) {
   width_ = width;
   height_ = height;

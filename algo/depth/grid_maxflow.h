@@ -55,6 +55,10 @@ class GridMaxflow {
   // After Solve: true when p is on the source side of the minimum cut.
   bool InSource(int32_t p) const { return nodes_[p].tree == kSourceTree; }
 
+  // Node storage that graphs of at most width x height nodes never touch, lent to the caller
+  // until a larger graph begins: its size in bytes, and where it starts (nullptr when none).
+  uint8_t* Spare(int32_t width, int32_t height, size_t* bytes) const;
+
   int32_t width() const { return width_; }
   int32_t height() const { return height_; }
 
