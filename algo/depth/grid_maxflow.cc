@@ -242,6 +242,7 @@ void GridMaxflow::PushRow(int32_t y) {
   };
   Node* row = nodes_ + y * w;
   const bool down = y + 1 < height_;
+
   for (int32_t x = 0; x < w; ++x) {
     Node& n = row[x];
     if (n.tcap == 0) continue;
@@ -259,6 +260,42 @@ void GridMaxflow::PushRow(int32_t y) {
       else if (n.tcap < 0 && m.tcap > 0)
         push(m, n, kUp);
     }
+  }
+  ChainRow(row, w);
+}
+
+// Moves excess along the row toward deficits it can reach, first rightward then leftward. Moving
+// excess d from a node to its neighbour over an arc of residual at least d leaves every cut's
+// capacity as it was, so the minimum cuts are the same; flow_ counts what meets a deficit.
+void GridMaxflow::ChainRow(Node* row, int32_t w) {
+  int32_t* demand = orphans_;  // free until Solve
+  auto move = [&](Node& from, Node& to, int dir, int32_t d) {
+    const int32_t met = -to.tcap < d ? -to.tcap : d;
+    if (met > 0) flow_ += met;
+    from.tcap -= d;
+    to.tcap += d;
+    from.cap[dir] -= d;
+    to.cap[dir ^ 1] += d;
+  };
+  demand[w - 1] = 0;
+  for (int32_t x = w - 2; x >= 0; --x) {
+    const int32_t want = demand[x + 1] - row[x + 1].tcap;
+    const int32_t c = row[x].cap[kRight];
+    demand[x] = want <= 0 ? 0 : (want < c ? want : c);
+  }
+  for (int32_t x = 0; x + 1 < w; ++x) {
+    const int32_t b = row[x].tcap;
+    if (b > 0 && demand[x] > 0) move(row[x], row[x + 1], kRight, b < demand[x] ? b : demand[x]);
+  }
+  demand[0] = 0;
+  for (int32_t x = 1; x < w; ++x) {
+    const int32_t want = demand[x - 1] - row[x - 1].tcap;
+    const int32_t c = row[x].cap[kLeft];
+    demand[x] = want <= 0 ? 0 : (want < c ? want : c);
+  }
+  for (int32_t x = w - 1; x > 0; --x) {
+    const int32_t b = row[x].tcap;
+    if (b > 0 && demand[x] > 0) move(row[x], row[x - 1], kLeft, b < demand[x] ? b : demand[x]);
   }
 }
 

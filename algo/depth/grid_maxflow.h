@@ -81,6 +81,7 @@ class GridMaxflow {
 
   void Start(int32_t width, int32_t height);
   void PushRow(int32_t y);
+  void ChainRow(Node* row, int32_t w);
   void InitRow(int32_t y);
   void Activate(int32_t p);
   int32_t NextActive();
