@@ -241,27 +241,16 @@ void GridMaxflow::PushRow(int32_t y) {
     flow_ += d;
   };
   Node* row = nodes_ + y * w;
-  const bool down = y + 1 < height_;
-
+  ChainRow(row, w);
+  if (y + 1 >= height_) return;
   for (int32_t x = 0; x < w; ++x) {
     Node& n = row[x];
-    if (n.tcap == 0) continue;
-    if (x + 1 < w) {
-      Node& m = row[x + 1];
-      if (n.tcap > 0 && m.tcap < 0)
-        push(n, m, kRight);
-      else if (n.tcap < 0 && m.tcap > 0)
-        push(m, n, kLeft);
-    }
-    if (down) {
-      Node& m = row[x + w];
-      if (n.tcap > 0 && m.tcap < 0)
-        push(n, m, kDown);
-      else if (n.tcap < 0 && m.tcap > 0)
-        push(m, n, kUp);
-    }
+    Node& m = row[x + w];
+    if (n.tcap > 0 && m.tcap < 0)
+      push(n, m, kDown);
+    else if (n.tcap < 0 && m.tcap > 0)
+      push(m, n, kUp);
   }
-  ChainRow(row, w);
 }
 
 // Moves excess along the row toward deficits it can reach, first rightward then leftward. Moving
