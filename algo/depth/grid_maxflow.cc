@@ -272,15 +272,17 @@ void GridMaxflow::ChainRow(Node* row, int32_t w) {
     const int32_t c = row[x].cap[kRight];
     demand[x] = want <= 0 ? 0 : (want < c ? want : c);
   }
-  for (int32_t x = 0; x + 1 < w; ++x) {
-    const int32_t b = row[x].tcap;
-    if (b > 0 && demand[x] > 0) move(row[x], row[x + 1], kRight, b < demand[x] ? b : demand[x]);
-  }
-  demand[0] = 0;
-  for (int32_t x = 1; x < w; ++x) {
-    const int32_t want = demand[x - 1] - row[x - 1].tcap;
-    const int32_t c = row[x].cap[kLeft];
-    demand[x] = want <= 0 ? 0 : (want < c ? want : c);
+  // Rightward moves, and behind them (node x - 1 is done with) the leftward demand.
+  int32_t left = 0;
+  for (int32_t x = 0; x < w; ++x) {
+    if (x > 0) {
+      const int32_t want = left - row[x - 1].tcap;
+      const int32_t c = row[x].cap[kLeft];
+      left = want <= 0 ? 0 : (want < c ? want : c);
+    }
+    const int32_t b = row[x].tcap, right = demand[x];
+    demand[x] = left;
+    if (x + 1 < w && b > 0 && right > 0) move(row[x], row[x + 1], kRight, b < right ? b : right);
   }
   for (int32_t x = w - 1; x > 0; --x) {
     const int32_t b = row[x].tcap;
