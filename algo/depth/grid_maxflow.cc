@@ -267,11 +267,15 @@ void GridMaxflow::ChainRow(Node* row, int32_t w) {
     to.cap[dir ^ 1] += d;
   };
   demand[w - 1] = 0;
+  bool excess = row[w - 1].tcap > 0, deficit = row[w - 1].tcap < 0;
   for (int32_t x = w - 2; x >= 0; --x) {
     const int32_t want = demand[x + 1] - row[x + 1].tcap;
     const int32_t c = row[x].cap[kRight];
     demand[x] = want <= 0 ? 0 : (want < c ? want : c);
+    excess |= row[x].tcap > 0;
+    deficit |= row[x].tcap < 0;
   }
+  if (!excess || !deficit) return;  // nothing to meet
   // Rightward moves, and behind them (node x - 1 is done with) the leftward demand.
   int32_t left = 0;
   for (int32_t x = 0; x < w; ++x) {
