@@ -226,9 +226,10 @@ void GridMaxflow::Adopt(int32_t p) {
   n.tree = kFree;
 }
 
-// Augments every path source -> p -> q -> sink over one arc of row y, before any tree search:
-// the asymmetric split of the pair terms leaves many such neighbouring pairs. Needs row y + 1
-// set, and is the last change to row y's terminal balances.
+// Before any tree search: moves row y's excess along the row to deficits (ChainRow), then
+// augments every path source -> p -> q -> sink over one arc down or up (the asymmetric split of
+// the pair terms leaves many such neighbouring pairs). Needs row y + 1 set, and is the last
+// change to row y's terminal balances.
 void GridMaxflow::PushRow(int32_t y) {
   const int32_t w = width_;
   auto push = [&](Node& from, Node& to, int dir) {
