@@ -226,7 +226,7 @@ void GridMaxflow::Adopt(int32_t p) {
   n.tree = kFree;
 }
 
-// Before any tree search: moves row y's excess along the row to deficits (ChainRow), then
+// Before any tree search: moves row y's excess rightward to deficits (ChainRow), then
 // augments every path source -> p -> q -> sink over one arc down or up (the asymmetric split of
 // the pair terms leaves many such neighbouring pairs). Needs row y + 1 set, and is the last
 // change to row y's terminal balances.
@@ -254,19 +254,13 @@ void GridMaxflow::PushRow(int32_t y) {
   }
 }
 
-// Moves excess along the row toward deficits it can reach, first rightward then leftward. Moving
-// excess d from a node to its neighbour over an arc of residual at least d leaves every cut's
-// capacity as it was, so the minimum cuts are the same; flow_ counts what meets a deficit.
+// Moves excess rightward along the row toward the deficits it can reach. Moving excess d from a
+// node to its neighbour over an arc of residual at least d leaves every cut's capacity as it
+// was, so the minimum cuts are the same; flow_ counts what meets a deficit. (Moving leftward as
+// well cost more than it saved the tree search on the depth stage's graphs.)
 void GridMaxflow::ChainRow(Node* row, int32_t w) {
+  // What the nodes right of x still lack that the arc x -> x + 1 can carry.
   int32_t* demand = orphans_;  // free until Solve
-  auto move = [&](Node& from, Node& to, int dir, int32_t d) {
-    const int32_t met = -to.tcap < d ? -to.tcap : d;
-    if (met > 0) flow_ += met;
-    from.tcap -= d;
-    to.tcap += d;
-    from.cap[dir] -= d;
-    to.cap[dir ^ 1] += d;
-  };
   demand[w - 1] = 0;
   bool excess = row[w - 1].tcap > 0, deficit = row[w - 1].tcap < 0;
   for (int32_t x = w - 2; x >= 0; --x) {
@@ -277,21 +271,17 @@ void GridMaxflow::ChainRow(Node* row, int32_t w) {
     deficit |= row[x].tcap < 0;
   }
   if (!excess || !deficit) return;  // nothing to meet
-  // Rightward moves, and behind them (node x - 1 is done with) the leftward demand.
-  int32_t left = 0;
-  for (int32_t x = 0; x < w; ++x) {
-    if (x > 0) {
-      const int32_t want = left - row[x - 1].tcap;
-      const int32_t c = row[x].cap[kLeft];
-      left = want <= 0 ? 0 : (want < c ? want : c);
-    }
-    const int32_t b = row[x].tcap, right = demand[x];
-    demand[x] = left;
-    if (x + 1 < w && b > 0 && right > 0) move(row[x], row[x + 1], kRight, b < right ? b : right);
-  }
-  for (int32_t x = w - 1; x > 0; --x) {
-    const int32_t b = row[x].tcap;
-    if (b > 0 && demand[x] > 0) move(row[x], row[x - 1], kLeft, b < demand[x] ? b : demand[x]);
+  for (int32_t x = 0; x + 1 < w; ++x) {
+    Node& from = row[x];
+    Node& to = row[x + 1];
+    const int32_t d = from.tcap < demand[x] ? from.tcap : demand[x];
+    if (d <= 0) continue;
+    const int32_t met = -to.tcap < d ? -to.tcap : d;
+    if (met > 0) flow_ += met;
+    from.tcap -= d;
+    to.tcap += d;
+    from.cap[kRight] -= d;
+    to.cap[kLeft] += d;
   }
 }
 
