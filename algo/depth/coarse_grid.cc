@@ -55,12 +55,20 @@ void DepthStage::CoarseWinnerTakeAll() {
     g.cost[p] = 0xffff;
     g.labels[p] = 0;
   }
+  // The moves would compute these costs again, label by label: kept when there is room.
+  const int32_t coarse_labels = (config_.labels + config_.coarse_step - 1) / config_.coarse_step;
+  size_t spare = 0;
+  uint8_t* room = maxflow_.Spare(g.width, g.height, &spare);
+  block_costs_ = spare >= sizeof(uint16_t) * static_cast<size_t>(n) * coarse_labels
+                     ? reinterpret_cast<uint16_t*>(room)
+                     : nullptr;
   const Rect all{0, g.width, 0, g.height};
   for (int32_t label = 0; label < config_.labels; label += config_.coarse_step) {
-    BlockCosts(label, all, g.cost_alpha);
+    uint16_t* d = block_costs_ != nullptr ? CoarseCosts(label) : g.cost_alpha;
+    BlockCosts(label, all, d);
     for (int32_t p = 0; p < n; ++p) {
-      if (g.cost_alpha[p] < g.cost[p]) {
-        g.cost[p] = g.cost_alpha[p];
+      if (d[p] < g.cost[p]) {
+        g.cost[p] = d[p];
         g.labels[p] = static_cast<uint8_t>(label);
       }
     }
@@ -78,9 +86,12 @@ void DepthStage::CoarsePass() {
     coarse_.span[2 * y] = coarse_.span[2 * y + 1] = 0;
   }
   window_ = DepthConfig::kMaxLabels;
+  uint16_t* const scratch = coarse_.cost_alpha;
   for (int32_t alpha = 0; alpha < config_.labels; alpha += config_.coarse_step) {
     if (Expand(alpha)) ++stats_.moves;
   }
+  coarse_.cost_alpha = scratch;
+  block_costs_ = nullptr;
   stats_.coarse_energy = energy_;
   on_coarse_ = false;
   FineFromBlocks();

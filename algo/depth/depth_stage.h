@@ -169,6 +169,10 @@ class DepthStage {
   void BlockWeights();
   void BlockCosts(int32_t label, const Rect& blocks, uint16_t* out);
   void CoarseWinnerTakeAll();
+  uint16_t* CoarseCosts(int32_t label) {
+    return block_costs_ +
+           static_cast<size_t>(label / config_.coarse_step) * coarse_.width * coarse_.height;
+  }
   void CoarsePass();
   void FineFromBlocks();
   // One alpha-expansion move (expansion_move.cc) on grid(); returns true when it lowered the
@@ -196,6 +200,9 @@ class DepthStage {
   Grid fine_;    // the pixels
   Grid coarse_;  // the coarse pass's blocks, in the memory of below_ and above_
   bool on_coarse_ = false;
+  // The coarse pass's block D of every coarse label, kept from its winner-take-all for its moves
+  // in storage the max-flow does not touch on the blocks' graphs; nullptr when it does not fit.
+  uint16_t* block_costs_ = nullptr;
   enum : uint8_t { kFree = 0, kKeep = 1, kTake = 2 };
   int32_t* move_rows_ = nullptr;                  // the moves' row ring (expansion_move.cc)
   int32_t smooth_[DepthConfig::kMaxLabels] = {};  // min(d, smooth_trunc) for a label distance d

@@ -65,9 +65,14 @@ int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1
   if (restricted) {
     const int32_t lo = alpha - window_, top = alpha + window_;
     const uint8_t* fu = y > 0 ? f - w : f;
-    for (int32_t x = x0 > 0 ? x0 - 1 : 0; x < x1 + 1 && x < w; ++x) {
-      near[x] = (fu[x] >= lo && fu[x] <= top) | (f[x] >= lo && f[x] <= top) |
-                (fd[x] >= lo && fd[x] <= top);
+    // One unsigned compare per label (a label below lo wraps above the window's width).
+    const uint8_t base = static_cast<uint8_t>(lo > 0 ? lo : 0);
+    const uint8_t width = static_cast<uint8_t>((top < 255 ? top : 255) - base);
+    const int32_t xe1 = x1 + 1 < w ? x1 + 1 : w;
+    for (int32_t x = x0 > 0 ? x0 - 1 : 0; x < xe1; ++x) {
+      near[x] = static_cast<uint8_t>(static_cast<uint8_t>(fu[x] - base) <= width) |
+                static_cast<uint8_t>(static_cast<uint8_t>(f[x] - base) <= width) |
+                static_cast<uint8_t>(static_cast<uint8_t>(fd[x] - base) <= width);
     }
     if (x0 == 0) near[-1] = 0;
     if (x1 == w) near[w] = 0;
@@ -75,20 +80,25 @@ int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1
   const uint16_t* ca = g.cost_alpha + row;
   const uint16_t* cc = g.cost + row;
   uint8_t* state = g.state + row;
-  int32_t present = 0;
+  // Without branches, so that the loop vectorizes.
+  const uint8_t full = restricted ? 0 : 1;
+  uint8_t any_free = 0, any_take = 0;
   for (int32_t x = x0; x < x1; ++x) {
     const int32_t u = ca[x] - cc[x];
     int32_t limit = sw[x] * k;
     limit = limit < 0xffff ? limit : 0xffff;
     const int32_t lo = u - v(f[x], alpha) * sw[x];
-    hi[x] += lo;
-    const bool far = restricted && (near[x - 1] | near[x] | near[x + 1]) == 0;
-    const bool keep = u > limit || f[x] == alpha || lo > 0 || far;
-    const uint8_t s = keep ? kKeep : (hi[x] < 0 ? kTake : kFree);
-    state[x] = s;
-    present |= (s == kFree ? kRowFree : 0) | (s == kTake ? kRowTake : 0);
+    const int32_t high = hi[x] + lo;
+    hi[x] = high;
+    const uint8_t far = (near[x - 1] | near[x] | near[x + 1] | full) == 0;
+    const uint8_t keep = static_cast<uint8_t>(u > limit) | static_cast<uint8_t>(f[x] == alpha) |
+                         static_cast<uint8_t>(lo > 0) | far;
+    const uint8_t take = static_cast<uint8_t>(keep == 0) & static_cast<uint8_t>(high < 0);
+    state[x] = keep != 0 ? kKeep : (take != 0 ? kTake : kFree);
+    any_free |= static_cast<uint8_t>((keep | take) == 0);
+    any_take |= take;
   }
-  return present;
+  return (any_free != 0 ? kRowFree : 0) | (any_take != 0 ? kRowTake : 0);
 }
 
 // The pairs from row y (fixed: above a rectangle) down into the rectangle's first row.
@@ -236,7 +246,9 @@ bool DepthStage::Expand(int32_t alpha) {
   int64_t delta = 0;
   for (int32_t i = 0; i < count; ++i) {
     const Rect& r = g.rects[i];
-    if (on_coarse_) {
+    if (on_coarse_ && block_costs_ != nullptr) {
+      g.cost_alpha = CoarseCosts(alpha);  // the whole grid, from the winner-take-all
+    } else if (on_coarse_) {
       BlockCosts(alpha, r, g.cost_alpha);
     } else {
       data_.ComputeRect(disp_q8, r.x0, r.x1, r.y0, r.y1, g.cost_alpha + r.y0 * g.width, g.width);

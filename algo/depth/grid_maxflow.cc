@@ -20,6 +20,14 @@ void GridMaxflow::Carve(Arena& arena, int32_t max_width, int32_t max_height) {
   queue_ = arena.Allocate<int32_t>(static_cast<size_t>(max_nodes_));
 }
 
+uint8_t* GridMaxflow::Spare(int32_t width, int32_t height, size_t* bytes) const {
+  const int64_t used = int64_t{width} * height + 2 * int64_t{width};
+  const int64_t total = int64_t{max_nodes_} + 2 * int64_t{max_width_};
+  *bytes =
+      storage_ != nullptr && used < total ? sizeof(Node) * static_cast<size_t>(total - used) : 0;
+  return *bytes > 0 ? reinterpret_cast<uint8_t*>(storage_ + used) : nullptr;
+}
+
 void GridMaxflow::Start(int32_t width, int32_t height) {
   width_ = width;
   height_ = height;
@@ -218,9 +226,10 @@ void GridMaxflow::Adopt(int32_t p) {
   n.tree = kFree;
 }
 
-// Augments every path source -> p -> q -> sink over one arc of row y, before any tree search:
-// the asymmetric split of the pair terms leaves many such neighbouring pairs. Needs row y + 1
-// set, and is the last change to row y's terminal balances.
+// Before any tree search: moves row y's excess rightward to deficits (ChainRow), then
+// augments every path source -> p -> q -> sink over one arc down or up (the asymmetric split of
+// the pair terms leaves many such neighbouring pairs). Needs row y + 1 set, and is the last
+// change to row y's terminal balances.
 void GridMaxflow::PushRow(int32_t y) {
   const int32_t w = width_;
   auto push = [&](Node& from, Node& to, int dir) {
@@ -233,24 +242,46 @@ void GridMaxflow::PushRow(int32_t y) {
     flow_ += d;
   };
   Node* row = nodes_ + y * w;
-  const bool down = y + 1 < height_;
+  ChainRow(row, w);
+  if (y + 1 >= height_) return;
   for (int32_t x = 0; x < w; ++x) {
     Node& n = row[x];
-    if (n.tcap == 0) continue;
-    if (x + 1 < w) {
-      Node& m = row[x + 1];
-      if (n.tcap > 0 && m.tcap < 0)
-        push(n, m, kRight);
-      else if (n.tcap < 0 && m.tcap > 0)
-        push(m, n, kLeft);
-    }
-    if (down) {
-      Node& m = row[x + w];
-      if (n.tcap > 0 && m.tcap < 0)
-        push(n, m, kDown);
-      else if (n.tcap < 0 && m.tcap > 0)
-        push(m, n, kUp);
-    }
+    Node& m = row[x + w];
+    if (n.tcap > 0 && m.tcap < 0)
+      push(n, m, kDown);
+    else if (n.tcap < 0 && m.tcap > 0)
+      push(m, n, kUp);
+  }
+}
+
+// Moves excess rightward along the row toward the deficits it can reach. Moving excess d from a
+// node to its neighbour over an arc of residual at least d leaves every cut's capacity as it
+// was, so the minimum cuts are the same; flow_ counts what meets a deficit. (Moving leftward as
+// well cost more than it saved the tree search on the depth stage's graphs.)
+void GridMaxflow::ChainRow(Node* row, int32_t w) {
+  // What the nodes right of x still lack that the arc x -> x + 1 can carry.
+  int32_t* demand = orphans_;  // free until Solve
+  demand[w - 1] = 0;
+  bool excess = row[w - 1].tcap > 0, deficit = row[w - 1].tcap < 0;
+  for (int32_t x = w - 2; x >= 0; --x) {
+    const int32_t want = demand[x + 1] - row[x + 1].tcap;
+    const int32_t c = row[x].cap[kRight];
+    demand[x] = want <= 0 ? 0 : (want < c ? want : c);
+    excess |= row[x].tcap > 0;
+    deficit |= row[x].tcap < 0;
+  }
+  if (!excess || !deficit) return;  // nothing to meet
+  for (int32_t x = 0; x + 1 < w; ++x) {
+    Node& from = row[x];
+    Node& to = row[x + 1];
+    const int32_t d = from.tcap < demand[x] ? from.tcap : demand[x];
+    if (d <= 0) continue;
+    const int32_t met = -to.tcap < d ? -to.tcap : d;
+    if (met > 0) flow_ += met;
+    from.tcap -= d;
+    to.tcap += d;
+    from.cap[kRight] -= d;
+    to.cap[kLeft] += d;
   }
 }
 

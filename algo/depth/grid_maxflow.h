@@ -26,7 +26,7 @@ class GridMaxflow {
   void Carve(Arena& arena, int32_t max_width, int32_t max_height);
 
   // Starts a new graph of width x height nodes whose every node the caller then sets once with
-  // SetNode, row by row, calling RowDone after each row (no clearing pass: the one-arc paths
+  // SetNode, row by row, calling RowDone after each row (no clearing pass: the rows' pushes
   // and the initial trees are prepared two rows behind, while the rows are still in cache).
   void Begin(int32_t width, int32_t height);
   // Sets node p: its terminal balance (positive: source->p, negative: p->sink) and its arcs to
@@ -55,6 +55,10 @@ class GridMaxflow {
   // After Solve: true when p is on the source side of the minimum cut.
   bool InSource(int32_t p) const { return nodes_[p].tree == kSourceTree; }
 
+  // Node storage that graphs of at most width x height nodes never touch, lent to the caller
+  // until a larger graph begins: its size in bytes, and where it starts (nullptr when none).
+  uint8_t* Spare(int32_t width, int32_t height, size_t* bytes) const;
+
   int32_t width() const { return width_; }
   int32_t height() const { return height_; }
 
@@ -77,6 +81,7 @@ class GridMaxflow {
 
   void Start(int32_t width, int32_t height);
   void PushRow(int32_t y);
+  void ChainRow(Node* row, int32_t w);
   void InitRow(int32_t y);
   void Activate(int32_t p);
   int32_t NextActive();
@@ -89,14 +94,14 @@ class GridMaxflow {
 
   Node* storage_ = nullptr;
   Node* nodes_ = nullptr;       // storage_ + width_: the first grid node
-  int32_t* orphans_ = nullptr;  // ring buffer of max_nodes_ entries
+  int32_t* orphans_ = nullptr;  // ring buffer of max_nodes_ entries (the chains scratch before)
   // FIFO of active nodes, max_nodes_ entries (a node is queued at most once): unlike a linked
   // list, it shows the nodes to come, which are prefetched.
   int32_t* queue_ = nullptr;
   int32_t max_nodes_ = 0, max_width_ = 0;
   int32_t width_ = 0, height_ = 0, count_ = 0;
   int32_t offset_[4] = {};           // node index step in each direction
-  int32_t pushed_ = 0, inited_ = 0;  // rows whose one-arc paths / initial trees are done
+  int32_t pushed_ = 0, inited_ = 0;  // rows whose pushes / initial trees are done
   int32_t queue_head_ = 0, queue_count_ = 0;
   int32_t orphan_head_ = 0, orphan_count_ = 0;
   int32_t time_ = 0;

@@ -34,8 +34,10 @@ Graph RandomGraph(std::mt19937& rng, int32_t w, int32_t h, int32_t max_cap) {
   return g;
 }
 
-// Edmonds-Karp on the explicit graph: node 0 is the source, 1 the sink, pixel p is p + 2.
-int64_t TextbookMaxflow(const Graph& g) {
+// Edmonds-Karp on the explicit graph: node 0 is the source, 1 the sink, pixel p is p + 2. With
+// `reachable`, also the pixels the source reaches in the residual graph of the maximum flow: the
+// least source side of a minimum cut, the same for every maximum flow.
+int64_t TextbookMaxflow(const Graph& g, std::vector<bool>* reachable = nullptr) {
   const int32_t n = g.w * g.h + 2;
   std::vector<int64_t> cap(static_cast<size_t>(n * n), 0);
   auto at = [&](int32_t a, int32_t b) -> int64_t& { return cap[static_cast<size_t>(a * n + b)]; };
@@ -69,7 +71,13 @@ int64_t TextbookMaxflow(const Graph& g) {
         }
       }
     }
-    if (prev[1] < 0) return flow;
+    if (prev[1] < 0) {
+      if (reachable != nullptr) {
+        reachable->assign(static_cast<size_t>(g.w * g.h), false);
+        for (int32_t p = 0; p < g.w * g.h; ++p) (*reachable)[p] = prev[p + 2] >= 0;
+      }
+      return flow;
+    }
     int64_t push = INT64_MAX;
     for (int32_t b = 1; b != 0; b = prev[b]) push = std::min(push, at(prev[b], b));
     for (int32_t b = 1; b != 0; b = prev[b]) {
@@ -145,6 +153,22 @@ TEST_F(MaxflowTest, MatchesTextbookOnThousandsOfRandomGrids) {
     const int64_t flow = Solve(g, mf_);
     ASSERT_EQ(flow, expected) << "trial " << trial << " " << w << "x" << h;
     ASSERT_EQ(CutCapacity(g, mf_), expected) << "trial " << trial;
+  }
+}
+
+// The depth stage's labels depend on which minimum cut is reported, not only on its capacity:
+// the source side must be the least one (what the source reaches in the residual graph), which
+// every maximum flow gives, so that a change of the solver's insides keeps the labels' bits.
+TEST_F(MaxflowTest, SourceSideIsTheLeastMinimumCut) {
+  std::mt19937 rng(4321);
+  std::uniform_int_distribution<int32_t> side(1, 8);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const int32_t w = side(rng), h = side(rng);
+    // Small capacities make ties between minimum cuts common.
+    const Graph g = RandomGraph(rng, w, h, trial % 2 == 0 ? 2 : 30);
+    std::vector<bool> reachable;
+    ASSERT_EQ(Solve(g, mf_), TextbookMaxflow(g, &reachable)) << "trial " << trial;
+    for (int32_t p = 0; p < w * h; ++p) ASSERT_EQ(mf_.InSource(p), reachable[p]) << trial;
   }
 }
 
