@@ -60,7 +60,7 @@ void PlaneSpansC(const WarpRow& row, const WarpSpanJob* jobs, int32_t count, uin
 #if defined(__x86_64__)
 void PlaneSpansAvx2(const WarpRow& row, const WarpSpanJob* jobs, int32_t count, uint8_t* out);
 #endif
-#if defined(__ARM_NEON)
+#if defined(__ARM_NEON) || defined(__arm__)
 void PlaneSpansNeon(const WarpRow& row, const WarpSpanJob* jobs, int32_t count, uint8_t* out);
 #endif
 void HSumRowC(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum);
