@@ -107,8 +107,7 @@ Status Job::Configure(Sensor* sensor, const JobOptions& options) {
   }
   if (pc.reference < 0) pc.reference = pc.frames / 2;
   LB_RETURN_IF_ERROR(CheckFocusRegion(options_.render.focus, mode_.width, mode_.height));
-  const int32_t cores = WorkerPool::AvailableCores();
-  pc.workers = options.threads > 0 ? options.threads : (cores < kMaxWorkers ? cores : kMaxWorkers);
+  pc.workers = WorkerPool::CountFor(options.threads);
   size_t bytes = 0;
   LB_RETURN_IF_ERROR(Pipeline::RequiredBytes(pc, &bytes));
   if (bytes != arena_bytes_) {

@@ -94,8 +94,7 @@ Status Rerenderer::Render(const RerenderOptions& options, const char* out_path,
   rc.working_width = depth_w_;
   rc.working_height = depth_h_;
   rc.max_radius = options.max_blur_radius;
-  const int32_t cores = WorkerPool::AvailableCores();
-  rc.workers = options.threads > 0 ? options.threads : (cores < kMaxWorkers ? cores : kMaxWorkers);
+  rc.workers = WorkerPool::CountFor(options.threads);
   LB_RETURN_IF_ERROR(RenderStage::Validate(rc));
   const size_t bytes = RenderStage::RequiredBytes(rc);
   std::unique_ptr<void, decltype(&free)> block(aligned_alloc(Arena::kAlign, Arena::RoundUp(bytes)),

@@ -100,4 +100,10 @@ int32_t WorkerPool::AvailableCores() {
   return n < 1 ? 1 : n;
 }
 
+int32_t WorkerPool::CountFor(int32_t threads) {
+  if (threads > 0) return threads;
+  const int32_t cores = AvailableCores();
+  return cores < kMaxWorkers ? cores : kMaxWorkers;
+}
+
 }  // namespace lb

@@ -34,6 +34,9 @@ class WorkerPool final : public TaskRunner {
 
   // The cores this process may run on (its affinity mask), at least 1.
   static int32_t AvailableCores();
+  // The workers for a `threads` setting: itself when positive, else one per available core,
+  // at most kMaxWorkers.
+  static int32_t CountFor(int32_t threads);
 
  private:
   static void* Entry(void* thread);
