@@ -1,5 +1,7 @@
 #include "firmware/daemon/config.h"
 
+#include <arpa/inet.h>
+
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -18,6 +20,36 @@ constexpr size_t kMaxText = 63;  // make, model
 bool Text(const char* v, std::string* out, std::string* why) {
   if (strlen(v) > kMaxText) return Why(why, "longer than %zu characters", kMaxText);
   *out = v;
+  return true;
+}
+
+// `off`, or ADDRESS:PORT with a numeric IPv4 address or a bracketed IPv6 one ([::1]:8080).
+bool WebAddress(const char* v, DaemonConfig* c, std::string* why) {
+  if (strcmp(v, "off") == 0) {
+    c->web_address.clear();
+    c->web_port = 0;
+    return true;
+  }
+  const char* colon = strrchr(v, ':');
+  if (colon == nullptr) return Why(why, "'%s' is neither off nor ADDRESS:PORT", v);
+  std::string host(v, static_cast<size_t>(colon - v));
+  bool v6 = false;
+  if (host.size() >= 2 && host.front() == '[' && host.back() == ']') {
+    host = host.substr(1, host.size() - 2);
+    v6 = true;
+  }
+  unsigned char addr[16];
+  if (inet_pton(v6 ? AF_INET6 : AF_INET, host.c_str(), addr) != 1) {
+    return Why(why, "'%s' is not a numeric %s address (e.g. 0.0.0.0:8080 or [::]:8080)",
+               host.c_str(), v6 ? "IPv6" : "IPv4");
+  }
+  std::string port_why;
+  int32_t port = 0;
+  if (!ParseWholeNumber(colon + 1, 0, 65535, &port, &port_why)) {
+    return Why(why, "port: %s", port_why.c_str());
+  }
+  c->web_address = host;
+  c->web_port = port;
   return true;
 }
 
@@ -95,6 +127,26 @@ const Key kKeys[] = {
        if (ParseLogLevel(v, &c->log_level)) return true;
        return Why(why, "'%s' is none of: debug, info, warning, error", v);
      }},
+    {"web", WebAddress},
+    {"web_token",
+     [](const char* v, DaemonConfig* c, std::string* why) {
+       const size_t n = strlen(v);
+       if (n < 16 || n > 128) return Why(why, "%zu characters; it needs 16 to 128", n);
+       for (const char* p = v; *p != '\0'; ++p) {
+         if (*p < '!' || *p > '~') {
+           return Why(why, "only printable ASCII characters without spaces are allowed");
+         }
+       }
+       c->web_token = v;
+       return true;
+     }},
+    {"web_root",
+     [](const char* v, DaemonConfig* c, std::string* why) {
+       if (v[0] != '/') return Why(why, "'%s' is not an absolute path", v);
+       if (strlen(v) > 900) return Why(why, "longer than 900 characters");
+       c->web_root = v;
+       return true;
+     }},
 };
 constexpr int kKeyCount = sizeof(kKeys) / sizeof(kKeys[0]);
 
@@ -158,6 +210,7 @@ Status ParseConfig(const char* name, const char* text, DaemonConfig* config) {
   std::vector<int> first_line(static_cast<size_t>(count), 0);
   int line_no = 0;
   int focus_line = 0;
+  int web_line = 0;
   const char* p = text;
   while (*p != '\0') {
     ++line_no;
@@ -198,6 +251,14 @@ Status ParseConfig(const char* name, const char* text, DaemonConfig* config) {
       return Status(Code::kInvalidArgument, "%s:%d: %s: %s", name, line_no, known, why.c_str());
     }
     if (strcmp(known, "focus") == 0) focus_line = line_no;
+    if (strcmp(known, "web") == 0) web_line = line_no;
+  }
+  // The page shows and changes every photo: never without a token.
+  if (config->web_on() && config->web_token.empty()) {
+    return Status(Code::kInvalidArgument,
+                  "%s:%d: web is on but web_token is not set (16 to 128 characters; the page "
+                  "asks for it)",
+                  name, web_line);
   }
   // As the command line checks it once the frame size is known (the native size: at start).
   const SensorConfig& sensor = config->job.sensor;

@@ -42,6 +42,15 @@ struct DaemonConfig {
   JobOptions job = DaemonJobDefaults();
   // Log.
   LogLevel log_level = LogLevel::kInfo;
+  // Web page (firmware/web/web_server.h): off while web_address is "". The address is numeric
+  // (IPv4 dotted or IPv6 without brackets); port 0 takes any free port (tests; the log says
+  // which). web_token is required (16 to 128 printable characters, no space) whenever the web
+  // side is on: the page is reachable by anyone on the network.
+  std::string web_address;
+  int32_t web_port = 0;
+  std::string web_token;
+  std::string web_root = "/usr/share/refocusd/www";
+  bool web_on() const { return !web_address.empty(); }
 };
 
 // Parses the text of a configuration file over the defaults in `config`; `name` is the file

@@ -16,6 +16,7 @@
 #include "firmware/daemon/log.h"
 #include "firmware/daemon/startup_checks.h"
 #include "firmware/platform/cpu_features.h"
+#include "firmware/web/web_server.h"
 
 namespace {
 
@@ -156,7 +157,21 @@ int main(int argc, char** argv) {
   signal(SIGPIPE, SIG_IGN);
 
   s = daemon.Start();
+  // The web page (web = ADDRESS:PORT) after the camera: a port that cannot be bound is logged
+  // and the camera runs on without it. Declared after the daemon, so it goes first.
+  std::unique_ptr<lb::RefocusBackend> backend;
+  std::unique_ptr<lb::WebServer> web;
+  if (s.ok() && config.web_on()) {
+    backend = lb::MakeRefocusBackend(config, &log, &daemon);
+    web = std::make_unique<lb::WebServer>(lb::WebOptionsFrom(config), backend.get(), &log);
+    lb::Status ws = web->Start();
+    if (!ws.ok()) {
+      log.Printf(lb::LogLevel::kError, "%s; the camera runs without the web page", ws.message());
+      web.reset();
+    }
+  }
   if (s.ok()) s = daemon.Run();
+  if (web) web->Stop();
   g_daemon.store(nullptr);
   return s.ok() ? 0 : 1;
 }

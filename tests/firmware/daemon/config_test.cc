@@ -58,8 +58,11 @@ TEST(ConfigTest, EveryKeyIsDocumentedInTheShippedFile) {
   const std::string text(bytes.begin(), bytes.end());
   int keys = 0;
   for (int i = 0; ConfigKeyName(i) != nullptr; ++i, ++keys) {
+    // The web keys are shown commented out (the web side stays off until a token is chosen).
     const std::string line = std::string("\n") + ConfigKeyName(i) + " = ";
-    EXPECT_NE(text.find(line), std::string::npos) << ConfigKeyName(i) << " is not in the file";
+    const std::string commented = std::string("\n# ") + ConfigKeyName(i) + " = ";
+    EXPECT_TRUE(text.find(line) != std::string::npos || text.find(commented) != std::string::npos)
+        << ConfigKeyName(i) << " is not in the file";
   }
   EXPECT_GE(keys, 20);
 }
@@ -243,6 +246,45 @@ TEST(ConfigTest, UnreadableFilesAreClearErrors) {
   s = LoadConfig(path.c_str(), &c);
   EXPECT_EQ(s.code(), Code::kInvalidArgument);
   EXPECT_NE(std::string(s.message()).find("NUL byte"), std::string::npos) << s.message();
+}
+
+TEST(ConfigTest, WebIsOffUntilAnAddressAndATokenAreSet) {
+  DaemonConfig c;
+  EXPECT_FALSE(c.web_on());
+  EXPECT_EQ(c.web_root, "/usr/share/refocusd/www");
+  ASSERT_TRUE(Parse("web = 0.0.0.0:8080\nweb_token = 0123456789abcdef\n", &c).ok());
+  EXPECT_TRUE(c.web_on());
+  EXPECT_EQ(c.web_address, "0.0.0.0");
+  EXPECT_EQ(c.web_port, 8080);
+  EXPECT_EQ(c.web_token, "0123456789abcdef");
+  DaemonConfig v6;
+  ASSERT_TRUE(Parse("web = [::1]:0\nweb_token = 0123456789abcdef\nweb_root = /srv/www\n", &v6)
+                  .ok());
+  EXPECT_EQ(v6.web_address, "::1");
+  EXPECT_EQ(v6.web_port, 0);
+  EXPECT_EQ(v6.web_root, "/srv/www");
+  DaemonConfig off;
+  ASSERT_TRUE(Parse("web = off\n", &off).ok());
+  EXPECT_FALSE(off.web_on());
+}
+
+TEST(ConfigTest, WebWithoutAGoodTokenIsRefusedAtLoad) {
+  EXPECT_EQ(Error("frames = 5\nweb = 0.0.0.0:8080\n"),
+            "test.conf:2: web is on but web_token is not set (16 to 128 characters; the page asks "
+            "for it)");
+  // Loopback too: another user of the board could reach it.
+  EXPECT_EQ(Error("web = 127.0.0.1:8080\n"),
+            "test.conf:1: web is on but web_token is not set (16 to 128 characters; the page asks "
+            "for it)");
+  EXPECT_EQ(Error("web_token = short\n"), "test.conf:1: web_token: 5 characters; it needs 16 to 128");
+  EXPECT_EQ(Error("web_token = has a space in it ok\n"),
+            "test.conf:1: web_token: only printable ASCII characters without spaces are allowed");
+  EXPECT_EQ(Error("web = camera.local:80\n"),
+            "test.conf:1: web: 'camera.local' is not a numeric IPv4 address (e.g. 0.0.0.0:8080 or "
+            "[::]:8080)");
+  EXPECT_EQ(Error("web = 0.0.0.0\n"), "test.conf:1: web: '0.0.0.0' is neither off nor ADDRESS:PORT");
+  EXPECT_NE(Error("web = 0.0.0.0:70000\n").find("test.conf:1: web: port: "), std::string::npos);
+  EXPECT_EQ(Error("web_root = www\n"), "test.conf:1: web_root: 'www' is not an absolute path");
 }
 
 }  // namespace

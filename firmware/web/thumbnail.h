@@ -1,0 +1,21 @@
+// Gallery thumbnails straight from a photo's own main image: libjpeg-turbo decodes it already
+// shrunk in the DCT domain (scale M/8, the smallest that still gives at least the wanted width,
+// so a 12 MP photo costs a 1/8 decode), an area average takes it the rest of the way, and the
+// result is encoded again. Only a row of each is held, so the memory is a few KiB a column.
+// The embedded depth and all-in-focus images of a refocusable JPEG are APP segments the decoder
+// skips. EXIF orientation is not applied (the camera writes upright photos).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "algo/core/status.h"
+
+namespace lb {
+
+// Reads the JPEG from `fd` (borrowed; read from its current offset) and writes a JPEG at most
+// `width` px wide (narrower images keep their width) into `out`. kCorruptData for bytes that do
+// not decode, kUnsupported for an image over 16384 px a side.
+Status MakeThumbnail(int fd, int32_t width, int quality, std::vector<uint8_t>* out);
+
+}  // namespace lb

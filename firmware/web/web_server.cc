@@ -1,0 +1,827 @@
+#include "firmware/web/web_server.h"
+
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <microhttpd.h>
+#include <netinet/in.h>
+#include <strings.h>
+#include <sys/random.h>
+#include <sys/resource.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <new>
+#include <thread>
+#include <vector>
+
+#include "firmware/storage/errno_text.h"
+#include "firmware/web/photo_folder.h"
+#include "firmware/web/thumbnail.h"
+
+namespace lb {
+
+// One request's state between libmicrohttpd's calls: the body so far (bounded) and whether an
+// answer was queued.
+struct WebServer::Request {
+  char method[8] = "";
+  char path[168] = "";  // as logged
+  std::string body;
+  bool too_large = false;
+  bool replied = false;
+};
+
+// The render outputs: a fixed number of sinks whose capacity stays between requests (so steady
+// use does not grow memory), each lent to one render and returned when libmicrohttpd has sent
+// and freed its response.
+class WebServer::Sinks {
+ public:
+  static constexpr int kCount = 2;
+  static constexpr size_t kMaxBytes = 48u << 20;  // a full-size JPEG of a 16 MP photo fits
+
+  class Sink final : public ByteSink {
+   public:
+    bool Append(const uint8_t* data, size_t size) override {
+      if (size > kMaxBytes - bytes.size()) return false;
+      bytes.insert(bytes.end(), data, data + size);
+      return true;
+    }
+    std::vector<uint8_t> bytes;
+    Sinks* owner = nullptr;
+    bool lent = false;
+  };
+
+  Sinks() {
+    for (Sink& s : sinks_) s.owner = this;
+  }
+  Sink* Acquire() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    for (Sink& s : sinks_) {
+      if (!s.lent) {
+        s.lent = true;
+        s.bytes.clear();
+        return &s;
+      }
+    }
+    return nullptr;
+  }
+  void Release(Sink* s) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    s->lent = false;
+  }
+
+ private:
+  std::mutex mutex_;
+  Sink sinks_[kCount];
+};
+
+namespace {
+
+struct ErrText {
+  explicit ErrText(int err) { ErrnoText(err, text, sizeof(text)); }
+  char text[96];
+};
+
+MHD_Result OnRequest(void* cls, MHD_Connection* c, const char* url, const char* method,
+                     const char* /*version*/, const char* upload, size_t* upload_size,
+                     void** request) {
+  auto* self = static_cast<WebServer*>(cls);
+  return self->Handle(c, url, method, upload, upload_size,
+                      reinterpret_cast<WebServer::Request**>(request))
+             ? MHD_YES
+             : MHD_NO;
+}
+
+void OnCompleted(void* /*cls*/, MHD_Connection* /*c*/, void** request,
+                 MHD_RequestTerminationCode /*why*/) {
+  delete static_cast<WebServer::Request*>(*request);
+  *request = nullptr;
+}
+
+void OnLibraryMessage(void* cls, const char* format, va_list args) {
+  char text[Log::kMaxLine];
+  vsnprintf(text, sizeof(text), format, args);
+  static_cast<WebServer*>(cls)->LogLibraryMessage(text);
+}
+
+void ReleaseSink(void* cls) {
+  auto* sink = static_cast<WebServer::Sinks::Sink*>(cls);
+  sink->owner->Release(sink);
+}
+
+// Equal in time that does not depend on where the first difference is.
+bool SameSecret(const char* given, const std::string& secret) {
+  const size_t n = strnlen(given, 1024);
+  unsigned diff = n != secret.size() ? 1u : 0u;
+  for (size_t i = 0; i < secret.size(); ++i) {
+    const unsigned char g = i < n ? static_cast<unsigned char>(given[i]) : 0;
+    diff |= g ^ static_cast<unsigned char>(secret[i]);
+  }
+  return diff == 0;
+}
+
+void AppendJsonString(std::string* out, const char* s) {
+  out->push_back('"');
+  for (; *s != '\0'; ++s) {
+    const unsigned char ch = static_cast<unsigned char>(*s);
+    if (ch == '"' || ch == '\\') {
+      out->push_back('\\');
+      out->push_back(static_cast<char>(ch));
+    } else if (ch < 0x20 || ch == 0x7f) {
+      char esc[8];
+      snprintf(esc, sizeof(esc), "\\u%04x", ch);
+      out->append(esc);
+    } else {
+      out->push_back(static_cast<char>(ch));
+    }
+  }
+  out->push_back('"');
+}
+
+// A request path as the log shows it: printable ASCII, at most 160 characters (a decoded
+// "%0a" cannot start a fake log line).
+void LoggablePath(const char* url, char* out, size_t size) {
+  size_t i = 0;
+  for (; url[i] != '\0' && i + 1 < size && i < 160; ++i) {
+    const unsigned char ch = static_cast<unsigned char>(url[i]);
+    out[i] = ch >= 0x20 && ch < 0x7f ? static_cast<char>(ch) : '?';
+  }
+  out[i] = '\0';
+}
+
+// The decoded fields of a form or a flat JSON object body.
+struct Fields {
+  static constexpr int kMax = 12;
+  std::string key[kMax], value[kMax];
+  int count = 0;
+  const char* Get(const char* name) const {
+    for (int i = 0; i < count; ++i) {
+      if (key[i] == name) return value[i].c_str();
+    }
+    return nullptr;
+  }
+  bool Add(std::string k, std::string v) {
+    if (count == kMax) return false;
+    // A decoded NUL would cut the text the checks see short of what was sent.
+    if (k.find('\0') != std::string::npos || v.find('\0') != std::string::npos) return false;
+    key[count] = std::move(k);
+    value[count] = std::move(v);
+    ++count;
+    return true;
+  }
+};
+
+// application/x-www-form-urlencoded: '+' is a space, %XX decoded by libmicrohttpd.
+bool ParseForm(const std::string& body, Fields* f) {
+  size_t pos = 0;
+  while (pos < body.size()) {
+    size_t end = body.find('&', pos);
+    if (end == std::string::npos) end = body.size();
+    std::string pair = body.substr(pos, end - pos);
+    pos = end + 1;
+    if (pair.empty()) continue;
+    for (char& ch : pair) ch = ch == '+' ? ' ' : ch;
+    const size_t eq = pair.find('=');
+    std::string k = pair.substr(0, eq);
+    std::string v = eq == std::string::npos ? std::string() : pair.substr(eq + 1);
+    k.resize(MHD_http_unescape(k.data()));
+    v.resize(MHD_http_unescape(v.data()));
+    if (!f->Add(std::move(k), std::move(v))) return false;
+  }
+  return true;
+}
+
+// A flat JSON object whose values are strings, numbers or booleans; anything else is refused.
+bool ParseJsonObject(const std::string& b, Fields* f) {
+  size_t i = 0;
+  auto space = [&] {
+    while (i < b.size() && (b[i] == ' ' || b[i] == '\t' || b[i] == '\r' || b[i] == '\n')) ++i;
+  };
+  auto string = [&](std::string* out) {
+    if (i >= b.size() || b[i] != '"') return false;
+    for (++i; i < b.size() && b[i] != '"'; ++i) {
+      char ch = b[i];
+      if (static_cast<unsigned char>(ch) < 0x20) return false;
+      if (ch == '\\') {
+        if (++i == b.size()) return false;
+        const char* from = "\"\\/bfnrt";
+        const char* to = "\"\\/\b\f\n\r\t";
+        const char* at = strchr(from, b[i]);
+        if (at == nullptr || b[i] == '\0') return false;  // \u: names are ASCII
+        ch = to[at - from];
+      }
+      out->push_back(ch);
+    }
+    if (i >= b.size()) return false;
+    ++i;
+    return true;
+  };
+  space();
+  if (i >= b.size() || b[i] != '{') return false;
+  ++i;
+  space();
+  if (i < b.size() && b[i] == '}') {
+    ++i;
+  } else {
+    for (;;) {
+      std::string k, v;
+      space();
+      if (!string(&k)) return false;
+      space();
+      if (i >= b.size() || b[i] != ':') return false;
+      ++i;
+      space();
+      if (i < b.size() && b[i] == '"') {
+        if (!string(&v)) return false;
+      } else {
+        while (i < b.size() && strchr("+-.0123456789eEtruefals", b[i]) != nullptr &&
+               b[i] != '\0') {
+          v.push_back(b[i++]);
+        }
+        if (v.empty()) return false;
+      }
+      if (!f->Add(std::move(k), std::move(v))) return false;
+      space();
+      if (i < b.size() && b[i] == ',') {
+        ++i;
+        continue;
+      }
+      if (i < b.size() && b[i] == '}') {
+        ++i;
+        break;
+      }
+      return false;
+    }
+  }
+  space();
+  return i == b.size();
+}
+
+bool Number(const char* text, float lo, float hi, float* out) {
+  if (text == nullptr || *text == '\0') return false;
+  char* end = nullptr;
+  const float v = strtof(text, &end);
+  if (*end != '\0' || !std::isfinite(v) || v < lo || v > hi) return false;
+  *out = v;
+  return true;
+}
+
+// The page's choice from a preview/render/save body.
+Status ParseRefocus(const Fields& f, std::string* name, RefocusParams* p) {
+  const char* n = f.Get("name");
+  if (n == nullptr) return Status(Code::kInvalidArgument, "the body names no photo (name=)");
+  *name = n;
+  if (!Number(f.Get("x0"), 0.0f, 1.0f, &p->x0) || !Number(f.Get("y0"), 0.0f, 1.0f, &p->y0)) {
+    return Status(Code::kInvalidArgument, "x0 and y0 must be numbers from 0 to 1");
+  }
+  p->x1 = p->x0;
+  p->y1 = p->y0;
+  if ((f.Get("x1") != nullptr && !Number(f.Get("x1"), 0.0f, 1.0f, &p->x1)) ||
+      (f.Get("y1") != nullptr && !Number(f.Get("y1"), 0.0f, 1.0f, &p->y1))) {
+    return Status(Code::kInvalidArgument, "x1 and y1 must be numbers from 0 to 1");
+  }
+  if (p->x1 < p->x0) std::swap(p->x0, p->x1);
+  if (p->y1 < p->y0) std::swap(p->y0, p->y1);
+  if (f.Get("f") != nullptr && !Number(f.Get("f"), 1.0f, 22.0f, &p->f_number)) {
+    return Status(Code::kInvalidArgument, "f must be an f-number from 1 to 22");
+  }
+  float blades = 0.0f;
+  if (f.Get("blades") != nullptr) {
+    if (!Number(f.Get("blades"), 0.0f, 12.0f, &blades) || blades != std::floor(blades) ||
+        (blades > 0.0f && blades < 3.0f)) {
+      return Status(Code::kInvalidArgument, "blades must be 0 (a disc) or 3 to 12");
+    }
+  }
+  p->aperture.blades = static_cast<int32_t>(blades);
+  return Status::Ok();
+}
+
+int HttpStatusFor(Code code) {
+  switch (code) {
+    case Code::kInvalidArgument:
+      return MHD_HTTP_BAD_REQUEST;
+    case Code::kNotFound:
+      return MHD_HTTP_NOT_FOUND;
+    case Code::kUnsupported:
+    case Code::kCorruptData:
+    case Code::kDegenerate:
+      return MHD_HTTP_UNPROCESSABLE_CONTENT;
+    case Code::kBusy:
+    case Code::kTimeout:
+      return MHD_HTTP_SERVICE_UNAVAILABLE;
+    default:
+      return MHD_HTTP_INTERNAL_SERVER_ERROR;
+  }
+}
+
+bool StartsWith(const char* s, const char* prefix, const char** rest) {
+  const size_t n = strlen(prefix);
+  if (strncmp(s, prefix, n) != 0) return false;
+  *rest = s + n;
+  return true;
+}
+
+int ThreadId() { return static_cast<int>(gettid()); }
+
+}  // namespace
+
+WebServerOptions WebOptionsFrom(const DaemonConfig& config) {
+  WebServerOptions o;
+  o.address = config.web_address;
+  o.port = config.web_port;
+  o.token = config.web_token;
+  o.web_root = config.web_root;
+  o.photo_dir = config.output_dir;
+  return o;
+}
+
+WebServer::WebServer(const WebServerOptions& options, RefocusBackend* backend, Log* log)
+    : options_(options), backend_(backend), log_(log) {}
+
+WebServer::~WebServer() { Stop(); }
+
+Status WebServer::Start() {
+  if (mhd_ != nullptr) return Status(Code::kBusy, "web: already started");
+  if (options_.token.size() < 16) {
+    return Status(Code::kInvalidArgument, "web: the token must have at least 16 characters");
+  }
+  uint8_t random[32];
+  size_t got = 0;
+  while (got < sizeof(random)) {
+    const ssize_t n = getrandom(random + got, sizeof(random) - got, 0);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return Status(Code::kIoError, "web: getrandom: %s", ErrText(errno).text);
+    got += static_cast<size_t>(n);
+  }
+  session_.clear();
+  for (uint8_t b : random) {
+    static const char kHex[] = "0123456789abcdef";
+    session_.push_back(kHex[b >> 4]);
+    session_.push_back(kHex[b & 15]);
+  }
+
+  // The listening socket is made here so the address can be either family and port 0 can be
+  // read back.
+  sockaddr_storage addr{};
+  socklen_t addr_len = 0;
+  const bool v6 = options_.address.find(':') != std::string::npos;
+  if (v6) {
+    auto* a = reinterpret_cast<sockaddr_in6*>(&addr);
+    a->sin6_family = AF_INET6;
+    a->sin6_port = htons(static_cast<uint16_t>(options_.port));
+    if (inet_pton(AF_INET6, options_.address.c_str(), &a->sin6_addr) != 1) addr_len = 1;
+    addr_len = addr_len == 1 ? 0 : sizeof(*a);
+  } else {
+    auto* a = reinterpret_cast<sockaddr_in*>(&addr);
+    a->sin_family = AF_INET;
+    a->sin_port = htons(static_cast<uint16_t>(options_.port));
+    addr_len = inet_pton(AF_INET, options_.address.c_str(), &a->sin_addr) == 1 ? sizeof(*a) : 0;
+  }
+  if (addr_len == 0) {
+    return Status(Code::kInvalidArgument, "web: '%s' is not a numeric address",
+                  options_.address.c_str());
+  }
+  const int fd = socket(addr.ss_family, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return Status(Code::kIoError, "web: socket: %s", ErrText(errno).text);
+  const int one = 1, zero = 0;
+  setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one));
+  if (v6) setsockopt(fd, IPPROTO_IPV6, IPV6_V6ONLY, &zero, sizeof(zero));
+  if (bind(fd, reinterpret_cast<sockaddr*>(&addr), addr_len) != 0 ||
+      listen(fd, options_.max_connections) != 0) {
+    const int err = errno;
+    close(fd);
+    return Status(Code::kIoError, "web: cannot listen on %s%s%s:%d: %s", v6 ? "[" : "",
+                  options_.address.c_str(), v6 ? "]" : "", options_.port, ErrText(err).text);
+  }
+  sockaddr_storage bound{};
+  socklen_t bound_len = sizeof(bound);
+  getsockname(fd, reinterpret_cast<sockaddr*>(&bound), &bound_len);
+  port_ = ntohs(v6 ? reinterpret_cast<sockaddr_in6*>(&bound)->sin6_port
+                   : reinterpret_cast<sockaddr_in*>(&bound)->sin_port);
+  listen_fd_ = fd;
+  sinks_ = std::make_unique<Sinks>();
+
+  // Threads start with their creator's nice value: libmicrohttpd's listening thread is created
+  // from one at the web's priority, and it creates every connection's thread.
+  int nice_err = 0;
+  std::thread starter([&] {
+    if (setpriority(PRIO_PROCESS, static_cast<id_t>(ThreadId()), options_.nice) != 0) {
+      nice_err = errno;
+    }
+    const unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_THREAD_PER_CONNECTION |
+                           MHD_USE_POLL | MHD_USE_ERROR_LOG;
+    mhd_ = MHD_start_daemon(
+        flags, 0, nullptr, nullptr, &OnRequest, this, MHD_OPTION_EXTERNAL_LOGGER,
+        &OnLibraryMessage, this, MHD_OPTION_LISTEN_SOCKET, static_cast<MHD_socket>(listen_fd_),
+        MHD_OPTION_CONNECTION_LIMIT, static_cast<unsigned>(options_.max_connections),
+        MHD_OPTION_PER_IP_CONNECTION_LIMIT, static_cast<unsigned>(options_.max_per_client),
+        MHD_OPTION_CONNECTION_MEMORY_LIMIT, options_.connection_memory,
+        MHD_OPTION_CONNECTION_TIMEOUT, static_cast<unsigned>(options_.timeout_s),
+        MHD_OPTION_THREAD_STACK_SIZE, static_cast<size_t>(1u << 20), MHD_OPTION_NOTIFY_COMPLETED,
+        &OnCompleted, this, MHD_OPTION_END);
+  });
+  starter.join();
+  if (mhd_ == nullptr) {
+    close(listen_fd_);
+    listen_fd_ = -1;
+    return Status(Code::kIoError, "web: libmicrohttpd did not start");
+  }
+  if (nice_err != 0) {
+    log_->Printf(LogLevel::kWarning, "web: cannot lower the web threads' priority: %s",
+                 ErrText(nice_err).text);
+  }
+  log_->Printf(LogLevel::kInfo,
+               "web: listening on %s%s%s:%d (page files from %s; at most %d connections, %d per "
+               "client)",
+               v6 ? "[" : "", options_.address.c_str(), v6 ? "]" : "", port_,
+               options_.web_root.c_str(), options_.max_connections, options_.max_per_client);
+  return Status::Ok();
+}
+
+void WebServer::Stop() {
+  if (mhd_ == nullptr) return;
+  MHD_stop_daemon(mhd_);  // joins every thread, frees every response (sinks come back)
+  mhd_ = nullptr;
+  if (listen_fd_ >= 0) close(listen_fd_);
+  listen_fd_ = -1;
+  log_->Printf(LogLevel::kInfo, "web: stopped after %lld request(s)",
+               static_cast<long long>(requests_.load()));
+}
+
+void WebServer::LogLibraryMessage(const char* text) {
+  char line[Log::kMaxLine];
+  LoggablePath(text, line, sizeof(line));
+  size_t n = strlen(line);
+  while (n > 0 && (line[n - 1] == '?' || line[n - 1] == ' ')) line[--n] = '\0';  // the newline
+  log_->Printf(LogLevel::kWarning, "web: refused or failed (libmicrohttpd): %s", line);
+}
+
+bool WebServer::Handle(MHD_Connection* c, const char* url, const char* method,
+                       const char* upload, size_t* upload_size, Request** request) {
+  if (*request == nullptr) {
+    Request* r = new (std::nothrow) Request;
+    if (r == nullptr) return false;
+    *request = r;
+    requests_.fetch_add(1);
+    LoggablePath(method, r->method, sizeof(r->method));
+    LoggablePath(url, r->path, sizeof(r->path));
+    const char* length =
+        MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_LENGTH);
+    if (length != nullptr && strtoull(length, nullptr, 10) > options_.max_body) {
+      return ReplyError(c, r, MHD_HTTP_CONTENT_TOO_LARGE, "request body over the limit");
+    }
+    if (strcmp(method, "POST") == 0) return true;  // the body comes in the next calls
+  }
+  Request* r = *request;
+  if (r->replied) {
+    *upload_size = 0;
+    return true;
+  }
+  if (*upload_size != 0) {
+    if (!r->too_large && *upload_size <= options_.max_body - r->body.size()) {
+      r->body.append(upload, *upload_size);
+    } else {
+      r->too_large = true;
+      r->body.clear();
+    }
+    *upload_size = 0;
+    return true;
+  }
+  if (r->too_large) {
+    return ReplyError(c, r, MHD_HTTP_CONTENT_TOO_LARGE, "request body over the limit");
+  }
+  return Route(c, url, method, r);
+}
+
+bool WebServer::Route(MHD_Connection* c, const char* url, const char* method, Request* r) {
+  const bool get = strcmp(method, "GET") == 0 || strcmp(method, "HEAD") == 0;
+  const bool post = strcmp(method, "POST") == 0;
+  static const struct {
+    const char *url, *file, *type;
+  } kPage[] = {
+      {"/", "index.html", "text/html; charset=utf-8"},
+      {"/index.html", "index.html", "text/html; charset=utf-8"},
+      {"/app.js", "app.js", "text/javascript; charset=utf-8"},
+      {"/style.css", "style.css", "text/css; charset=utf-8"},
+  };
+  for (const auto& page : kPage) {
+    if (strcmp(url, page.url) == 0) {
+      if (!get) return ReplyError(c, r, MHD_HTTP_METHOD_NOT_ALLOWED, "only GET");
+      return ServePage(c, r, page.file, page.type);
+    }
+  }
+  if (strcmp(url, "/api/login") == 0) {
+    if (!post) return ReplyError(c, r, MHD_HTTP_METHOD_NOT_ALLOWED, "only POST");
+    return Login(c, r);
+  }
+  if (!Authorized(c)) {
+    return ReplyError(c, r, MHD_HTTP_UNAUTHORIZED, "no valid session cookie or token");
+  }
+  const char* rest = nullptr;
+  if (strcmp(url, "/api/photos") == 0) {
+    if (!get) return ReplyError(c, r, MHD_HTTP_METHOD_NOT_ALLOWED, "only GET");
+    return ListPhotos(c, r);
+  }
+  if (StartsWith(url, "/photos/", &rest) || StartsWith(url, "/thumbs/", &rest)) {
+    if (!get) return ReplyError(c, r, MHD_HTTP_METHOD_NOT_ALLOWED, "only GET");
+    return ServePhoto(c, r, rest, url[1] == 't');
+  }
+  if (StartsWith(url, "/api/info/", &rest)) {
+    if (!get) return ReplyError(c, r, MHD_HTTP_METHOD_NOT_ALLOWED, "only GET");
+    return Info(c, r, rest);
+  }
+  if (StartsWith(url, "/api/", &rest) &&
+      (strcmp(rest, "preview") == 0 || strcmp(rest, "render") == 0 || strcmp(rest, "save") == 0)) {
+    if (!post) return ReplyError(c, r, MHD_HTTP_METHOD_NOT_ALLOWED, "only POST");
+    return Refocus(c, r, rest);
+  }
+  return ReplyError(c, r, MHD_HTTP_NOT_FOUND, "no such page");
+}
+
+bool WebServer::Authorized(MHD_Connection* c) const {
+  const char* cookie = MHD_lookup_connection_value(c, MHD_COOKIE_KIND, "refocusd");
+  if (cookie != nullptr && SameSecret(cookie, session_)) return true;
+  const char* auth = MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_AUTHORIZATION);
+  if (auth == nullptr || strncasecmp(auth, "Bearer ", 7) != 0) return false;
+  const char* token = auth + 7;
+  while (*token == ' ') ++token;
+  return SameSecret(token, options_.token);
+}
+
+void WebServer::LogRequest(MHD_Connection* c, const Request* r, int status, const char* why) {
+  char client[INET6_ADDRSTRLEN] = "?";
+  const MHD_ConnectionInfo* info = MHD_get_connection_info(c, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
+  if (info != nullptr && info->client_addr != nullptr) {
+    const sockaddr* sa = info->client_addr;
+    if (sa->sa_family == AF_INET) {
+      inet_ntop(AF_INET, &reinterpret_cast<const sockaddr_in*>(sa)->sin_addr, client,
+                sizeof(client));
+    } else if (sa->sa_family == AF_INET6) {
+      inet_ntop(AF_INET6, &reinterpret_cast<const sockaddr_in6*>(sa)->sin6_addr, client,
+                sizeof(client));
+    }
+  }
+  LogLevel level = LogLevel::kInfo;
+  if (status >= 500 && status != MHD_HTTP_SERVICE_UNAVAILABLE) {
+    level = LogLevel::kError;
+  } else if (status >= 400) {
+    level = LogLevel::kWarning;
+  }
+  log_->Printf(level, "web: %s %s %s %d%s%s", client, r->method, r->path, status,
+               why != nullptr ? ": " : "", why != nullptr ? why : "");
+}
+
+namespace {
+
+// Headers every answer carries: nothing is sniffed, framed or sent on to another site.
+void CommonHeaders(MHD_Response* response) {
+  MHD_add_response_header(response, "X-Content-Type-Options", "nosniff");
+  MHD_add_response_header(response, "X-Frame-Options", "DENY");
+  MHD_add_response_header(response, "Referrer-Policy", "no-referrer");
+}
+
+}  // namespace
+
+bool WebServer::Reply(MHD_Connection* c, Request* r, int status, const char* type,
+                      const void* data, size_t size, const char* why) {
+  MHD_Response* response =
+      MHD_create_response_from_buffer(size, const_cast<void*>(data), MHD_RESPMEM_MUST_COPY);
+  if (response == nullptr) return false;
+  CommonHeaders(response);
+  if (type != nullptr) MHD_add_response_header(response, MHD_HTTP_HEADER_CONTENT_TYPE, type);
+  MHD_add_response_header(response, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
+  if (status == MHD_HTTP_SERVICE_UNAVAILABLE) {
+    MHD_add_response_header(response, MHD_HTTP_HEADER_RETRY_AFTER, "1");
+  }
+  const bool ok = MHD_queue_response(c, static_cast<unsigned>(status), response) == MHD_YES;
+  MHD_destroy_response(response);
+  r->replied = true;
+  LogRequest(c, r, status, why);
+  return ok;
+}
+
+bool WebServer::ReplyError(MHD_Connection* c, Request* r, int status, const char* why) {
+  std::string json = "{\"error\":";
+  AppendJsonString(&json, why);
+  json += "}";
+  return Reply(c, r, status, "application/json", json.data(), json.size(), why);
+}
+
+bool WebServer::ReplyStatus(MHD_Connection* c, Request* r, const Status& s) {
+  return ReplyError(c, r, HttpStatusFor(s.code()), s.message());
+}
+
+bool WebServer::ServePage(MHD_Connection* c, Request* r, const char* file, const char* type) {
+  const std::string path = options_.web_root + "/" + file;
+  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  struct stat st;
+  if (fd < 0 || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    if (fd >= 0) close(fd);
+    char why[160];
+    snprintf(why, sizeof(why), "the page file %s is missing (web_root)", file);
+    return ReplyError(c, r, MHD_HTTP_NOT_FOUND, why);
+  }
+  MHD_Response* response = MHD_create_response_from_fd(static_cast<size_t>(st.st_size), fd);
+  if (response == nullptr) {
+    close(fd);
+    return false;
+  }
+  CommonHeaders(response);
+  MHD_add_response_header(response, MHD_HTTP_HEADER_CONTENT_TYPE, type);
+  MHD_add_response_header(response, MHD_HTTP_HEADER_CACHE_CONTROL, "no-cache");
+  // The page loads only its own files and the photos; no inline script, nothing from outside.
+  MHD_add_response_header(response, MHD_HTTP_HEADER_CONTENT_SECURITY_POLICY,
+                          "default-src 'self'; img-src 'self' blob: data:; "
+                          "frame-ancestors 'none'; base-uri 'none'; form-action 'self'");
+  const bool ok = MHD_queue_response(c, MHD_HTTP_OK, response) == MHD_YES;
+  MHD_destroy_response(response);
+  r->replied = true;
+  LogRequest(c, r, MHD_HTTP_OK, nullptr);
+  return ok;
+}
+
+bool WebServer::Login(MHD_Connection* c, Request* r) {
+  Fields f;
+  const char* token = ParseForm(r->body, &f) ? f.Get("token") : nullptr;
+  if (token == nullptr || !SameSecret(token, options_.token)) {
+    // Each wrong guess costs its connection a moment (and the per-client limit caps those).
+    std::this_thread::sleep_for(std::chrono::milliseconds(options_.failed_login_delay_ms));
+    return ReplyError(c, r, MHD_HTTP_UNAUTHORIZED, "wrong token");
+  }
+  MHD_Response* response = MHD_create_response_from_buffer(0, nullptr, MHD_RESPMEM_PERSISTENT);
+  if (response == nullptr) return false;
+  CommonHeaders(response);
+  const std::string cookie = "refocusd=" + session_ + "; HttpOnly; SameSite=Strict; Path=/";
+  MHD_add_response_header(response, MHD_HTTP_HEADER_SET_COOKIE, cookie.c_str());
+  MHD_add_response_header(response, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
+  const bool ok = MHD_queue_response(c, MHD_HTTP_NO_CONTENT, response) == MHD_YES;
+  MHD_destroy_response(response);
+  r->replied = true;
+  LogRequest(c, r, MHD_HTTP_NO_CONTENT, "logged in");
+  return ok;
+}
+
+bool WebServer::ListPhotos(MHD_Connection* c, Request* r) {
+  int dir_fd = -1;
+  Status s = OpenPhotoFolder(options_.photo_dir.c_str(), &dir_fd);
+  std::vector<PhotoEntry> photos;
+  if (s.ok()) {
+    s = ListPhotoFolder(dir_fd, options_.max_listed, &photos);
+    close(dir_fd);
+  }
+  if (!s.ok()) return ReplyStatus(c, r, s);
+  std::string json = "{\"photos\":[";
+  for (size_t i = 0; i < photos.size(); ++i) {
+    if (i > 0) json += ",";
+    json += "{\"name\":";
+    AppendJsonString(&json, photos[i].name.c_str());
+    char numbers[80];
+    snprintf(numbers, sizeof(numbers), ",\"mtime\":%lld,\"size\":%lld}",
+             static_cast<long long>(photos[i].mtime_ns / 1000000000),
+             static_cast<long long>(photos[i].size));
+    json += numbers;
+  }
+  json += "]}";
+  return Reply(c, r, MHD_HTTP_OK, "application/json", json.data(), json.size(), nullptr);
+}
+
+bool WebServer::ServePhoto(MHD_Connection* c, Request* r, const char* name, bool thumbnail) {
+  int dir_fd = -1;
+  Status s = OpenPhotoFolder(options_.photo_dir.c_str(), &dir_fd);
+  int fd = -1;
+  struct stat st;
+  if (s.ok()) {
+    s = OpenPhoto(dir_fd, name, &fd, &st);
+    close(dir_fd);
+  }
+  if (!s.ok()) return ReplyStatus(c, r, s);
+  if (thumbnail) {
+    std::vector<uint8_t> jpeg;
+    s = MakeThumbnail(fd, options_.thumb_width, 80, &jpeg);
+    close(fd);
+    if (!s.ok()) return ReplyStatus(c, r, s.Prefix("%s: ", name));
+    return Reply(c, r, MHD_HTTP_OK, "image/jpeg", jpeg.data(), jpeg.size(), nullptr);
+  }
+  MHD_Response* response = MHD_create_response_from_fd(static_cast<size_t>(st.st_size), fd);
+  if (response == nullptr) {
+    close(fd);
+    return false;
+  }
+  CommonHeaders(response);
+  MHD_add_response_header(response, MHD_HTTP_HEADER_CONTENT_TYPE, "image/jpeg");
+  MHD_add_response_header(response, MHD_HTTP_HEADER_CACHE_CONTROL, "private, no-cache");
+  const char* download = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "download");
+  if (download != nullptr && strcmp(download, "1") == 0) {
+    // The name passed IsServablePhotoName: no quote, slash or control character to escape.
+    const std::string disposition = std::string("attachment; filename=\"") + name + "\"";
+    MHD_add_response_header(response, MHD_HTTP_HEADER_CONTENT_DISPOSITION, disposition.c_str());
+  }
+  const bool ok = MHD_queue_response(c, MHD_HTTP_OK, response) == MHD_YES;
+  MHD_destroy_response(response);
+  r->replied = true;
+  LogRequest(c, r, MHD_HTTP_OK, nullptr);
+  return ok;
+}
+
+bool WebServer::Info(MHD_Connection* c, Request* r, const char* name) {
+  int dir_fd = -1;
+  Status s = OpenPhotoFolder(options_.photo_dir.c_str(), &dir_fd);
+  int fd = -1;
+  struct stat st;
+  if (s.ok()) {
+    s = OpenPhoto(dir_fd, name, &fd, &st);
+    close(dir_fd);
+  }
+  if (!s.ok()) return ReplyStatus(c, r, s);
+  close(fd);
+  const std::string path = options_.photo_dir + "/" + name;
+  PhotoInfo info;
+  s = backend_->Describe(path.c_str(), &info);
+  if (!s.ok()) return ReplyStatus(c, r, s);
+  char json[400];
+  const RefocusParams& p = info.current;
+  snprintf(json, sizeof(json),
+           "{\"width\":%d,\"height\":%d,\"refocusable\":%s,\"current\":{\"x0\":%.4f,\"y0\":%.4f,"
+           "\"x1\":%.4f,\"y1\":%.4f,\"f\":%.2f,\"blades\":%d}}",
+           info.width, info.height, info.refocusable ? "true" : "false", p.x0, p.y0, p.x1, p.y1,
+           p.f_number, p.aperture.blades);
+  return Reply(c, r, MHD_HTTP_OK, "application/json", json, strlen(json), nullptr);
+}
+
+bool WebServer::Refocus(MHD_Connection* c, Request* r, const char* action) {
+  Fields f;
+  const char* type = MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
+  const bool json = type != nullptr && strncasecmp(type, "application/json", 16) == 0;
+  if (!(json ? ParseJsonObject(r->body, &f) : ParseForm(r->body, &f))) {
+    return ReplyError(c, r, MHD_HTTP_BAD_REQUEST,
+                      json ? "the body is not a flat JSON object" : "the body is not a form");
+  }
+  std::string name;
+  RefocusParams params;
+  Status s = ParseRefocus(f, &name, &params);
+  int dir_fd = -1;
+  if (s.ok()) s = OpenPhotoFolder(options_.photo_dir.c_str(), &dir_fd);
+  if (s.ok()) {
+    int fd = -1;
+    struct stat st;
+    s = OpenPhoto(dir_fd, name.c_str(), &fd, &st);
+    if (fd >= 0) close(fd);
+  }
+  if (!s.ok()) {
+    if (dir_fd >= 0) close(dir_fd);
+    return ReplyStatus(c, r, s);
+  }
+  const std::string path = options_.photo_dir + "/" + name;
+  if (strcmp(action, "save") == 0) {
+    char out[kMaxPhotoName + 1];
+    {
+      // Two saves at once must not pick the same name.
+      std::lock_guard<std::mutex> lock(save_mutex_);
+      s = ChooseRerenderName(dir_fd, name.c_str(), out, sizeof(out));
+      if (s.ok()) {
+        const std::string out_path = options_.photo_dir + "/" + out;
+        s = backend_->Save(path.c_str(), params, out_path.c_str());
+      }
+    }
+    close(dir_fd);
+    if (!s.ok()) return ReplyStatus(c, r, s);
+    std::string body = "{\"name\":";
+    AppendJsonString(&body, out);
+    body += "}";
+    char why[200];
+    snprintf(why, sizeof(why), "saved %s", out);
+    return Reply(c, r, MHD_HTTP_OK, "application/json", body.data(), body.size(), why);
+  }
+  close(dir_fd);
+  Sinks::Sink* sink = sinks_->Acquire();
+  if (sink == nullptr) {
+    return ReplyError(c, r, MHD_HTTP_SERVICE_UNAVAILABLE, "renders in progress; try again");
+  }
+  s = backend_->Render(path.c_str(), params, strcmp(action, "preview") == 0, sink);
+  if (!s.ok()) {
+    sinks_->Release(sink);
+    return ReplyStatus(c, r, s);
+  }
+  MHD_Response* response = MHD_create_response_from_buffer_with_free_callback_cls(
+      sink->bytes.size(), sink->bytes.data(), &ReleaseSink, sink);
+  if (response == nullptr) {
+    sinks_->Release(sink);
+    return false;
+  }
+  CommonHeaders(response);
+  MHD_add_response_header(response, MHD_HTTP_HEADER_CONTENT_TYPE, "image/jpeg");
+  MHD_add_response_header(response, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
+  const bool ok = MHD_queue_response(c, MHD_HTTP_OK, response) == MHD_YES;
+  MHD_destroy_response(response);
+  r->replied = true;
+  LogRequest(c, r, MHD_HTTP_OK, nullptr);
+  return ok;
+}
+
+}  // namespace lb
