@@ -1,14 +1,20 @@
 #!/usr/bin/env bash
 # Unpacks the target-architecture libraries the firmware links (libjpeg, libpng, zlib, libexif,
-# libmd, Eigen) into build/sysroot/<arch>. `apt-get download` + `dpkg -x` instead of multiarch
+# libmd, libmicrohttpd, Eigen) into build/sysroot/<arch>. `apt-get download` + `dpkg -x` instead of multiarch
 # installs: multiarch requires the host's and the target's versions of every shared package to
 # match exactly, which breaks whenever the mirror's security updates differ between architectures.
 set -euo pipefail
 arch=${1:?usage: cross-sysroot.sh arm64|armhf}
 top=$(cd "$(dirname "$0")/.." && pwd)
 root="$top/build/sysroot/$arch"
+# libmicrohttpd (refocusd's web page) links GnuTLS: the linker resolves a shared library's own
+# dependencies, so their runtime packages come too (no -dev: CMake finds libmicrohttpd without
+# pkg-config, whose file would ask for gnutls.pc). The stamp lists the packages, so adding one
+# here rebuilds an older sysroot.
 pkgs=(libjpeg62-turbo libjpeg62-turbo-dev libpng16-16 libpng-dev zlib1g zlib1g-dev
-      libexif12 libexif-dev libmd0 libmd-dev)
+      libexif12 libexif-dev libmd0 libmd-dev
+      libmicrohttpd12 libmicrohttpd-dev libgnutls30 libp11-kit0 libffi8 libidn2-0 libunistring2
+      libtasn1-6 libnettle8 libhogweed6 libgmp10)
 stamp="$root/.complete"
 [ -f "$stamp" ] && [ "$(cat "$stamp")" = "${pkgs[*]}" ] && exit 0
 

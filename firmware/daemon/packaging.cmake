@@ -1,6 +1,7 @@
 # `cpack -G DEB` (or the `package` target) in a build tree makes the board's Debian package:
 # refocusd and refocus in /usr/bin, the systemd unit in /lib/systemd/system and the default
-# configuration as the conffile /etc/refocusd.conf (local edits survive upgrades).
+# configuration as the conffile /etc/refocusd.conf (local edits survive upgrades), and the web
+# page's files in /usr/share/refocusd/www (firmware/web/CMakeLists.txt).
 set(CPACK_GENERATOR DEB)
 set(CPACK_PACKAGE_NAME refocusd)
 set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
@@ -30,7 +31,7 @@ endif()
 # link is covered. Bookworm's versions.
 set(lb_deb_depends "libc6 (>= 2.36), libgcc-s1 (>= 3.0), libstdc++6 (>= 12)"
     "libjpeg62-turbo (>= 1:2.1)" "libpng16-16 (>= 1.6.2)" "libexif12 (>= 0.6.21)"
-    "libmd0 (>= 1.0)")
+    "libmd0 (>= 1.0)" "libmicrohttpd12 (>= 0.9.75)")
 if(TARGET lb_libcamera)
   list(APPEND lb_deb_depends "libcamera0.0.3")
 endif()

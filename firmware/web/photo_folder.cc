@@ -4,11 +4,11 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <strings.h>
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <strings.h>
 
 #include "firmware/storage/errno_text.h"
 
@@ -57,8 +57,9 @@ Status OpenPhotoFolder(const char* dir, int* dir_fd) {
 Status OpenPhoto(int dir_fd, const char* name, int* fd, struct stat* st) {
   *fd = -1;
   if (!IsServablePhotoName(name)) {
-    return Status(Code::kInvalidArgument, "not a photo name (one name of letters, digits, _ . -, "
-                                          "ending in .jpg or .jpeg)");
+    return Status(Code::kInvalidArgument,
+                  "not a photo name (one name of letters, digits, _ . -, "
+                  "ending in .jpg or .jpeg)");
   }
   const int f = openat(dir_fd, name, O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK);
   if (f < 0) {
@@ -124,8 +125,8 @@ Status ChooseRerenderName(int dir_fd, const char* name, char* out, size_t size) 
     stem -= digits + 2;
   }
   for (int k = 1; k <= 99; ++k) {
-    const int len = snprintf(out, size, "%.*s_r%d%s", static_cast<int>(stem), name, k,
-                             name + n - ext);
+    const int len =
+        snprintf(out, size, "%.*s_r%d%s", static_cast<int>(stem), name, k, name + n - ext);
     if (len < 0 || static_cast<size_t>(len) >= size || !IsServablePhotoName(out)) {
       return Status(Code::kInvalidArgument, "%s: the name of its re-render would be too long",
                     name);

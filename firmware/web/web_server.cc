@@ -240,8 +240,7 @@ bool ParseJsonObject(const std::string& b, Fields* f) {
       if (i < b.size() && b[i] == '"') {
         if (!string(&v)) return false;
       } else {
-        while (i < b.size() && strchr("+-.0123456789eEtruefals", b[i]) != nullptr &&
-               b[i] != '\0') {
+        while (i < b.size() && strchr("+-.0123456789eEtruefals", b[i]) != nullptr && b[i] != '\0') {
           v.push_back(b[i++]);
         }
         if (v.empty()) return false;
@@ -417,8 +416,8 @@ Status WebServer::Start() {
     const unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_THREAD_PER_CONNECTION |
                            MHD_USE_POLL | MHD_USE_ERROR_LOG;
     mhd_ = MHD_start_daemon(
-        flags, 0, nullptr, nullptr, &OnRequest, this, MHD_OPTION_EXTERNAL_LOGGER,
-        &OnLibraryMessage, this, MHD_OPTION_LISTEN_SOCKET, static_cast<MHD_socket>(listen_fd_),
+        flags, 0, nullptr, nullptr, &OnRequest, this, MHD_OPTION_EXTERNAL_LOGGER, &OnLibraryMessage,
+        this, MHD_OPTION_LISTEN_SOCKET, static_cast<MHD_socket>(listen_fd_),
         MHD_OPTION_CONNECTION_LIMIT, static_cast<unsigned>(options_.max_connections),
         MHD_OPTION_PER_IP_CONNECTION_LIMIT, static_cast<unsigned>(options_.max_per_client),
         MHD_OPTION_CONNECTION_MEMORY_LIMIT, options_.connection_memory,
@@ -462,8 +461,8 @@ void WebServer::LogLibraryMessage(const char* text) {
   log_->Printf(LogLevel::kWarning, "web: refused or failed (libmicrohttpd): %s", line);
 }
 
-bool WebServer::Handle(MHD_Connection* c, const char* url, const char* method,
-                       const char* upload, size_t* upload_size, Request** request) {
+bool WebServer::Handle(MHD_Connection* c, const char* url, const char* method, const char* upload,
+                       size_t* upload_size, Request** request) {
   if (*request == nullptr) {
     Request* r = new (std::nothrow) Request;
     if (r == nullptr) return false;
@@ -588,8 +587,8 @@ void CommonHeaders(MHD_Response* response) {
 
 }  // namespace
 
-bool WebServer::Reply(MHD_Connection* c, Request* r, int status, const char* type,
-                      const void* data, size_t size, const char* why) {
+bool WebServer::Reply(MHD_Connection* c, Request* r, int status, const char* type, const void* data,
+                      size_t size, const char* why) {
   MHD_Response* response =
       MHD_create_response_from_buffer(size, const_cast<void*>(data), MHD_RESPMEM_MUST_COPY);
   if (response == nullptr) return false;

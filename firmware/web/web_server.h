@@ -53,9 +53,9 @@ class CameraDaemon;
 
 struct WebServerOptions {
   std::string address = "127.0.0.1";  // numeric IPv4 or IPv6
-  int32_t port = 0;                    // 0: any free port (see WebServer::port)
-  std::string token;                   // required, at least 16 characters
-  std::string web_root;                // index.html, app.js, style.css
+  int32_t port = 0;                   // 0: any free port (see WebServer::port)
+  std::string token;                  // required, at least 16 characters
+  std::string web_root;               // index.html, app.js, style.css
   std::string photo_dir;
   int32_t max_connections = 16;
   int32_t max_per_client = 8;

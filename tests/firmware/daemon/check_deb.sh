@@ -45,7 +45,8 @@ echo "check_deb: $(basename "$deb")"
 dpkg-deb -c "$deb" >"$work/contents.txt"
 cat "$work/contents.txt"
 for entry in "-rwxr-xr-x ./usr/bin/refocusd" "-rwxr-xr-x ./usr/bin/refocus" \
-             "-rw-r--r-- ./lib/systemd/system/refocusd.service" "-rw-r--r-- ./etc/refocusd.conf"; do
+             "-rw-r--r-- ./lib/systemd/system/refocusd.service" "-rw-r--r-- ./etc/refocusd.conf" \
+             "-rw-r--r-- ./usr/share/refocusd/www/index.html"; do
   mode=${entry%% *} path=${entry#* }
   grep -qE "^$mode root/root +[0-9]+ [0-9-]+ [0-9:]+ $path\$" "$work/contents.txt" ||
     fail "the package lacks $path with mode $mode owned by root"
@@ -57,6 +58,18 @@ field() { dpkg-deb -f "$deb" "$1"; }
 [[ $(field Version) == "$version" ]] || fail "version $(field Version), not $version"
 dpkg-deb --ctrl-tarfile "$deb" | tar -xO ./conffiles | grep -qx /etc/refocusd.conf ||
   fail "/etc/refocusd.conf is not a conffile"
+# The web page: every file of the source's www/ is in the package (the page that web_root's
+# default names), and the configuration shows the web settings, commented out (off by default).
+for page in "$source_dir"/firmware/web/www/*; do
+  grep -qE " \./usr/share/refocusd/www/$(basename "$page")\$" "$work/contents.txt" ||
+    fail "the package lacks the web page's $(basename "$page") in /usr/share/refocusd/www"
+done
+dpkg-deb --fsys-tarfile "$deb" | tar -xO ./etc/refocusd.conf >"$work/refocusd.conf"
+for key in web web_token web_root; do
+  grep -qE "^# $key = " "$work/refocusd.conf" || fail "/etc/refocusd.conf lacks a commented $key setting"
+done
+grep -qE "^# web_root = /usr/share/refocusd/www\$" "$work/refocusd.conf" ||
+  fail "the configuration's web_root is not where the package puts the page"
 depends=$(field Depends)
 echo "check_deb: Depends: $depends"
 
@@ -75,6 +88,7 @@ for program in refocusd refocus; do
       libexif.so.12) pkg=libexif12 ;;
       libmd.so.0) pkg=libmd0 ;;
       libz.so.1) pkg=zlib1g ;;
+      libmicrohttpd.so.12) pkg=libmicrohttpd12 ;;
       libcamera.so.* | libcamera-base.so.*) pkg=libcamera0.0.3 ;;
       *) fail "$program links $lib, which no known package provides" ;;
     esac

@@ -258,8 +258,8 @@ TEST(ConfigTest, WebIsOffUntilAnAddressAndATokenAreSet) {
   EXPECT_EQ(c.web_port, 8080);
   EXPECT_EQ(c.web_token, "0123456789abcdef");
   DaemonConfig v6;
-  ASSERT_TRUE(Parse("web = [::1]:0\nweb_token = 0123456789abcdef\nweb_root = /srv/www\n", &v6)
-                  .ok());
+  ASSERT_TRUE(
+      Parse("web = [::1]:0\nweb_token = 0123456789abcdef\nweb_root = /srv/www\n", &v6).ok());
   EXPECT_EQ(v6.web_address, "::1");
   EXPECT_EQ(v6.web_port, 0);
   EXPECT_EQ(v6.web_root, "/srv/www");
@@ -276,13 +276,15 @@ TEST(ConfigTest, WebWithoutAGoodTokenIsRefusedAtLoad) {
   EXPECT_EQ(Error("web = 127.0.0.1:8080\n"),
             "test.conf:1: web is on but web_token is not set (16 to 128 characters; the page asks "
             "for it)");
-  EXPECT_EQ(Error("web_token = short\n"), "test.conf:1: web_token: 5 characters; it needs 16 to 128");
+  EXPECT_EQ(Error("web_token = short\n"),
+            "test.conf:1: web_token: 5 characters; it needs 16 to 128");
   EXPECT_EQ(Error("web_token = has a space in it ok\n"),
             "test.conf:1: web_token: only printable ASCII characters without spaces are allowed");
   EXPECT_EQ(Error("web = camera.local:80\n"),
             "test.conf:1: web: 'camera.local' is not a numeric IPv4 address (e.g. 0.0.0.0:8080 or "
             "[::]:8080)");
-  EXPECT_EQ(Error("web = 0.0.0.0\n"), "test.conf:1: web: '0.0.0.0' is neither off nor ADDRESS:PORT");
+  EXPECT_EQ(Error("web = 0.0.0.0\n"),
+            "test.conf:1: web: '0.0.0.0' is neither off nor ADDRESS:PORT");
   EXPECT_NE(Error("web = 0.0.0.0:70000\n").find("test.conf:1: web: port: "), std::string::npos);
   EXPECT_EQ(Error("web_root = www\n"), "test.conf:1: web_root: 'www' is not an absolute path");
 }

@@ -10,7 +10,7 @@
 namespace lb::test {
 
 struct HttpResponse {
-  int status = 0;  // 0: no answer (the connection was closed or refused)
+  int status = 0;       // 0: no answer (the connection was closed or refused)
   std::string headers;  // raw header lines, "\r\n" separated
   std::string body;
   // The value of `name` (case-insensitive), "" when absent.

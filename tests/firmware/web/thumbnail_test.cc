@@ -56,7 +56,9 @@ TEST(ThumbnailTest, ShrinksToAbout320AndKeepsThePicture) {
   EXPECT_EQ(t.h, 240);
   EXPECT_LT(t.jpeg.size(), photo.size() / 4);
   EXPECT_LT(t.jpeg.size(), 20000u);
-  const auto luma = [&](int32_t x, int32_t y) { return t.ycc[static_cast<size_t>(y * t.w + x) * 3]; };
+  const auto luma = [&](int32_t x, int32_t y) {
+    return t.ycc[static_cast<size_t>(y * t.w + x) * 3];
+  };
   EXPECT_NEAR(luma(40, 120), 40, 6);
   EXPECT_NEAR(luma(280, 120), 210, 6);
 }

@@ -228,12 +228,13 @@ TEST_F(WebServerTest, ListingIsNewestFirstAndOnlyRegularPhotoFiles) {
   HttpResponse r = Get("/api/photos");
   ASSERT_EQ(r.status, 200);
   EXPECT_EQ(r.Header("Content-Type"), "application/json");
-  EXPECT_EQ(r.body, "{\"photos\":[{\"name\":\"d.jpg\",\"mtime\":3000,\"size\":4},"
-                    "{\"name\":\"b.jpg\",\"mtime\":3000,\"size\":2},"
-                    "{\"name\":\"c.JPEG\",\"mtime\":2000,\"size\":3},"
-                    "{\"name\":\"a.jpg\",\"mtime\":1000,\"size\":1},"
-                    "{\"name\":\"IMG_20260101_120000_0001.jpg\",\"mtime\":500,\"size\":" +
-                        std::to_string(photo_.size()) + "}]}");
+  EXPECT_EQ(r.body,
+            "{\"photos\":[{\"name\":\"d.jpg\",\"mtime\":3000,\"size\":4},"
+            "{\"name\":\"b.jpg\",\"mtime\":3000,\"size\":2},"
+            "{\"name\":\"c.JPEG\",\"mtime\":2000,\"size\":3},"
+            "{\"name\":\"a.jpg\",\"mtime\":1000,\"size\":1},"
+            "{\"name\":\"IMG_20260101_120000_0001.jpg\",\"mtime\":500,\"size\":" +
+                std::to_string(photo_.size()) + "}]}");
 }
 
 TEST_F(WebServerTest, PhotoDownloadAndThumbnail) {
@@ -297,9 +298,9 @@ TEST_F(WebServerTest, InfoPreviewRenderAndSaveReachTheRenderer) {
   EXPECT_FLOAT_EQ(backend_.last.y1, 0.9f);
   EXPECT_EQ(backend_.last.aperture.blades, 0);
 
-  for (const char* body : {"x0=0.5&y0=0.5", "name=a.jpg", "name=a.jpg&x0=2&y0=0.5",
-                           "name=a.jpg&x0=0.5&y0=0.5&f=0.5", "name=a.jpg&x0=0.5&y0=0.5&blades=2",
-                           "name=a.jpg&x0=nan&y0=0.5"}) {
+  for (const char* body :
+       {"x0=0.5&y0=0.5", "name=a.jpg", "name=a.jpg&x0=2&y0=0.5", "name=a.jpg&x0=0.5&y0=0.5&f=0.5",
+        "name=a.jpg&x0=0.5&y0=0.5&blades=2", "name=a.jpg&x0=nan&y0=0.5"}) {
     EXPECT_EQ(Post("/api/preview", body).status, 400) << body;
   }
   EXPECT_EQ(Http(port_, "POST", "/api/render", kAuth + "Content-Type: application/json\r\n",
@@ -332,17 +333,17 @@ TEST_F(WebServerTest, TraversalAbsolutePathsAndLinksAreRefused) {
   const std::string out_abs = outside_.Path("outside.jpg");
   for (const std::string& target : std::vector<std::string>{
            std::string("/photos/../outside.jpg"), std::string("/photos/..%2foutside.jpg"),
-        std::string("/photos/%2e%2e%2foutside.jpg"), std::string("/photos/%2E%2E/outside.jpg"),
-        std::string("/photos/%2f") + out_abs.substr(1), "/photos/" + out_abs,
-        "/thumbs/%2e%2e%2f%2e%2e%2f" + out_abs, "/api/info/..%2F..%2Fetc%2Fpasswd",
-        std::string("/photos/link.jpg"), std::string("/thumbs/link.jpg"),
-        std::string("/photos/.hidden.jpg"), std::string("/photos/a%00.jpg")}) {
+           std::string("/photos/%2e%2e%2foutside.jpg"), std::string("/photos/%2E%2E/outside.jpg"),
+           std::string("/photos/%2f") + out_abs.substr(1), "/photos/" + out_abs,
+           "/thumbs/%2e%2e%2f%2e%2e%2f" + out_abs, "/api/info/..%2F..%2Fetc%2Fpasswd",
+           std::string("/photos/link.jpg"), std::string("/thumbs/link.jpg"),
+           std::string("/photos/.hidden.jpg"), std::string("/photos/a%00.jpg")}) {
     HttpResponse r = Get(target);
     EXPECT_EQ(r.status, 400) << target << " " << r.body;
     EXPECT_EQ(r.body.find("OUTSIDE-SECRET"), std::string::npos) << target;
   }
-  for (const std::string& name : std::vector<std::string>{"../outside.jpg", out_abs, "link.jpg",
-                                                          "%2e%2e%2foutside.jpg"}) {
+  for (const std::string& name :
+       std::vector<std::string>{"../outside.jpg", out_abs, "link.jpg", "%2e%2e%2foutside.jpg"}) {
     EXPECT_EQ(Post("/api/preview", "name=" + name + "&x0=0.5&y0=0.5").status, 400) << name;
     EXPECT_EQ(Post("/api/save", "name=" + name + "&x0=0.5&y0=0.5").status, 400) << name;
   }
