@@ -2,8 +2,10 @@
 // depth, renders the shallow depth of field and saves the JPEG; see camera_daemon.h.
 #include <getopt.h>
 #include <signal.h>
+#include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <memory>
@@ -34,10 +36,14 @@ const char kUsage[] =
     "mounted later is found), and refuses a press with the reason unless a check at that press\n"
     "passes. A button that cannot be opened stops it (exit 1).\n"
     "\n"
+    "With web = ADDRESS:PORT it also serves the photo page (a gallery, tap to refocus, save,\n"
+    "download; web_token required); a port it cannot bind is logged and the camera runs on.\n"
+    "\n"
     "  --config FILE     configuration (default /etc/refocusd.conf; every key is documented "
     "there)\n"
     "  --check-config    read the configuration and check the camera, the button and the output\n"
-    "                    folder as at start; print every problem, one per line, and exit 1, or\n"
+    "                    folder as at start (and the web page's files when web is on); print\n"
+    "                    every problem, one per line, and exit 1, or\n"
     "                    \"configuration OK\" and exit 0 when everything holds\n"
     "  --version         print the version and the sensor backends of this build\n"
     "  --help            this text\n"
@@ -80,6 +86,14 @@ int CheckConfig(const char* path, const lb::DaemonConfig& config) {
   if (!s.ok()) {
     fprintf(stderr, "refocusd: %s\n", s.message());
     ++problems;
+  }
+  // The web page's files (the token was checked with the file).
+  if (config.web_on()) {
+    const std::string page = config.web_root + "/index.html";
+    if (access(page.c_str(), R_OK) != 0) {
+      fprintf(stderr, "refocusd: web_root: cannot read %s: %s\n", page.c_str(), strerror(errno));
+      ++problems;
+    }
   }
   if (problems > 0) return 1;
   printf("refocusd: %s: configuration OK\n", path);
