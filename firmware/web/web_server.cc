@@ -427,7 +427,9 @@ Status WebServer::Start() {
   });
   starter.join();
   if (mhd_ == nullptr) {
-    close(listen_fd_);
+    // Not closed here: whether libmicrohttpd already closed the socket it was given depends on
+    // where it failed (a thread or memory it could not get), and closing a number another
+    // thread may have reused since would be worse than one descriptor left open.
     listen_fd_ = -1;
     return Status(Code::kIoError, "web: libmicrohttpd did not start");
   }
@@ -445,9 +447,10 @@ Status WebServer::Start() {
 
 void WebServer::Stop() {
   if (mhd_ == nullptr) return;
-  MHD_stop_daemon(mhd_);  // joins every thread, frees every response (sinks come back)
+  // Joins every thread, frees every response (the sinks come back) and closes the listening
+  // socket it was given.
+  MHD_stop_daemon(mhd_);
   mhd_ = nullptr;
-  if (listen_fd_ >= 0) close(listen_fd_);
   listen_fd_ = -1;
   log_->Printf(LogLevel::kInfo, "web: stopped after %lld request(s)",
                static_cast<long long>(requests_.load()));

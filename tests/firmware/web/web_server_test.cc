@@ -435,6 +435,28 @@ TEST_F(WebServerTest, WebThreadsRunBelowTheCamera) {
   EXPECT_EQ(Get("/api/photos").status, 200);
 }
 
+int OpenFds() {
+  int n = 0;
+  DIR* d = opendir("/proc/self/fd");
+  while (dirent* e = readdir(d)) n += e->d_name[0] != '.' ? 1 : 0;
+  closedir(d);
+  return n;
+}
+
+TEST_F(WebServerTest, StopReleasesEveryDescriptorAndEveryThread) {
+  const int fds = OpenFds();
+  Start();
+  EXPECT_EQ(Get(std::string("/photos/") + kPhoto).status, 200);
+  EXPECT_EQ(Get(std::string("/thumbs/") + kPhoto).status, 200);
+  server_->Stop();
+  EXPECT_EQ(OpenFds(), fds);
+  EXPECT_EQ(sink_.Count("web: stopped after 2 request(s)"), 1) << sink_.All();
+  Start();  // again, on a fresh port
+  EXPECT_EQ(Get("/api/photos").status, 200);
+  server_.reset();
+  EXPECT_EQ(OpenFds(), fds);
+}
+
 TEST_F(WebServerTest, ABusyPortIsAClearError) {
   Start();
   WebServerOptions same = options_;
