@@ -386,13 +386,17 @@ Status RefocusEngine::Configure(const RefocusEngineConfig& config) {
   scratch_.reserve(file);
   extended_.resize(file);
   chunks_.reserve(file / kExtendedXmpChunk + 2);
-  png_.reserve(file / 4 * 3);  // base64 in the extended XMP: at most 3/4 of the file
+  // Base64 in the extended XMP: at most 3/4 of the file; a 16-bit depth PNG, at most its
+  // values' bytes and a little (stored rows of 64 KiB deflate blocks).
+  const size_t depth_px =
+      std::min(pixels, static_cast<size_t>(std::max(1, config.max_depth_pixels)));
+  png_.reserve(std::min(file / 4 * 3, depth_px * 2 + depth_px / 64 + 65536));
   original_.reserve(file / 4 * 3);
   rgb_rows_.resize(static_cast<size_t>(W) * 7);
   y_.resize(pixels);
   cb_.resize(cpx);
   cr_.resize(cpx);
-  depth_values_.resize(std::min(pixels, static_cast<size_t>(std::max(1, config.max_depth_pixels))));
+  depth_values_.resize(depth_px);
   disp_q8_.resize(depth_values_.size());
   py_.resize(ppx);
   pcb_.resize(pcpx);
