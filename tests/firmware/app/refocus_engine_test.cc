@@ -206,22 +206,71 @@ TEST_F(RefocusEngineTest, FocusMovesToTheTap) {
   }
 }
 
-TEST_F(RefocusEngineTest, PreviewFocusMoves) {
+// At preview size, against the same engine's preview at the photo's own focus: a photo whose
+// depth scale the preview step does not divide (the depth map resampled), and one where it does
+// (the render stage upsamples the stored map, as at full size).
+void CheckPreview(const Photo& p, int32_t side, bool divides) {
+  SCOPED_TRACE(p.path);
   RefocusEngine engine;
-  RefocusEngineConfig c = Config();
-  c.preview_side = 200;
+  RefocusEngineConfig c;
+  c.max_width = 800;
+  c.max_height = 600;
+  c.max_blur_radius = 16;
+  c.preview_side = side;
   ASSERT_TRUE(engine.Configure(c).ok());
-  const Photo& p = photos_->front();
   ASSERT_TRUE(engine.Load(p.path.c_str()).ok());
-  // As shot, at preview size: the same engine at the photo's own focus.
-  ASSERT_TRUE(engine.RenderPreview(engine.photo().current).ok());
+  const EnginePhoto& e = engine.photo();
+  const int32_t step = (std::max(e.width, e.height) + side - 1) / side;
+  ASSERT_GT(step, 1);
+  EXPECT_EQ(e.working_scale % step == 0, divides);
+  ASSERT_TRUE(engine.RenderPreview(e.current).ok());
   const Luma before = Decode(Output(engine));
   ASSERT_TRUE(engine.RenderPreview(TapAt(p, p.new_x, p.new_y)).ok());
   const Luma after = Decode(Output(engine));
-  EXPECT_EQ(after.width, engine.photo().preview_width);
-  EXPECT_LE(std::max(after.width, after.height), 200);
+  EXPECT_EQ(after.width, e.preview_width);
+  EXPECT_LE(std::max(after.width, after.height), side);
+  EXPECT_GE(after.width, e.width / step - 16);
   EXPECT_GT(Sharpness(after, p.new_x, p.new_y, 4), 1.5 * Sharpness(before, p.new_x, p.new_y, 4));
   EXPECT_LT(Sharpness(after, p.old_x, p.old_y, 8), 0.8 * Sharpness(before, p.old_x, p.old_y, 8));
+}
+
+TEST_F(RefocusEngineTest, PreviewFocusMovesFromAResampledDepthMap) {
+  CheckPreview(photos_->front(), 200, false);
+}
+
+TEST_F(RefocusEngineTest, PreviewFocusMovesFromTheStoredDepthMap) {
+  // 704 px wide: the pipeline works at half size (at most 640 px), and a 400 px preview is too.
+  CheckPreview(MakePhoto(*dir_, "IMG_d.jpg", 704, 528), 400, true);
+}
+
+TEST_F(RefocusEngineTest, DamagedFilesNeverCrashIt) {
+  RefocusEngine engine;
+  ASSERT_TRUE(engine.Configure(Config()).ok());
+  const std::vector<uint8_t> good = ReadFile(photos_->front().path);
+  const std::string bad = dir_->Path("damaged.jpg");
+  uint32_t seed = 12345;
+  int refused = 0;
+  for (int i = 0; i < 60; ++i) {
+    std::vector<uint8_t> bytes = good;
+    for (int k = 0; k < 1 + i % 4; ++k) {
+      seed = seed * 1664525u + 1013904223u;
+      // Most of the file is the XMP (depth and original): damage lands there and in the image.
+      bytes[seed % bytes.size()] ^= static_cast<uint8_t>(1 + (seed >> 24) % 255);
+    }
+    FILE* f = fopen(bad.c_str(), "wb");
+    ASSERT_NE(f, nullptr);
+    fwrite(bytes.data(), 1, bytes.size(), f);
+    fclose(f);
+    const Status s = engine.Load(bad.c_str());
+    if (!s.ok()) {
+      ++refused;
+      EXPECT_FALSE(engine.loaded());
+    } else {
+      EXPECT_TRUE(engine.RenderPreview(engine.photo().current).ok());
+    }
+  }
+  EXPECT_GT(refused, 0);
+  EXPECT_TRUE(engine.Load(photos_->front().path.c_str()).ok());
 }
 
 TEST_F(RefocusEngineTest, RefusesWhatItCannotTake) {
