@@ -477,6 +477,7 @@ Status RefocusEngine::Load(const char* path) {
   if (!configured_) return Status(Code::kInvalidArgument, "refocus engine: Load before Configure");
   loaded_ = false;
   output_size_ = 0;
+  WaitForCamera();  // reading and decoding a 12 MP photo takes about 0.1 s of a core
   Status s = LoadFile(path);
   scratch_.clear();  // the bytes are decoded; the buffer now holds outputs
   if (!s.ok()) return s;

@@ -317,11 +317,13 @@ TEST_F(RefocusEngineTest, WaitsWhileTheCameraIsBusy) {
   std::atomic<bool> busy{true};
   RefocusEngine engine;
   ASSERT_TRUE(engine.Configure(Config()).ok());
-  engine.set_camera_busy(&busy);
   const Photo& p = photos_->front();
   ASSERT_TRUE(engine.Load(p.path.c_str()).ok());
+  engine.set_camera_busy(&busy);
   std::atomic<bool> done{false};
   std::thread render([&] {
+    // Loading waits for the camera too; then the render, between strips.
+    EXPECT_TRUE(engine.Load(p.path.c_str()).ok());
     EXPECT_TRUE(engine.RenderFull(TapAt(p, p.new_x, p.new_y)).ok());
     done = true;
   });
