@@ -34,9 +34,13 @@ async function call(url, options, stillWanted) {
       continue;
     }
     if (!response.ok) {
+      // The server answers {"error": "..."}: show its words, not the JSON.
       let text = response.statusText;
-      try { text = (await response.text()).trim() || text; } catch (e) { /* keep statusText */ }
-      throw new Error(`${response.status} ${text}`);
+      try {
+        const body = (await response.text()).trim();
+        try { text = JSON.parse(body).error || body; } catch (e) { text = body || text; }
+      } catch (e) { /* keep statusText */ }
+      throw new Error(response.status === 422 ? 'this photo cannot be refocused: ' + text : text);
     }
     return response;
   }
