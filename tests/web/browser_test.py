@@ -262,11 +262,17 @@ def main():
 
         img = browser.find_element(By.ID, "photo")
         w, h = img.size["width"], img.size["height"]
-        ActionChains(browser).move_to_element_with_offset(
-            img, int((tap[0] - 0.5) * w), int((tap[1] - 0.5) * h)).click().perform()
-        # The full render may follow the preview within the poll interval: wait for either.
-        wait.until(lambda b: b.find_element(By.TAG_NAME, "body").get_attribute("data-preview-ms"))
-        latency = float(browser.find_element(By.TAG_NAME, "body").get_attribute("data-preview-ms"))
+        body = lambda b: b.find_element(By.TAG_NAME, "body")  # noqa: E731
+        # Three taps (the new point, back to the old focus, the new point again), each after the
+        # previous full render is done: the latency of a tap on an idle renderer, best of three
+        # (the host is shared), the last tap's preview and render kept for the checks.
+        for k, point in enumerate((tap, old, tap), start=1):
+            ActionChains(browser).move_to_element_with_offset(
+                img, int((point[0] - 0.5) * w), int((point[1] - 0.5) * h)).click().perform()
+            wait.until(lambda b: b.execute_script("return window.lbLatencies.length") == k)
+            wait.until(lambda b: body(b).get_attribute("data-state") == "rendered")
+        latencies = browser.execute_script("return window.lbLatencies")
+        latency = min(latencies)
         preview_url = browser.execute_script("return URL.createObjectURL(window.lbPreviewBlob)")
         pw = browser.execute_script(
             "return createImageBitmap(window.lbPreviewBlob).then(b => b.width)")
@@ -274,7 +280,6 @@ def main():
         measures = {}
         measures["preview"] = [sharp(preview_url, p, pw, 8) for p in (tap, old)]
         measures["original at preview size"] = [sharp(original, p, pw, 8) for p in (tap, old)]
-        state("rendered")
         browser.find_element(By.ID, "save").click()
         state("saved")
         saved = browser.find_element(By.TAG_NAME, "body").get_attribute("data-saved-name")
@@ -287,8 +292,9 @@ def main():
 
         for k, (at_tap, at_old) in measures.items():
             print(f"sharpness {k:>26}: at the tap {at_tap:8.1f}, at the old focus {at_old:8.1f}")
-        print(f"tap -> preview shown: {latency:.0f} ms (preview {pw} px wide); saved {saved}; "
-              f"screenshot {shot}")
+        print(f"tap -> preview shown: best {latency:.0f} ms of "
+              f"{', '.join(f'{v:.0f}' for v in latencies)} ms (preview {pw} px wide); "
+              f"saved {saved}; screenshot {shot}")
         failures = []
         for got, ref in (("preview", "original at preview size"), ("saved", "original")):
             if not measures[got][0] > 1.3 * measures[ref][0]:
