@@ -34,6 +34,11 @@ def skip(why):
     sys.exit(SKIP)
 
 
+def rss_kib(pid):
+    with open(f"/proc/{pid}/status") as f:
+        return int(next(line for line in f if line.startswith("VmRSS:")).split()[1])
+
+
 def free_port():
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
@@ -271,6 +276,8 @@ def main():
                 img, int((point[0] - 0.5) * w), int((point[1] - 0.5) * h)).click().perform()
             wait.until(lambda b: b.execute_script("return window.lbLatencies.length") == k)
             wait.until(lambda b: body(b).get_attribute("data-state") == "rendered")
+            if k == 1:
+                rss_first = rss_kib(daemon.pid)  # the engine's buffers all touched by now
         latencies = browser.execute_script("return window.lbLatencies")
         latency = min(latencies)
         preview_url = browser.execute_script("return URL.createObjectURL(window.lbPreviewBlob)")
@@ -286,6 +293,7 @@ def main():
         full_w = int(args.resolution.split("x")[0])
         measures["saved"] = [sharp(f"/photos/{saved}", p, full_w, 12) for p in (tap, old)]
         measures["original"] = [sharp(original, p, full_w, 12) for p in (tap, old)]
+        rss_last = rss_kib(daemon.pid)
         os.makedirs(args.out, exist_ok=True)
         shot = os.path.join(args.out, "browser_refocus.png")
         browser.save_screenshot(shot)
@@ -305,6 +313,10 @@ def main():
             failures.append(f"saved as '{saved}': not a new photo in the folder")
         if latency > args.max_latency_ms:
             failures.append(f"tap -> preview {latency:.0f} ms > {args.max_latency_ms:.0f} ms")
+        print(f"refocusd resident: {rss_first / 1024:.1f} MiB after the first render, "
+              f"{rss_last / 1024:.1f} MiB after three more renders and a save")
+        if rss_last - rss_first > 8 * 1024:
+            failures.append("refocusd's memory grew by more than 8 MiB")
         if daemon.poll() is not None:
             failures.append("refocusd ended")
         for f in failures:
