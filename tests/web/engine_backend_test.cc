@@ -155,12 +155,12 @@ TEST_F(EngineBackendTest, QueueIsBoundedAndPreviewsSupersede) {
   VectorSink a, b, c, d, e;
   std::thread t1([&] { first = backend.Render(path.c_str(), Tap(0.2f, 0.2f), false, &a); });
   auto wait_for = [&](int n) {
-    for (int i = 0; i < 500 && backend.queued() != n; ++i) {
+    for (int i = 0; i < 5000 && backend.queued() != n; ++i) {
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
     return backend.queued() == n;
   };
-  for (int i = 0; i < 500 && backend.loads() == 0; ++i) {
+  for (int i = 0; i < 5000 && backend.loads() == 0; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
   ASSERT_TRUE(wait_for(0));  // taken: it waits for the camera
@@ -193,7 +193,7 @@ TEST_F(EngineBackendTest, WaitingRequestsGiveUpWhileTheCameraWorks) {
   Status first;
   VectorSink a, b;
   std::thread t1([&] { first = backend.Render(path.c_str(), Tap(0.2f, 0.2f), false, &a); });
-  for (int i = 0; i < 500 && backend.loads() == 0; ++i) {
+  for (int i = 0; i < 5000 && backend.loads() == 0; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(50));
