@@ -108,20 +108,34 @@ Status Rerenderer::Render(const RerenderOptions& options, const char* out_path,
   render.SetRunner(&pool);
   LB_RETURN_IF_ERROR(render.Begin(reference(), disparity_q8(), options.render));
 
+  RerenderSource source;
+  source.disp_q8 = disparity_q8();
+  source.range = range_;
+  source.original_jpeg = &original_jpeg_;
+  source.orientation = orientation_;
+  source.width = width_;
+  source.height = height_;
+  return WriteRerendered(&render, options.render, source, options.quality, "refocus rerender",
+                         observer, options.progress, out_path);
+}
+
+Status WriteRerendered(RenderStage* render, const RenderParams& params,
+                       const RerenderSource& source, int quality, const char* software,
+                       StripObserver* observer, Progress* progress, const char* out_path) {
   AtomicFile file;
   LB_RETURN_IF_ERROR(file.Open(out_path));
   JpegMetadata meta;
   meta.make = "LensBlur";
   meta.model = "Re-rendered";
-  meta.software = "refocus rerender";
-  meta.f_number = options.render.f_number;
-  meta.orientation = orientation_;
-  LB_RETURN_IF_ERROR(BuildRefocusableSegments(disparity_q8(), range_, original_jpeg_,
-                                              FocusOf(render, options.render, width_, height_),
-                                              width_, &meta.extra_segments));
+  meta.software = software;
+  meta.f_number = params.f_number;
+  meta.orientation = source.orientation;
+  LB_RETURN_IF_ERROR(BuildRefocusableSegments(source.disp_q8, source.range, *source.original_jpeg,
+                                              FocusOf(*render, params, source.width, source.height),
+                                              source.width, &meta.extra_segments));
   JpegWriter writer;
-  LB_RETURN_IF_ERROR(writer.Begin(&file, width_, height_, options.quality, meta));
-  LB_RETURN_IF_ERROR(WriteStrips(&render, observer, &writer, options.progress));
+  LB_RETURN_IF_ERROR(writer.Begin(&file, source.width, source.height, quality, meta));
+  LB_RETURN_IF_ERROR(WriteStrips(render, observer, &writer, progress));
   return file.Commit();
 }
 

@@ -22,6 +22,23 @@ struct RerenderOptions {
   Progress* progress = nullptr;  // told how far the render is (borrowed)
 };
 
+// What a re-render writes besides the pixels: the depth the file carried, its all-in-focus
+// original and its orientation, so the new photo is refocusable again.
+struct RerenderSource {
+  ConstImageU16 disp_q8;
+  DisparityRange range;
+  const std::vector<uint8_t>* original_jpeg = nullptr;
+  int32_t orientation = 0;
+  int32_t width = 0, height = 0;
+};
+
+// The writing half of every re-render (`refocus rerender` and the web page's engine): `render`
+// has begun with `params`; its strips go through `observer` (may be nullptr) into a refocusable
+// JPEG written atomically at `out_path`. Allocates the metadata (XMP, EXIF) while it writes.
+Status WriteRerendered(RenderStage* render, const RenderParams& params,
+                       const RerenderSource& source, int quality, const char* software,
+                       StripObserver* observer, Progress* progress, const char* out_path);
+
 class Rerenderer {
  public:
   // Reads `path`: its GDepth must be RangeInverse and its depth map a whole-number fraction of
