@@ -47,10 +47,10 @@ cmake --preset host-asan >/dev/null || die "configure host-asan"
 cmake --build --preset host-asan -j "$jobs" || die "build host-asan"
 run_ctest host-asan --preset host-asan -LE 'data|vm|accuracy'
 
-step "host (Release): Middlebury and motion accuracy, the refocusd soak (500 presses)"
+step "host (Release): Middlebury and motion accuracy, the refocusd and web soaks, the page in Chromium"
 cmake --preset host >/dev/null || die "configure host"
 cmake --build --preset host -j "$jobs" || die "build host"
-run_ctest host-data --preset host -L 'data|soak|accuracy'
+run_ctest host-data --preset host -L 'data|soak|accuracy|browser'
 
 if [ -d tests/vm ]; then
   step "kernel drivers in a VM (vivid, uinput, vimc)"

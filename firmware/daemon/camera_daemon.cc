@@ -194,6 +194,7 @@ void CameraDaemon::OnPress() {
   ++counts_.presses;
   if (!busy_) {
     busy_ = start_ = true;
+    camera_busy_.store(true);
     state_ = State::kCapture;
     ++current_;
     log_->Printf(LogLevel::kInfo, "press: photo %d", current_);
@@ -262,6 +263,7 @@ void CameraDaemon::Worker() {
         log_->Printf(LogLevel::kInfo, "queued press: photo %d", current_);
       } else {
         busy_ = false;
+        camera_busy_.store(false);
         state_ = State::kIdle;
         idle_.notify_all();
       }

@@ -74,6 +74,9 @@ class CameraDaemon {
   Counts counts() const;
   // Every check holds, "ready" was logged.
   bool ready() const { return ready_.load(); }
+  // Set from a press until its photo (and a queued one) is done: other work on the board (the
+  // web page's renders) waits while it is set, so the camera comes first.
+  const std::atomic<bool>* camera_busy() const { return &camera_busy_; }
   // Tests: waits until no photo is in progress or queued; false on timeout.
   bool WaitIdle(int32_t timeout_ms);
 
@@ -132,6 +135,7 @@ class CameraDaemon {
   Log* log_;
   std::atomic<bool> stop_{false};
   std::atomic<bool> ready_{false};
+  std::atomic<bool> camera_busy_{false};  // mirrors busy_ for readers that take no lock
 
   // Run thread only, until ready: the checks' last findings and schedule.
   Problem camera_problem_, folder_problem_;

@@ -1,31 +1,26 @@
-// The renderer refocusd gives its web page. Until the fixed-memory engine (engine_backend.h,
-// class EngineBackend) is merged, a stand-in that answers kUnsupported: the gallery,
-// thumbnails and downloads work and the page says refocusing is not available yet. Once merged
-// this file returns std::make_unique<EngineBackend>(config, log, daemon).
+// The renderer refocusd gives its web page: EngineBackend, sized at start for the camera's photos.
+// With `resolution = 0x0` (the sensor's native size, known only once it is configured) it is
+// sized for kLargestPhoto; a larger photo in the folder is refused by the engine, not cropped.
+#include "firmware/daemon/camera_daemon.h"
+#include "firmware/web/engine_backend.h"
 #include "firmware/web/web_server.h"
 
 namespace lb {
 namespace {
 
-class UnavailableBackend final : public RefocusBackend {
- public:
-  Status Describe(const char*, PhotoInfo*) override { return Unavailable(); }
-  Status Render(const char*, const RefocusParams&, bool, ByteSink*) override {
-    return Unavailable();
-  }
-  Status Save(const char*, const RefocusParams&, const char*) override { return Unavailable(); }
-
- private:
-  static Status Unavailable() {
-    return Status(Code::kUnsupported, "refocusing from the page is not in this build yet");
-  }
-};
+// The largest sensor the product is specified for (12 MP, 4056x3040).
+constexpr int32_t kLargestWidth = 4056;
+constexpr int32_t kLargestHeight = 3040;
 
 }  // namespace
 
-std::unique_ptr<RefocusBackend> MakeRefocusBackend(const DaemonConfig& /*config*/, Log* /*log*/,
-                                                   CameraDaemon* /*daemon*/) {
-  return std::make_unique<UnavailableBackend>();
+std::unique_ptr<RefocusBackend> MakeRefocusBackend(const DaemonConfig& config, Log* log,
+                                                   CameraDaemon* daemon) {
+  const SensorConfig& sensor = config.job.sensor;
+  const bool sized = sensor.width > 0 && sensor.height > 0;
+  return std::make_unique<EngineBackend>(sized ? sensor.width : kLargestWidth,
+                                         sized ? sensor.height : kLargestHeight, config.job.threads,
+                                         log, daemon->camera_busy());
 }
 
 }  // namespace lb

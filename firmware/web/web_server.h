@@ -121,10 +121,8 @@ class WebServer {
   std::atomic<int64_t> requests_{0};
 };
 
-// The renderer the daemon gives the page: EngineBackend (firmware/web/engine_backend.h, the
-// fixed-memory engine, another change) once that is merged. Until then a backend that answers
-// kUnsupported to every call, so the gallery, thumbnails and downloads work and refocusing says
-// it is not available yet.
+// The renderer the daemon gives the page: EngineBackend (engine_backend.h), sized from the
+// configuration's resolution, yielding to the daemon's captures (backend_factory.cc).
 std::unique_ptr<RefocusBackend> MakeRefocusBackend(const DaemonConfig& config, Log* log,
                                                    CameraDaemon* daemon);
 
