@@ -61,7 +61,7 @@ echo "pictures: near focus at $near, far at $far (of 1920x1440)"
 
 # The page after a tap, from the browser test's screenshot.
 if [ -x "$refocusd" ] && /usr/bin/python3 "$root/tests/web/browser_test.py" --refocusd "$refocusd" \
-  --www "$root/firmware/web/www" --out "$tmp" --max-latency-ms 1e9 >"$tmp/browser.log" 2>&1; then
+  --www "$root/firmware/web/www" --out "$tmp" >"$tmp/browser.log" 2>&1; then
   /usr/bin/python3 - "$tmp" "$root/tests/web" <<'PY'
 import sys
 tmp, tests = sys.argv[1], sys.argv[2]

@@ -27,13 +27,48 @@
 
 namespace lb {
 
-// One request's state between libmicrohttpd's calls: the body so far (bounded) and whether an
-// answer was queued.
+// The decoded fields of a form body (application/x-www-form-urlencoded), as libmicrohttpd's
+// post processor hands them over: a value may come in pieces.
+struct Fields {
+  static constexpr int kMax = 12;
+  std::string key[kMax], value[kMax];
+  int count = 0;
+  const char* Get(const char* name) const {
+    for (int i = 0; i < count; ++i) {
+      if (key[i] == name) return value[i].c_str();
+    }
+    return nullptr;
+  }
+  // Adds `key` when `offset` is 0, else continues its value.
+  bool Add(const char* k, const char* data, uint64_t offset, size_t size) {
+    // A decoded NUL would cut the text the checks see short of what was sent.
+    if (memchr(data, '\0', size) != nullptr) return false;
+    if (offset == 0) {
+      if (count == kMax) return false;
+      key[count] = k;
+      value[count].clear();
+      ++count;
+    } else if (count == 0 || key[count - 1] != k || value[count - 1].size() != offset) {
+      return false;
+    }
+    value[count - 1].append(data, size);
+    return true;
+  }
+};
+
+// One request's state between libmicrohttpd's calls: the form fields so far (its post processor
+// decodes the body; at most max_body bytes) and whether an answer was queued.
 struct WebServer::Request {
+  ~Request() {
+    if (post != nullptr) MHD_destroy_post_processor(post);
+  }
   char method[8] = "";
   char path[168] = "";  // as logged
-  std::string body;
+  MHD_PostProcessor* post = nullptr;
+  Fields fields;
+  size_t body_bytes = 0;
   bool too_large = false;
+  bool bad_body = false;
   bool replied = false;
 };
 
@@ -155,111 +190,10 @@ void LoggablePath(const char* url, char* out, size_t size) {
   out[i] = '\0';
 }
 
-// The decoded fields of a form or a flat JSON object body.
-struct Fields {
-  static constexpr int kMax = 12;
-  std::string key[kMax], value[kMax];
-  int count = 0;
-  const char* Get(const char* name) const {
-    for (int i = 0; i < count; ++i) {
-      if (key[i] == name) return value[i].c_str();
-    }
-    return nullptr;
-  }
-  bool Add(std::string k, std::string v) {
-    if (count == kMax) return false;
-    // A decoded NUL would cut the text the checks see short of what was sent.
-    if (k.find('\0') != std::string::npos || v.find('\0') != std::string::npos) return false;
-    key[count] = std::move(k);
-    value[count] = std::move(v);
-    ++count;
-    return true;
-  }
-};
-
-// application/x-www-form-urlencoded: '+' is a space, %XX decoded by libmicrohttpd.
-bool ParseForm(const std::string& body, Fields* f) {
-  size_t pos = 0;
-  while (pos < body.size()) {
-    size_t end = body.find('&', pos);
-    if (end == std::string::npos) end = body.size();
-    std::string pair = body.substr(pos, end - pos);
-    pos = end + 1;
-    if (pair.empty()) continue;
-    for (char& ch : pair) ch = ch == '+' ? ' ' : ch;
-    const size_t eq = pair.find('=');
-    std::string k = pair.substr(0, eq);
-    std::string v = eq == std::string::npos ? std::string() : pair.substr(eq + 1);
-    k.resize(MHD_http_unescape(k.data()));
-    v.resize(MHD_http_unescape(v.data()));
-    if (!f->Add(std::move(k), std::move(v))) return false;
-  }
-  return true;
-}
-
-// A flat JSON object whose values are strings, numbers or booleans; anything else is refused.
-bool ParseJsonObject(const std::string& b, Fields* f) {
-  size_t i = 0;
-  auto space = [&] {
-    while (i < b.size() && (b[i] == ' ' || b[i] == '\t' || b[i] == '\r' || b[i] == '\n')) ++i;
-  };
-  auto string = [&](std::string* out) {
-    if (i >= b.size() || b[i] != '"') return false;
-    for (++i; i < b.size() && b[i] != '"'; ++i) {
-      char ch = b[i];
-      if (static_cast<unsigned char>(ch) < 0x20) return false;
-      if (ch == '\\') {
-        if (++i == b.size()) return false;
-        const char* from = "\"\\/bfnrt";
-        const char* to = "\"\\/\b\f\n\r\t";
-        const char* at = strchr(from, b[i]);
-        if (at == nullptr || b[i] == '\0') return false;  // \u: names are ASCII
-        ch = to[at - from];
-      }
-      out->push_back(ch);
-    }
-    if (i >= b.size()) return false;
-    ++i;
-    return true;
-  };
-  space();
-  if (i >= b.size() || b[i] != '{') return false;
-  ++i;
-  space();
-  if (i < b.size() && b[i] == '}') {
-    ++i;
-  } else {
-    for (;;) {
-      std::string k, v;
-      space();
-      if (!string(&k)) return false;
-      space();
-      if (i >= b.size() || b[i] != ':') return false;
-      ++i;
-      space();
-      if (i < b.size() && b[i] == '"') {
-        if (!string(&v)) return false;
-      } else {
-        while (i < b.size() && strchr("+-.0123456789eEtruefals", b[i]) != nullptr && b[i] != '\0') {
-          v.push_back(b[i++]);
-        }
-        if (v.empty()) return false;
-      }
-      if (!f->Add(std::move(k), std::move(v))) return false;
-      space();
-      if (i < b.size() && b[i] == ',') {
-        ++i;
-        continue;
-      }
-      if (i < b.size() && b[i] == '}') {
-        ++i;
-        break;
-      }
-      return false;
-    }
-  }
-  space();
-  return i == b.size();
+MHD_Result OnFormField(void* cls, MHD_ValueKind /*kind*/, const char* key, const char* /*filename*/,
+                       const char* /*type*/, const char* /*encoding*/, const char* data,
+                       uint64_t offset, size_t size) {
+  return static_cast<Fields*>(cls)->Add(key, data, offset, size) ? MHD_YES : MHD_NO;
 }
 
 bool Number(const char* text, float lo, float hi, float* out) {
@@ -478,7 +412,16 @@ bool WebServer::Handle(MHD_Connection* c, const char* url, const char* method, c
     if (length != nullptr && strtoull(length, nullptr, 10) > options_.max_body) {
       return ReplyError(c, r, MHD_HTTP_CONTENT_TOO_LARGE, "request body over the limit");
     }
-    if (strcmp(method, "POST") == 0) return true;  // the body comes in the next calls
+    if (strcmp(method, "POST") == 0) {
+      // Only form bodies, decoded by the library's own parser (NULL for any other type).
+      const char* type =
+          MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
+      if (type != nullptr && strncasecmp(type, MHD_HTTP_POST_ENCODING_FORM_URLENCODED,
+                                         strlen(MHD_HTTP_POST_ENCODING_FORM_URLENCODED)) == 0) {
+        r->post = MHD_create_post_processor(c, 1024, &OnFormField, &r->fields);
+      }
+      return true;  // the body comes in the next calls
+    }
   }
   Request* r = *request;
   if (r->replied) {
@@ -486,17 +429,23 @@ bool WebServer::Handle(MHD_Connection* c, const char* url, const char* method, c
     return true;
   }
   if (*upload_size != 0) {
-    if (!r->too_large && *upload_size <= options_.max_body - r->body.size()) {
-      r->body.append(upload, *upload_size);
-    } else {
+    if (r->too_large || *upload_size > options_.max_body - r->body_bytes) {
       r->too_large = true;
-      r->body.clear();
+    } else {
+      r->body_bytes += *upload_size;
+      if (r->post == nullptr || MHD_post_process(r->post, upload, *upload_size) != MHD_YES) {
+        r->bad_body = true;
+      }
     }
     *upload_size = 0;
     return true;
   }
   if (r->too_large) {
     return ReplyError(c, r, MHD_HTTP_CONTENT_TOO_LARGE, "request body over the limit");
+  }
+  if (r->bad_body) {
+    return ReplyError(c, r, MHD_HTTP_BAD_REQUEST,
+                      "the body is not a form (application/x-www-form-urlencoded)");
   }
   return Route(c, url, method, r);
 }
@@ -649,8 +598,7 @@ bool WebServer::ServePage(MHD_Connection* c, Request* r, const char* file, const
 }
 
 bool WebServer::Login(MHD_Connection* c, Request* r) {
-  Fields f;
-  const char* token = ParseForm(r->body, &f) ? f.Get("token") : nullptr;
+  const char* token = r->fields.Get("token");
   if (token == nullptr || !SameSecret(token, options_.token)) {
     // Each wrong guess costs its connection a moment (and the per-client limit caps those).
     std::this_thread::sleep_for(std::chrono::milliseconds(options_.failed_login_delay_ms));
@@ -757,16 +705,9 @@ bool WebServer::Info(MHD_Connection* c, Request* r, const char* name) {
 }
 
 bool WebServer::Refocus(MHD_Connection* c, Request* r, const char* action) {
-  Fields f;
-  const char* type = MHD_lookup_connection_value(c, MHD_HEADER_KIND, MHD_HTTP_HEADER_CONTENT_TYPE);
-  const bool json = type != nullptr && strncasecmp(type, "application/json", 16) == 0;
-  if (!(json ? ParseJsonObject(r->body, &f) : ParseForm(r->body, &f))) {
-    return ReplyError(c, r, MHD_HTTP_BAD_REQUEST,
-                      json ? "the body is not a flat JSON object" : "the body is not a form");
-  }
   std::string name;
   RefocusParams params;
-  Status s = ParseRefocus(f, &name, &params);
+  Status s = ParseRefocus(r->fields, &name, &params);
   int dir_fd = -1;
   if (s.ok()) s = OpenPhotoFolder(options_.photo_dir.c_str(), &dir_fd);
   if (s.ok()) {

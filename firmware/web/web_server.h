@@ -22,7 +22,8 @@
 //   GET  /thumbs/NAME    a JPEG about 320 px wide from the photo's main image (thumbnail.h)
 //   GET  /api/info/NAME  {"width":W,"height":H,"refocusable":B,"current":{"x0":..,"y0":..,
 //                        "x1":..,"y1":..,"f":..,"blades":N}}
-//   POST /api/preview, /api/render   body (form, or a flat JSON object) name, x0, y0, x1, y1
+//   POST /api/preview, /api/render   form body (application/x-www-form-urlencoded, decoded by
+//                                    libmicrohttpd; any other body is 400) name, x0, y0, x1, y1
 //                        (0..1 of the displayed photo; x1, y1 default to x0, y0: a tap), f
 //                        (f-number 1..22), blades (0 disc, 3..12) -> image/jpeg
 //   POST /api/save       the same body -> {"name":"IMG_..._r1.jpg"}, a new photo beside the

