@@ -82,24 +82,6 @@ bool SpanOutsideView(const WarpRow& r, int32_t ax, int32_t ay, int32_t bx, int32
          q8(ay < by ? ay : by) > ymax;
 }
 
-// The data term asks for a view's rows in order, the next one after the other views' (data_term.h),
-// and the only tap rows that row will read for the first time are the lower colour row and the
-// census row, one below this row's: the hardware prefetcher cannot guess where a warped row
-// starts, so the span asks for them now and the other views' work hides the misses.
-inline void PrefetchNextRow(const WarpRow& r, int32_t ax, int32_t ay) {
-  const int32_t x = ax >> 16, y = ay >> 16;
-  if (x < 0 || x >= r.width || y < 0 || y + 2 >= r.height) return;
-  const uint8_t* rgb = r.view + (y + 2) * r.stride + 3 * x;
-  __builtin_prefetch(rgb);
-  __builtin_prefetch(rgb + 3 * kAnchorStep + 5);
-  const int32_t cy = ((ay + 32768) >> 16) + 1;
-  const uint8_t* census = r.census_view + static_cast<ptrdiff_t>(cy) * 3 * r.width + x;
-  __builtin_prefetch(census);
-  __builtin_prefetch(census + r.width);
-  __builtin_prefetch(census + 2 * r.width);
-  __builtin_prefetch(census + 2 * r.width + kAnchorStep + 2);
-}
-
 }  // namespace
 
 namespace dtk {
@@ -162,7 +144,6 @@ void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
     int32_t bx = ax, by = ay;
     const bool b_ok = x1 == x0 ? a_ok : map(x1, &bx, &by);
     if (a_ok && b_ok && !SpanOutsideView(row, ax, ay, bx, by)) {
-      PrefetchNextRow(row, ax, ay);
       batch[batched++] = WarpSpanJob{x0, x1 - x0, ax, ay, bx, by, lo, hi};
       if (batched == kSpanBatch) {
         span(row, batch, batched, out);
