@@ -220,14 +220,13 @@ LB_AVX2 inline __attribute__((always_inline)) __m256i Cost(const WarpRow& r, con
   return CostFromTaps(r, k, x, _mm256_min_epi32(ad, k.trunc), t.census);
 }
 
-// 8 costs 0..255: two packs leave pixels 0-3 in dword 0 and 4-7 in dword 4.
+// 8 costs 0..255: two packs leave pixels 0-3 in dword 0 and 4-7 in dword 4, joined for one store.
 LB_AVX2 inline void Store8(uint8_t* out, __m256i cost) {
   const __m256i packed =
       _mm256_packus_epi16(_mm256_packus_epi32(cost, cost), _mm256_setzero_si256());
-  const uint32_t lo = static_cast<uint32_t>(_mm256_extract_epi32(packed, 0));
-  const uint32_t hi = static_cast<uint32_t>(_mm256_extract_epi32(packed, 4));
-  std::memcpy(out, &lo, 4);
-  std::memcpy(out + 4, &hi, 4);
+  const __m128i both =
+      _mm_unpacklo_epi32(_mm256_castsi256_si128(packed), _mm256_extracti128_si256(packed, 1));
+  _mm_storel_epi64(reinterpret_cast<__m128i*>(out), both);
 }
 
 // Any step: lanes may leave the view, or need taps from different rows. The costs of pixels
@@ -345,7 +344,8 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
   const __m256i fy = _mm256_sub_epi32(ys, _mm256_slli_epi32(yb, 8));
   const __m256i nx = _mm256_sub_epi32(xb, _mm256_cmpgt_epi32(fx, Load(kC.near.v)));
   // Each half's least pair column: its first lane when the positions rise, else its last.
-  const __m256i least = band.rising ? _mm256_shuffle_epi32(xb, 0x00) : _mm256_shuffle_epi32(xb, 0xff);
+  const __m256i least =
+      band.rising ? _mm256_shuffle_epi32(xb, 0x00) : _mm256_shuffle_epi32(xb, 0xff);
   const __m256i start =
       _mm256_min_epi32(_mm256_add_epi32(least, _mm256_add_epi32(least, least)), k.last_window);
   const int32_t start_lo = _mm256_cvtsi256_si32(start), start_hi = _mm256_extract_epi32(start, 4);
@@ -395,8 +395,8 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
   }
   if (band.two_census) {
     const __m256i ny = _mm256_sub_epi32(yb, _mm256_cmpgt_epi32(fy, Load(kC.near.v)));
-    census = _mm256_blendv_epi8(census, census2,
-                                _mm256_cmpeq_epi32(ny, _mm256_set1_epi32(band.cy + 1)));
+    census =
+        _mm256_blendv_epi8(census, census2, _mm256_cmpeq_epi32(ny, _mm256_set1_epi32(band.cy + 1)));
   }
   Store8(dst, CostFromTaps(r, k, x, ad, census));
 }
@@ -472,6 +472,23 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpSpanJob* jobs, int32_t c
         Step(r, k, x, xq, yq, costs);
       }
       std::memcpy(out + job->lo, costs + (job->lo - x), static_cast<size_t>(job->hi - job->lo));
+      continue;
+    }
+    if (in_band && n == kAnchorStep && job->lo == job->x0 && job->hi == job->x0 + n) {
+      // A whole span of the band (most of them): its second step's positions are its first's
+      // moved 8 pixels on, Q16 parts and remainders both.
+      const __m256i ix = _mm256_add_epi32(_mm256_set1_epi32(job->ax), _mm256_mullo_epi32(iota, qx));
+      const __m256i iy = _mm256_add_epi32(_mm256_set1_epi32(job->ay), _mm256_mullo_epi32(iota, qy));
+      const __m256i rem_x = _mm256_add_epi32(half, _mm256_mullo_epi32(iota, rx));
+      const __m256i rem_y = _mm256_add_epi32(half, _mm256_mullo_epi32(iota, ry));
+      BandStep(r, k, band, job->x0, _mm256_add_epi32(ix, _mm256_srli_epi32(rem_x, 16)),
+               _mm256_add_epi32(iy, _mm256_srli_epi32(rem_y, 16)), out + job->x0);
+      const __m256i ix8 = _mm256_add_epi32(ix, _mm256_slli_epi32(qx, 3));
+      const __m256i iy8 = _mm256_add_epi32(iy, _mm256_slli_epi32(qy, 3));
+      const __m256i rem_x8 = _mm256_add_epi32(rem_x, _mm256_slli_epi32(rx, 3));
+      const __m256i rem_y8 = _mm256_add_epi32(rem_y, _mm256_slli_epi32(ry, 3));
+      BandStep(r, k, band, job->x0 + kLanes, _mm256_add_epi32(ix8, _mm256_srli_epi32(rem_x8, 16)),
+               _mm256_add_epi32(iy8, _mm256_srli_epi32(rem_y8, 16)), out + job->x0 + kLanes);
       continue;
     }
     for (int32_t step = job->lo; step < job->hi; step += kLanes) {
