@@ -333,6 +333,9 @@ LB_AVX2 inline __m256i ChannelPairs(const uint8_t* row, int32_t start_lo, int32_
 // A step of such a span: no clamps, no checks; the third row and the second census row only where
 // the span reaches them (rows y + 2 <= h - 1 and cy + 1 <= h - 1, both some pixel's own). Channel
 // by channel, so the taps need no more registers than one channel's.
+// kTwoRows, kTwoCensus: the span's band.two_rows and two_census, fixed per instance so the
+// step has no branch on them.
+template <bool kTwoRows, bool kTwoCensus>
 LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, const Consts& k,
                                                             const Band& band, int32_t x, __m256i xq,
                                                             __m256i yq, uint8_t* dst) {
@@ -357,13 +360,14 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
   const __m128i ref_lo = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r.ref + 3 * x));
   const __m128i ref_hi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r.ref + 3 * x + 8));
   const __m256i ref = _mm256_inserti128_si256(_mm256_castsi128_si256(ref_lo), ref_hi, 1);
-  const __m256i lower = _mm256_cmpeq_epi32(yb, _mm256_set1_epi32(band.y + 1));
+  const __m256i lower =
+      kTwoRows ? _mm256_cmpeq_epi32(yb, _mm256_set1_epi32(band.y + 1)) : _mm256_setzero_si256();
   __m256i ad = _mm256_setzero_si256();
   for (int32_t c = 0; c < 3; ++c) {
     const uint8_t* row = band.row + c;
     __m256i top = ChannelPairs(row, start_lo, start_hi, idx);
     __m256i bottom = ChannelPairs(row + r.stride, start_lo, start_hi, idx);
-    if (band.two_rows) {
+    if (kTwoRows) {
       const __m256i third = ChannelPairs(row + 2 * r.stride, start_lo, start_hi, idx);
       top = _mm256_blendv_epi8(top, bottom, lower);
       bottom = _mm256_blendv_epi8(bottom, third, lower);
@@ -388,17 +392,36 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
     const __m256i pidx = _mm256_or_si256(_mm256_slli_epi32(e, shift), Load(kC.census_idx[p].v));
     const uint8_t* plane = band.crow + p * r.width + cstart;
     census = _mm256_or_si256(census, _mm256_shuffle_epi8(Broadcast16(plane), pidx));
-    if (band.two_census) {
+    if (kTwoCensus) {
       census2 =
           _mm256_or_si256(census2, _mm256_shuffle_epi8(Broadcast16(plane + census_row), pidx));
     }
   }
-  if (band.two_census) {
+  if (kTwoCensus) {
     const __m256i ny = _mm256_sub_epi32(yb, _mm256_cmpgt_epi32(fy, Load(kC.near.v)));
     census =
         _mm256_blendv_epi8(census, census2, _mm256_cmpeq_epi32(ny, _mm256_set1_epi32(band.cy + 1)));
   }
   Store8(dst, CostFromTaps(r, k, x, ad, census));
+}
+
+// A step of a span of the band, its instance chosen at run time (partial and short spans).
+LB_AVX2 inline void AnyBandStep(const WarpRow& r, const Consts& k, const Band& band, int32_t x,
+                                __m256i xq, __m256i yq, uint8_t* dst) {
+  if (band.two_rows) {
+    if (band.two_census) return BandStep<true, true>(r, k, band, x, xq, yq, dst);
+    return BandStep<true, false>(r, k, band, x, xq, yq, dst);
+  }
+  if (band.two_census) return BandStep<false, true>(r, k, band, x, xq, yq, dst);
+  BandStep<false, false>(r, k, band, x, xq, yq, dst);
+}
+
+// The two steps of a whole span of the band: pixels x..x+7 at (xq0, yq0), x+8..x+15 at (xq1, yq1).
+template <bool kTwoRows, bool kTwoCensus>
+LB_AVX2 void BandSpan(const WarpRow& r, const Consts& k, const Band& band, int32_t x,
+                      const __m256i* q, uint8_t* out) {
+  BandStep<kTwoRows, kTwoCensus>(r, k, band, x, q[0], q[1], out + x);
+  BandStep<kTwoRows, kTwoCensus>(r, k, band, x + kLanes, q[2], q[3], out + x + kLanes);
 }
 
 }  // namespace
@@ -467,7 +490,7 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpSpanJob* jobs, int32_t c
       positions(x, &xq, &yq);
       uint8_t costs[kLanes];
       if (in_band) {
-        BandStep(r, k, band, x, xq, yq, costs);
+        AnyBandStep(r, k, band, x, xq, yq, costs);
       } else {
         Step(r, k, x, xq, yq, costs);
       }
@@ -481,14 +504,25 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpSpanJob* jobs, int32_t c
       const __m256i iy = _mm256_add_epi32(_mm256_set1_epi32(job->ay), _mm256_mullo_epi32(iota, qy));
       const __m256i rem_x = _mm256_add_epi32(half, _mm256_mullo_epi32(iota, rx));
       const __m256i rem_y = _mm256_add_epi32(half, _mm256_mullo_epi32(iota, ry));
-      BandStep(r, k, band, job->x0, _mm256_add_epi32(ix, _mm256_srli_epi32(rem_x, 16)),
-               _mm256_add_epi32(iy, _mm256_srli_epi32(rem_y, 16)), out + job->x0);
       const __m256i ix8 = _mm256_add_epi32(ix, _mm256_slli_epi32(qx, 3));
       const __m256i iy8 = _mm256_add_epi32(iy, _mm256_slli_epi32(qy, 3));
       const __m256i rem_x8 = _mm256_add_epi32(rem_x, _mm256_slli_epi32(rx, 3));
       const __m256i rem_y8 = _mm256_add_epi32(rem_y, _mm256_slli_epi32(ry, 3));
-      BandStep(r, k, band, job->x0 + kLanes, _mm256_add_epi32(ix8, _mm256_srli_epi32(rem_x8, 16)),
-               _mm256_add_epi32(iy8, _mm256_srli_epi32(rem_y8, 16)), out + job->x0 + kLanes);
+      const __m256i q[4] = {_mm256_add_epi32(ix, _mm256_srli_epi32(rem_x, 16)),
+                            _mm256_add_epi32(iy, _mm256_srli_epi32(rem_y, 16)),
+                            _mm256_add_epi32(ix8, _mm256_srli_epi32(rem_x8, 16)),
+                            _mm256_add_epi32(iy8, _mm256_srli_epi32(rem_y8, 16))};
+      if (band.two_rows) {
+        if (band.two_census) {
+          BandSpan<true, true>(r, k, band, job->x0, q, out);
+        } else {
+          BandSpan<true, false>(r, k, band, job->x0, q, out);
+        }
+      } else if (band.two_census) {
+        BandSpan<false, true>(r, k, band, job->x0, q, out);
+      } else {
+        BandSpan<false, false>(r, k, band, job->x0, q, out);
+      }
       continue;
     }
     for (int32_t step = job->lo; step < job->hi; step += kLanes) {
@@ -496,7 +530,7 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpSpanJob* jobs, int32_t c
       const int32_t x = step + kLanes <= job->hi ? step : job->hi - kLanes;
       positions(x, &xq, &yq);
       if (in_band) {
-        BandStep(r, k, band, x, xq, yq, out + x);
+        AnyBandStep(r, k, band, x, xq, yq, out + x);
       } else {
         Step(r, k, x, xq, yq, out + x);
       }
