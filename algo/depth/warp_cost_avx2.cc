@@ -294,20 +294,26 @@ struct Band {
   bool rising;          // positions rise along the span: a step's first lane has its least column
 };
 
-bool BandOf(const WarpRow& r, const WarpSpanJob& job, Band* band) {
-  if (r.width < 16) return false;
-  const int64_t dx = int64_t{job.bx} - job.ax;
-  if ((dx < 0 ? -dx : dx) > int64_t{job.n} * 73728) return false;
-  const int32_t xmax = (r.width - 1) * 256, ymax = (r.height - 1) * 256;
+// The caller checks r.width >= 16 once. Positions |.| < 2^30, so differences fit 32 bits; a
+// Q8 position v lies in 0..max exactly when unsigned(v) <= max. A Q8 row position y has its
+// nearest row (y + 128) >> 8 whether or not its pair's upper row is clamped to h - 2.
+inline bool BandOf(const WarpRow& r, const WarpSpanJob& job, Band* band) {
+  const int32_t dx = job.bx - job.ax, reach = job.n * 73728;
+  if (dx > reach || -dx > reach) return false;
+  const uint32_t xmax = static_cast<uint32_t>(r.width - 1) * 256;
+  const uint32_t ymax = static_cast<uint32_t>(r.height - 1) * 256;
   const int32_t xa = (job.ax + 128) >> 8, xb = (job.bx + 128) >> 8;
   const int32_t ya = (job.ay + 128) >> 8, yb = (job.by + 128) >> 8;
-  if (Min(xa, xb) < 0 || Max(xa, xb) > xmax || Min(ya, yb) < 0 || Max(ya, yb) > ymax) {
+  if ((static_cast<uint32_t>(xa) > xmax) | (static_cast<uint32_t>(xb) > xmax) |
+      (static_cast<uint32_t>(ya) > ymax) | (static_cast<uint32_t>(yb) > ymax)) {
     return false;
   }
   const int32_t row_a = Min(ya >> 8, r.height - 2), row_b = Min(yb >> 8, r.height - 2);
-  const int32_t near_a = row_a + (ya - row_a * 256 >= 128 ? 1 : 0);
-  const int32_t near_b = row_b + (yb - row_b * 256 >= 128 ? 1 : 0);
-  if (Abs(row_a - row_b) > 1 || Abs(near_a - near_b) > 1) return false;
+  const int32_t near_a = (ya + 128) >> 8, near_b = (yb + 128) >> 8;
+  if ((static_cast<uint32_t>(row_a - row_b + 1) > 2) |
+      (static_cast<uint32_t>(near_a - near_b + 1) > 2)) {
+    return false;
+  }
   band->y = Min(row_a, row_b);
   band->cy = Min(near_a, near_b);
   band->row = r.view + band->y * r.stride;
@@ -483,7 +489,7 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpSpanJob* jobs, int32_t c
     };
     __m256i xq, yq;
     Band band{};
-    const bool in_band = BandOf(r, *job, &band);
+    const bool in_band = r.width >= 16 && BandOf(r, *job, &band);
     if (job->hi - job->lo < kLanes) {
       // A short range: one step over 8 pixels of the row that hold it, into a buffer.
       const int32_t x = Min(job->lo, r.width - kLanes);
