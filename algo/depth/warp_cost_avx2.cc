@@ -1,9 +1,11 @@
 // The plane sweep's span kernel for AVX2 (warp_cost.h; the C reference is dtk::PlaneSpansC in
-// warp_cost.cc): 8 pixels a step in 32-bit lanes. The view's taps come from byte shuffles of
-// 32-byte windows of the two rows when a step's taps share them (most steps: the positions
-// advance about one pixel per pixel), else from scalar loads (AVX2 gathers are slower than those
-// on some cores). Views narrower than a step or too large for 32-bit offsets, and census
-// weights over 31, take the reference.
+// warp_cost.cc): 8 pixels a step in 32-bit lanes. Spans inside the view whose taps stay in one
+// band of rows (most: the positions advance about one pixel per pixel) read each colour
+// channel's tap pairs from one 16-byte window per 128-bit half and row, picked by one byte
+// shuffle, and the census taps from 16-byte windows of the census planes; other steps take their
+// taps from byte shuffles of 32-byte windows of the two rows when they share them, else from
+// scalar loads (AVX2 gathers are slower than those on some cores). Views narrower than a step or
+// too large for 32-bit offsets, and census weights over 31, take the reference.
 #include "algo/depth/data_term_kernels.h"
 
 #if defined(__x86_64__)
