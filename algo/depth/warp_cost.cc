@@ -126,8 +126,15 @@ void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
   int32_t first = x_begin - x_begin % kAnchorStep;
   if (first == w - 1 && first > 0) first -= kAnchorStep;  // w - 1 ends the span before it
   // A span's end anchor is the next one's start: one Map per span.
+  // Where a 64-bit division is an instruction (x86-64, aarch64) Map's two are as fast as the
+  // row map's estimate and correction; on 32-bit ARM they are library calls.
+  constexpr bool kSlowDivision = sizeof(void*) < 8;
+  const PlaneRowMap row_map(h, y);
+  auto map = [&](int32_t x, int32_t* x_q16, int32_t* y_q16) {
+    return kSlowDivision ? row_map.At(x, x_q16, y_q16) : h.Map(x, y, x_q16, y_q16);
+  };
   int32_t ax = 0, ay = 0;
-  bool a_ok = h.Map(first, y, &ax, &ay);
+  bool a_ok = map(first, &ax, &ay);
   WarpSpanJob batch[kSpanBatch];
   int32_t batched = 0;
   for (int32_t x0 = first, end = 0; x0 < x_end; x0 = end) {
@@ -135,7 +142,7 @@ void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
     end = x1 == w - 1 ? w : x1;  // the last span keeps its end anchor
     const int32_t lo = x0 > x_begin ? x0 : x_begin, hi = end < x_end ? end : x_end;
     int32_t bx = ax, by = ay;
-    const bool b_ok = x1 == x0 ? a_ok : h.Map(x1, y, &bx, &by);
+    const bool b_ok = x1 == x0 ? a_ok : map(x1, &bx, &by);
     if (a_ok && b_ok && !SpanOutsideView(row, ax, ay, bx, by)) {
       batch[batched++] = WarpSpanJob{x0, x1 - x0, ax, ay, bx, by, lo, hi};
       if (batched == kSpanBatch) {

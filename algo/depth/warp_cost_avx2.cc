@@ -1,9 +1,11 @@
 // The plane sweep's span kernel for AVX2 (warp_cost.h; the C reference is dtk::PlaneSpansC in
-// warp_cost.cc): 8 pixels a step in 32-bit lanes. The view's taps come from byte shuffles of
-// 32-byte windows of the two rows when a step's taps share them (most steps: the positions
-// advance about one pixel per pixel), else from scalar loads (AVX2 gathers are slower than those
-// on some cores). Views narrower than a step or too large for 32-bit offsets, and census
-// weights over 31, take the reference.
+// warp_cost.cc): 8 pixels a step in 32-bit lanes. Spans inside the view whose taps stay in one
+// band of rows (most: the positions advance about one pixel per pixel) read each colour
+// channel's tap pairs from one 16-byte window per 128-bit half and row, picked by one byte
+// shuffle, and the census taps from 16-byte windows of the census planes; other steps take their
+// taps from byte shuffles of 32-byte windows of the two rows when they share them, else from
+// scalar loads (AVX2 gathers are slower than those on some cores). Views narrower than a step or
+// too large for 32-bit offsets, and census weights over 31, take the reference.
 #include "algo/depth/data_term_kernels.h"
 
 #if defined(__x86_64__)
@@ -107,7 +109,7 @@ LB_AVX2 inline void Pairs(__m256i ab0, __m256i ab2, __m256i* pairs) {
 // lookups of weight * bits (<= 31 * 4 per nibble, <= 248 per byte), summed in 16 then 32 bits.
 // Cost min(min(|dRGB|, trunc) + weighted bits, 255).
 struct Consts {
-  __m256i xmax, ymax, wm2, hm2, stride, census_row, trunc, invalid, lut;
+  __m256i xmax, ymax, wm2, hm2, stride, census_row, trunc, invalid, lut, last_window;
 };
 
 // Scalar loads: 8 bytes per tap row, the top one read forward (its 2 extra bytes lie in the row
@@ -182,6 +184,24 @@ LB_AVX2 inline __attribute__((always_inline)) void WindowTaps(const WarpRow& r, 
   t->census = bits;
 }
 
+// The costs of pixels x..x+7 from their truncated colour differences ad and their census taps.
+LB_AVX2 inline __attribute__((always_inline)) __m256i CostFromTaps(const WarpRow& r,
+                                                                   const Consts& k, int32_t x,
+                                                                   __m256i ad, __m256i census) {
+  const __m256i ref_bits =
+      _mm256_or_si256(_mm256_or_si256(_mm256_slli_epi32(Widen8(r.cref + x), 16),
+                                      _mm256_slli_epi32(Widen8(r.cref + r.width + x), 8)),
+                      Widen8(r.cref + 2 * r.width + x));
+  const __m256i bits = _mm256_xor_si256(census, ref_bits);
+  const __m256i nib = Load(kC.bytes15.v);
+  const __m256i count8 = _mm256_add_epi8(
+      _mm256_shuffle_epi8(k.lut, _mm256_and_si256(bits, nib)),
+      _mm256_shuffle_epi8(k.lut, _mm256_and_si256(_mm256_srli_epi16(bits, 4), nib)));
+  const __m256i ham =
+      _mm256_madd_epi16(_mm256_maddubs_epi16(count8, Load(kC.ones8.v)), Load(kC.ones16.v));
+  return _mm256_min_epi32(_mm256_add_epi32(ad, ham), Load(kC.max_cost.v));
+}
+
 // The costs of pixels x..x+7 from their taps, weights [256 - fx, fx] and row fractions fy.
 LB_AVX2 inline __attribute__((always_inline)) __m256i Cost(const WarpRow& r, const Consts& k,
                                                            int32_t x, const Taps& t, __m256i wx,
@@ -199,29 +219,16 @@ LB_AVX2 inline __attribute__((always_inline)) __m256i Cost(const WarpRow& r, con
     const __m256i rc = _mm256_shuffle_epi8(ref, Load(kMasks.ref[c]));
     ad = _mm256_add_epi32(ad, _mm256_abs_epi32(_mm256_sub_epi32(rc, v)));
   }
-  ad = _mm256_min_epi32(ad, k.trunc);
-  const __m256i ref_bits =
-      _mm256_or_si256(_mm256_or_si256(_mm256_slli_epi32(Widen8(r.cref + x), 16),
-                                      _mm256_slli_epi32(Widen8(r.cref + r.width + x), 8)),
-                      Widen8(r.cref + 2 * r.width + x));
-  const __m256i bits = _mm256_xor_si256(t.census, ref_bits);
-  const __m256i nib = Load(kC.bytes15.v);
-  const __m256i count8 = _mm256_add_epi8(
-      _mm256_shuffle_epi8(k.lut, _mm256_and_si256(bits, nib)),
-      _mm256_shuffle_epi8(k.lut, _mm256_and_si256(_mm256_srli_epi16(bits, 4), nib)));
-  const __m256i ham =
-      _mm256_madd_epi16(_mm256_maddubs_epi16(count8, Load(kC.ones8.v)), Load(kC.ones16.v));
-  return _mm256_min_epi32(_mm256_add_epi32(ad, ham), Load(kC.max_cost.v));
+  return CostFromTaps(r, k, x, _mm256_min_epi32(ad, k.trunc), t.census);
 }
 
-// 8 costs 0..255: two packs leave pixels 0-3 in dword 0 and 4-7 in dword 4.
+// 8 costs 0..255: two packs leave pixels 0-3 in dword 0 and 4-7 in dword 4, joined for one store.
 LB_AVX2 inline void Store8(uint8_t* out, __m256i cost) {
   const __m256i packed =
       _mm256_packus_epi16(_mm256_packus_epi32(cost, cost), _mm256_setzero_si256());
-  const uint32_t lo = static_cast<uint32_t>(_mm256_extract_epi32(packed, 0));
-  const uint32_t hi = static_cast<uint32_t>(_mm256_extract_epi32(packed, 4));
-  std::memcpy(out, &lo, 4);
-  std::memcpy(out + 4, &hi, 4);
+  const __m128i both =
+      _mm_unpacklo_epi32(_mm256_castsi256_si128(packed), _mm256_extracti128_si256(packed, 1));
+  _mm_storel_epi64(reinterpret_cast<__m128i*>(out), both);
 }
 
 // Any step: lanes may leave the view, or need taps from different rows. The costs of pixels
@@ -289,20 +296,26 @@ struct Band {
   bool rising;          // positions rise along the span: a step's first lane has its least column
 };
 
-bool BandOf(const WarpRow& r, const WarpSpanJob& job, Band* band) {
-  if (r.width < 16) return false;
-  const int64_t dx = int64_t{job.bx} - job.ax;
-  if ((dx < 0 ? -dx : dx) > int64_t{job.n} * 73728) return false;
-  const int32_t xmax = (r.width - 1) * 256, ymax = (r.height - 1) * 256;
+// The caller checks r.width >= 16 once. Positions |.| < 2^30, so differences fit 32 bits; a
+// Q8 position v lies in 0..max exactly when unsigned(v) <= max. A Q8 row position y has its
+// nearest row (y + 128) >> 8 whether or not its pair's upper row is clamped to h - 2.
+inline bool BandOf(const WarpRow& r, const WarpSpanJob& job, Band* band) {
+  const int32_t dx = job.bx - job.ax, reach = job.n * 73728;
+  if (dx > reach || -dx > reach) return false;
+  const uint32_t xmax = static_cast<uint32_t>(r.width - 1) * 256;
+  const uint32_t ymax = static_cast<uint32_t>(r.height - 1) * 256;
   const int32_t xa = (job.ax + 128) >> 8, xb = (job.bx + 128) >> 8;
   const int32_t ya = (job.ay + 128) >> 8, yb = (job.by + 128) >> 8;
-  if (Min(xa, xb) < 0 || Max(xa, xb) > xmax || Min(ya, yb) < 0 || Max(ya, yb) > ymax) {
+  if ((static_cast<uint32_t>(xa) > xmax) | (static_cast<uint32_t>(xb) > xmax) |
+      (static_cast<uint32_t>(ya) > ymax) | (static_cast<uint32_t>(yb) > ymax)) {
     return false;
   }
   const int32_t row_a = Min(ya >> 8, r.height - 2), row_b = Min(yb >> 8, r.height - 2);
-  const int32_t near_a = row_a + (ya - row_a * 256 >= 128 ? 1 : 0);
-  const int32_t near_b = row_b + (yb - row_b * 256 >= 128 ? 1 : 0);
-  if (Abs(row_a - row_b) > 1 || Abs(near_a - near_b) > 1) return false;
+  const int32_t near_a = (ya + 128) >> 8, near_b = (yb + 128) >> 8;
+  if ((static_cast<uint32_t>(row_a - row_b + 1) > 2) |
+      (static_cast<uint32_t>(near_a - near_b + 1) > 2)) {
+    return false;
+  }
   band->y = Min(row_a, row_b);
   band->cy = Min(near_a, near_b);
   band->row = r.view + band->y * r.stride;
@@ -313,8 +326,24 @@ bool BandOf(const WarpRow& r, const WarpSpanJob& job, Band* band) {
   return true;
 }
 
-// A step of such a span: no clamps, no checks; the second rows' windows only where the span
-// reaches them (rows y + 1 <= h - 2 and cy + 1 <= h - 1, both some pixel's own).
+// Channel c's tap pairs of 8 pixels from one row: each 128-bit half (pixels 0-3, 4-7) reads the
+// 16 bytes from its own start + c, start = 3 * (the half's least pair column) or 3 w - 18 if less,
+// so the read ends inside the row. A span of the band advances at most 9/8 px per pixel, so a
+// half's pair columns lie within 4 + 1 of its least: the pair's bytes d + c and d + c + 3 (d = 3 x
+// - start <= 12) are in the window, and one byte shuffle per row and channel picks them.
+LB_AVX2 inline __m256i ChannelPairs(const uint8_t* row, int32_t start_lo, int32_t start_hi,
+                                    __m256i idx) {
+  const __m128i lo = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + start_lo));
+  const __m128i hi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + start_hi));
+  return _mm256_shuffle_epi8(_mm256_inserti128_si256(_mm256_castsi128_si256(lo), hi, 1), idx);
+}
+
+// A step of such a span: no clamps, no checks; the third row and the second census row only where
+// the span reaches them (rows y + 2 <= h - 1 and cy + 1 <= h - 1, both some pixel's own). Channel
+// by channel, so the taps need no more registers than one channel's.
+// kTwoRows, kTwoCensus: the span's band.two_rows and two_census, fixed per instance so the
+// step has no branch on them.
+template <bool kTwoRows, bool kTwoCensus>
 LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, const Consts& k,
                                                             const Band& band, int32_t x, __m256i xq,
                                                             __m256i yq, uint8_t* dst) {
@@ -325,26 +354,82 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
   const __m256i fx = _mm256_sub_epi32(xs, _mm256_slli_epi32(xb, 8));
   const __m256i fy = _mm256_sub_epi32(ys, _mm256_slli_epi32(yb, 8));
   const __m256i nx = _mm256_sub_epi32(xb, _mm256_cmpgt_epi32(fx, Load(kC.near.v)));
-  Taps t;
-  const int32_t x_min = band.rising ? _mm256_cvtsi256_si32(xb) : _mm256_extract_epi32(xb, 7);
-  WindowTaps(r, band.row, band.crow, x_min, xb, nx, &t);
-  if (band.two_rows || band.two_census) {
-    Taps u;
-    WindowTaps(r, band.two_rows ? band.row + r.stride : band.row,
-               band.two_census ? band.crow + static_cast<ptrdiff_t>(3) * r.width : band.crow, x_min,
-               xb, nx, &u);
-    const __m256i lower = _mm256_cmpeq_epi32(yb, _mm256_set1_epi32(band.y + 1));
-    for (int32_t c = 0; c < 3; ++c) {
-      t.top[c] = _mm256_blendv_epi8(t.top[c], u.top[c], lower);
-      t.bottom[c] = _mm256_blendv_epi8(t.bottom[c], u.bottom[c], lower);
-    }
-    const __m256i ny = _mm256_sub_epi32(yb, _mm256_cmpgt_epi32(fy, Load(kC.near.v)));
-    t.census = _mm256_blendv_epi8(t.census, u.census,
-                                  _mm256_cmpeq_epi32(ny, _mm256_set1_epi32(band.cy + 1)));
-  }
+  // Each half's least pair column: its first lane when the positions rise, else its last.
+  const __m256i least =
+      band.rising ? _mm256_shuffle_epi32(xb, 0x00) : _mm256_shuffle_epi32(xb, 0xff);
+  const __m256i start =
+      _mm256_min_epi32(_mm256_add_epi32(least, _mm256_add_epi32(least, least)), k.last_window);
+  const int32_t start_lo = _mm256_cvtsi256_si32(start), start_hi = _mm256_extract_epi32(start, 4);
+  const __m256i d = _mm256_sub_epi32(_mm256_add_epi32(xb, _mm256_add_epi32(xb, xb)), start);
+  const __m256i idx =
+      _mm256_add_epi32(_mm256_add_epi32(d, _mm256_slli_epi32(d, 16)), Load(kC.pair_idx[0].v));
   const __m256i wx =
       _mm256_add_epi32(_mm256_sub_epi32(Load(kC.one.v), fx), _mm256_slli_epi32(fx, 16));
-  Store8(dst, Cost(r, k, x, t, wx, fy));
+  const __m128i ref_lo = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r.ref + 3 * x));
+  const __m128i ref_hi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r.ref + 3 * x + 8));
+  const __m256i ref = _mm256_inserti128_si256(_mm256_castsi128_si256(ref_lo), ref_hi, 1);
+  const __m256i lower =
+      kTwoRows ? _mm256_cmpeq_epi32(yb, _mm256_set1_epi32(band.y + 1)) : _mm256_setzero_si256();
+  __m256i ad = _mm256_setzero_si256();
+  for (int32_t c = 0; c < 3; ++c) {
+    const uint8_t* row = band.row + c;
+    __m256i top = ChannelPairs(row, start_lo, start_hi, idx);
+    __m256i bottom = ChannelPairs(row + r.stride, start_lo, start_hi, idx);
+    if (kTwoRows) {
+      const __m256i third = ChannelPairs(row + 2 * r.stride, start_lo, start_hi, idx);
+      top = _mm256_blendv_epi8(top, bottom, lower);
+      bottom = _mm256_blendv_epi8(bottom, third, lower);
+    }
+    const __m256i t = _mm256_madd_epi16(top, wx), b = _mm256_madd_epi16(bottom, wx);
+    const __m256i sum =
+        _mm256_add_epi32(_mm256_slli_epi32(t, 8), _mm256_mullo_epi32(_mm256_sub_epi32(b, t), fy));
+    const __m256i v = _mm256_srai_epi32(_mm256_add_epi32(sum, Load(kC.half.v)), 16);
+    const __m256i rc = _mm256_shuffle_epi8(ref, Load(kMasks.ref[c]));
+    ad = _mm256_add_epi32(ad, _mm256_abs_epi32(_mm256_sub_epi32(rc, v)));
+  }
+  ad = _mm256_min_epi32(ad, k.trunc);
+  // The census taps: the 8 nearest columns lie within 16 of the least (7 * 9/8 + 2 < 16).
+  const int32_t x_min = band.rising ? _mm256_cvtsi256_si32(xb) : _mm256_extract_epi32(xb, 7);
+  const int32_t cstart = Min(x_min, r.width - 16);
+  const __m256i e = _mm256_sub_epi32(nx, _mm256_set1_epi32(cstart));
+  __m256i census = _mm256_setzero_si256();
+  __m256i census2 = _mm256_setzero_si256();
+  const ptrdiff_t census_row = static_cast<ptrdiff_t>(3) * r.width;
+  for (int32_t p = 0; p < 3; ++p) {
+    const int32_t shift = 8 * (2 - p);  // plane 0 holds the top byte
+    const __m256i pidx = _mm256_or_si256(_mm256_slli_epi32(e, shift), Load(kC.census_idx[p].v));
+    const uint8_t* plane = band.crow + p * r.width + cstart;
+    census = _mm256_or_si256(census, _mm256_shuffle_epi8(Broadcast16(plane), pidx));
+    if (kTwoCensus) {
+      census2 =
+          _mm256_or_si256(census2, _mm256_shuffle_epi8(Broadcast16(plane + census_row), pidx));
+    }
+  }
+  if (kTwoCensus) {
+    const __m256i ny = _mm256_sub_epi32(yb, _mm256_cmpgt_epi32(fy, Load(kC.near.v)));
+    census =
+        _mm256_blendv_epi8(census, census2, _mm256_cmpeq_epi32(ny, _mm256_set1_epi32(band.cy + 1)));
+  }
+  Store8(dst, CostFromTaps(r, k, x, ad, census));
+}
+
+// A step of a span of the band, its instance chosen at run time (partial and short spans).
+LB_AVX2 inline void AnyBandStep(const WarpRow& r, const Consts& k, const Band& band, int32_t x,
+                                __m256i xq, __m256i yq, uint8_t* dst) {
+  if (band.two_rows) {
+    if (band.two_census) return BandStep<true, true>(r, k, band, x, xq, yq, dst);
+    return BandStep<true, false>(r, k, band, x, xq, yq, dst);
+  }
+  if (band.two_census) return BandStep<false, true>(r, k, band, x, xq, yq, dst);
+  BandStep<false, false>(r, k, band, x, xq, yq, dst);
+}
+
+// The two steps of a whole span of the band: pixels x..x+7 at (xq0, yq0), x+8..x+15 at (xq1, yq1).
+template <bool kTwoRows, bool kTwoCensus>
+LB_AVX2 void BandSpan(const WarpRow& r, const Consts& k, const Band& band, int32_t x,
+                      const __m256i* q, uint8_t* out) {
+  BandStep<kTwoRows, kTwoCensus>(r, k, band, x, q[0], q[1], out + x);
+  BandStep<kTwoRows, kTwoCensus>(r, k, band, x + kLanes, q[2], q[3], out + x + kLanes);
 }
 
 }  // namespace
@@ -370,7 +455,8 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpSpanJob* jobs, int32_t c
                  _mm256_set1_epi32(3 * r.width),
                  _mm256_set1_epi32(r.trunc),
                  _mm256_set1_epi32(r.invalid),
-                 Load(lut)};
+                 Load(lut),
+                 _mm256_set1_epi32(3 * r.width - 18)};
   const __m256i half = _mm256_set1_epi32(32768);
   const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   for (const WarpSpanJob* job = jobs; job < jobs + count; ++job) {
@@ -405,18 +491,46 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpSpanJob* jobs, int32_t c
     };
     __m256i xq, yq;
     Band band{};
-    const bool in_band = BandOf(r, *job, &band);
+    const bool in_band = r.width >= 16 && BandOf(r, *job, &band);
     if (job->hi - job->lo < kLanes) {
       // A short range: one step over 8 pixels of the row that hold it, into a buffer.
       const int32_t x = Min(job->lo, r.width - kLanes);
       positions(x, &xq, &yq);
       uint8_t costs[kLanes];
       if (in_band) {
-        BandStep(r, k, band, x, xq, yq, costs);
+        AnyBandStep(r, k, band, x, xq, yq, costs);
       } else {
         Step(r, k, x, xq, yq, costs);
       }
       std::memcpy(out + job->lo, costs + (job->lo - x), static_cast<size_t>(job->hi - job->lo));
+      continue;
+    }
+    if (in_band && n == kAnchorStep && job->lo == job->x0 && job->hi == job->x0 + n) {
+      // A whole span of the band (most of them): its second step's positions are its first's
+      // moved 8 pixels on, Q16 parts and remainders both.
+      const __m256i ix = _mm256_add_epi32(_mm256_set1_epi32(job->ax), _mm256_mullo_epi32(iota, qx));
+      const __m256i iy = _mm256_add_epi32(_mm256_set1_epi32(job->ay), _mm256_mullo_epi32(iota, qy));
+      const __m256i rem_x = _mm256_add_epi32(half, _mm256_mullo_epi32(iota, rx));
+      const __m256i rem_y = _mm256_add_epi32(half, _mm256_mullo_epi32(iota, ry));
+      const __m256i ix8 = _mm256_add_epi32(ix, _mm256_slli_epi32(qx, 3));
+      const __m256i iy8 = _mm256_add_epi32(iy, _mm256_slli_epi32(qy, 3));
+      const __m256i rem_x8 = _mm256_add_epi32(rem_x, _mm256_slli_epi32(rx, 3));
+      const __m256i rem_y8 = _mm256_add_epi32(rem_y, _mm256_slli_epi32(ry, 3));
+      const __m256i q[4] = {_mm256_add_epi32(ix, _mm256_srli_epi32(rem_x, 16)),
+                            _mm256_add_epi32(iy, _mm256_srli_epi32(rem_y, 16)),
+                            _mm256_add_epi32(ix8, _mm256_srli_epi32(rem_x8, 16)),
+                            _mm256_add_epi32(iy8, _mm256_srli_epi32(rem_y8, 16))};
+      if (band.two_rows) {
+        if (band.two_census) {
+          BandSpan<true, true>(r, k, band, job->x0, q, out);
+        } else {
+          BandSpan<true, false>(r, k, band, job->x0, q, out);
+        }
+      } else if (band.two_census) {
+        BandSpan<false, true>(r, k, band, job->x0, q, out);
+      } else {
+        BandSpan<false, false>(r, k, band, job->x0, q, out);
+      }
       continue;
     }
     for (int32_t step = job->lo; step < job->hi; step += kLanes) {
@@ -424,7 +538,7 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpSpanJob* jobs, int32_t c
       const int32_t x = step + kLanes <= job->hi ? step : job->hi - kLanes;
       positions(x, &xq, &yq);
       if (in_band) {
-        BandStep(r, k, band, x, xq, yq, out + x);
+        AnyBandStep(r, k, band, x, xq, yq, out + x);
       } else {
         Step(r, k, x, xq, yq, out + x);
       }

@@ -61,6 +61,68 @@ double WorstAnchorError(const PlaneHomography& h, int32_t w, int32_t hgt, int32_
   return static_cast<double>(worst) / 65536.0;
 }
 
+// The row map PlaneCostRow uses gives Map's results exactly: on the planes of random motions
+// over whole rows, and on quotients built to sit at their rounding boundaries (exactly at half a
+// Q16 step, just below and above, the largest and smallest denominators and numerators) with
+// both signs, where an estimate off by one would show.
+TEST(WarpCostTest, RowMapEqualsMap) {
+  std::mt19937 rng(11);
+  const CameraIntrinsics k{512.0, 512.0, 320, 240};
+  int64_t compared = 0;
+  auto same = [&](const PlaneHomography& h, int32_t x, int32_t y) {
+    int32_t ex = 0, ey = 0, gx = 0, gy = 0;
+    const bool e = h.Map(x, y, &ex, &ey);
+    const bool g = PlaneRowMap(h, y).At(x, &gx, &gy);
+    ASSERT_EQ(e, g) << x << "," << y;
+    if (e) {
+      ASSERT_EQ(ex, gx) << x << "," << y;
+      ASSERT_EQ(ey, gy) << x << "," << y;
+      ++compared;
+    }
+  };
+  for (int32_t trial = 0; trial < 40; ++trial) {
+    const ViewMotion m = RandomMotion(rng, 5, 0.05);
+    const PlaneHomography h = MakePlaneHomography(k, m, 0.05 + trial * 0.5);
+    for (int32_t y = -40; y < 520; y += 7) {
+      for (int32_t x = -40; x < 680; ++x) same(h, x, y);
+    }
+  }
+  // Odd denominators, so 2^16 has an inverse modulo den and a numerator can be chosen for any
+  // remainder of |n| 2^16 + den / 2: 0 and 1 (a quotient just at or above a whole value), den - 1
+  // and den - 2 (just below the next).
+  std::uniform_int_distribution<int64_t> den_of(int64_t{1} << 19, (int64_t{1} << 31) - 1);
+  auto inverse_2_16 = [](int64_t den) {  // extended Euclid
+    int64_t r0 = den, r1 = 65536 % den, t0 = 0, t1 = 1;
+    while (r1 != 0) {
+      const int64_t q = r0 / r1;
+      std::swap(r0, r1);
+      r1 -= q * r0;
+      std::swap(t0, t1);
+      t1 -= q * t0;
+    }
+    return (t0 % den + den) % den;
+  };
+  for (int32_t trial = 0; trial < 100000; ++trial) {
+    const int64_t den = trial % 5 == 0   ? (int64_t{1} << 20) + 1
+                        : trial % 5 == 1 ? (int64_t{1} << 32) - 1
+                                         : 2 * den_of(rng) + 1;
+    const int64_t targets[4] = {0, 1, den - 1, den - 2};
+    const int64_t t = targets[trial % 4];
+    const uint64_t residue =
+        static_cast<uint64_t>(((t - den / 2) % den + den) % den) * inverse_2_16(den) % den;
+    // |n| = residue + j den below den 2^14 (else Map refuses it, which is compared too).
+    const int64_t j = static_cast<int64_t>(rng() % (1u << 14));
+    const int64_t a = static_cast<int64_t>(residue) + j * den;
+    ASSERT_EQ(((a << 16) + den / 2) % den, t);
+    PlaneHomography h;
+    h.m[8] = den;
+    h.m[2] = trial % 8 < 4 ? a : -a;
+    h.m[5] = (trial / 8) % 2 == 0 ? a : -a;
+    same(h, 0, 0);
+  }
+  EXPECT_GT(compared, 1000000);
+}
+
 // Stated bound (warp_cost.h): rotations up to 2 degrees, translations up to 2 % of the depth,
 // at 640x480 (f = 0.8 w and the synthetic scene's 65 degree field of view): chord error
 // 16^2 / 8 * 2 * sin(2 deg) / f / D <= 1/215 px, plus the Q16 rounding of the anchors. The
