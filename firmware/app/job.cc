@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <utility>
 
 #include "algo/motion/camera.h"
 #include "firmware/app/focus.h"
@@ -117,7 +118,7 @@ class XmpBuild final : public PendingSegments {
     std::vector<uint8_t> original;
     status_ = EncodeYCbCr420(reference_, quality_, &original);
     if (status_.ok()) {
-      status_ = BuildRefocusableSegments(disparity_, range_, original, focus_,
+      status_ = BuildRefocusableSegments(disparity_, range_, std::move(original), focus_,
                                          reference_.planes[0].width, &segments_);
     }
     build_s_ = Now() - t0;
