@@ -29,10 +29,6 @@ void FormatExifTime(char* out, size_t size) {
   strftime(out, size, "%Y:%m:%d %H:%M:%S", &local);
 }
 
-}  // namespace
-
-namespace {
-
 Status InsertPending(PendingSegments* pending, JpegWriter* writer) {
   const std::vector<JpegSegment>* segments = nullptr;
   LB_RETURN_IF_ERROR(pending->Take(&segments));
