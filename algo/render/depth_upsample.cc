@@ -7,10 +7,14 @@
 
 namespace lb {
 void DepthUpsampler::Carve(Arena& arena, int32_t width, int32_t height, int32_t scale,
-                           int32_t working_width, int32_t working_height) {
+                           int32_t working_width, int32_t working_height, int32_t workers) {
   width_ = width, height_ = height, scale_ = scale, ww_ = working_width, wh_ = working_height;
-  for (Guide& g : guide_) g.yuv = arena.Allocate<uint8_t>(static_cast<size_t>(3) * ww_);
-  uniform_ = arena.Allocate<uint8_t>(static_cast<size_t>(ww_));
+  workers_ = Clamp(workers, 1, kMaxWorkers);
+  for (int32_t w = 0; w < workers_; ++w) {
+    Cache& c = cache_[w];
+    for (Guide& g : c.guide) g.yuv = arena.Allocate<uint8_t>(static_cast<size_t>(3) * ww_);
+    c.uniform = arena.Allocate<uint8_t>(static_cast<size_t>(ww_));
+  }
   spatial_q8_ = arena.Allocate<uint16_t>(static_cast<size_t>(3) * scale_);
   range_q8_ = arena.Allocate<uint16_t>(766);
 }
@@ -20,8 +24,10 @@ void DepthUpsampler::Carve(Arena& arena, int32_t width, int32_t height, int32_t 
 void DepthUpsampler::Begin(const ConstPlanarU8& ref, ConstImageU16 disp_q8) {
   ref_ = ref;
   disp_ = disp_q8;
-  for (Guide& g : guide_) g.tag = -1;
-  uniform_tag_ = -1;
+  for (int32_t w = 0; w < workers_; ++w) {
+    for (Guide& g : cache_[w].guide) g.tag = -1;
+    cache_[w].uniform_tag = -1;
+  }
   // Spatial term (1 - (d / 1.75)^2)^2 of the distance d in working px between a sub-position and
   // a neighbour's centre: every neighbour of the 3x3 keeps some weight, the near ones most.
   for (int32_t f = 0; f < scale_; ++f) {
@@ -40,8 +46,8 @@ void DepthUpsampler::Begin(const ConstPlanarU8& ref, ConstImageU16 disp_q8) {
   }
 }
 
-const uint8_t* DepthUpsampler::GuideRow(int32_t wy) {
-  Guide& g = guide_[wy & 3];
+const uint8_t* DepthUpsampler::GuideRow(Cache& c, int32_t wy) {
+  Guide& g = c.guide[wy & 3];
   if (g.tag == wy) return g.yuv;
   g.tag = wy;
   const int32_t s = scale_;
@@ -68,9 +74,10 @@ const uint8_t* DepthUpsampler::GuideRow(int32_t wy) {
   return g.yuv;
 }
 
-const uint8_t* DepthUpsampler::UniformRow(int32_t wy) {
-  if (uniform_tag_ == wy) return uniform_;
-  uniform_tag_ = wy;
+const uint8_t* DepthUpsampler::UniformRow(Cache& c, int32_t wy) {
+  uint8_t* uniform = c.uniform;
+  if (c.uniform_tag == wy) return uniform;
+  c.uniform_tag = wy;
   const uint16_t* rows[3] = {disp_.Row(Max(wy - 1, 0)), disp_.Row(wy),
                              disp_.Row(Min(wy + 1, wh_ - 1))};
   for (int32_t wx = 0; wx < ww_; ++wx) {
@@ -79,19 +86,20 @@ const uint8_t* DepthUpsampler::UniformRow(int32_t wy) {
     for (int32_t i = 0; i < 3; ++i) {
       for (int32_t q : {l, wx, r}) lo = Min(lo, rows[i][q]), hi = Max(hi, rows[i][q]);
     }
-    uniform_[wx] = hi == lo ? kFlat : (hi - lo <= kSmoothQ8 ? kSmooth : kEdge);
+    uniform[wx] = hi == lo ? kFlat : (hi - lo <= kSmoothQ8 ? kSmooth : kEdge);
   }
-  return uniform_;
+  return uniform;
 }
 
-void DepthUpsampler::Row(int32_t y, uint16_t* out) {
+void DepthUpsampler::Row(int32_t y, uint16_t* out, int32_t worker) {
+  Cache& c = cache_[worker];
   const int32_t s = scale_;
   const int32_t wy = Min(y / s, wh_ - 1);
   const int32_t fy = Min(y - wy * s, s - 1);
   const int32_t wys[3] = {Max(wy - 1, 0), wy, Min(wy + 1, wh_ - 1)};
-  const uint8_t* guide[3] = {GuideRow(wys[0]), GuideRow(wys[1]), GuideRow(wys[2])};
+  const uint8_t* guide[3] = {GuideRow(c, wys[0]), GuideRow(c, wys[1]), GuideRow(c, wys[2])};
   const uint16_t* disp[3] = {disp_.Row(wys[0]), disp_.Row(wys[1]), disp_.Row(wys[2])};
-  const uint8_t* uniform = UniformRow(wy);
+  const uint8_t* uniform = UniformRow(c, wy);
   const uint8_t* luma = ref_.planes[0].Row(y);
   const uint8_t* cb = ref_.planes[1].Row(y / 2);
   const uint8_t* cr = ref_.planes[2].Row(y / 2);

@@ -12,17 +12,21 @@
 
 #include "algo/core/arena.h"
 #include "algo/core/image.h"
+#include "algo/core/task_runner.h"
 
 namespace lb {
 
 class DepthUpsampler {
  public:
   // Carves the guide rows and the weight tables (tables are filled when the arena is real).
+  // `workers` (1..kMaxWorkers) rows may be upsampled at once, each worker with guide rows of
+  // its own.
   void Carve(Arena& arena, int32_t width, int32_t height, int32_t scale, int32_t working_width,
-             int32_t working_height);
+             int32_t working_height, int32_t workers = 1);
   void Begin(const ConstPlanarU8& ref, ConstImageU16 disp_q8);
-  // Disparity (Q8.8, working px per view step) of every pixel of full-resolution row y.
-  void Row(int32_t y, uint16_t* disp_q8);
+  // Disparity (Q8.8, working px per view step) of every pixel of full-resolution row y. Rows of
+  // different workers may be made at once; the values do not depend on which worker made them.
+  void Row(int32_t y, uint16_t* disp_q8, int32_t worker = 0);
 
   static constexpr int32_t kRangeSigma = 16;  // colour distance (|dY|+|dCb|+|dCr|) of weight 1/4
   // Blocks whose 3x3 disparities span at most this (Q8, a quarter px) are a smooth surface: the
@@ -34,16 +38,20 @@ class DepthUpsampler {
     int32_t tag = -1;
     uint8_t* yuv = nullptr;  // 3 x working_width: mean Y, Cb, Cr of each block
   };
-  const uint8_t* GuideRow(int32_t wy);
-  const uint8_t* UniformRow(int32_t wy);
+  // One worker's cache of the rows around the row it makes.
+  struct Cache {
+    Guide guide[4];
+    uint8_t* uniform = nullptr;  // per working pixel of row uniform_tag: how its 3x3 agree
+    int32_t uniform_tag = -1;
+  };
+  const uint8_t* GuideRow(Cache& c, int32_t wy);
+  const uint8_t* UniformRow(Cache& c, int32_t wy);
 
-  int32_t width_ = 0, height_ = 0, scale_ = 1, ww_ = 0, wh_ = 0;
+  int32_t width_ = 0, height_ = 0, scale_ = 1, ww_ = 0, wh_ = 0, workers_ = 1;
   ConstPlanarU8 ref_;
   ConstImageU16 disp_;
-  Guide guide_[4];
+  Cache cache_[kMaxWorkers];
   enum : uint8_t { kEdge = 0, kSmooth = 1, kFlat = 2 };
-  uint8_t* uniform_ = nullptr;  // per working pixel of row uniform_tag_: how its 3x3 agree
-  int32_t uniform_tag_ = -1;
   uint16_t* spatial_q8_ = nullptr;  // [f * 3 + o]: offset o-1 seen from sub-position f
   uint16_t* range_q8_ = nullptr;    // [colour distance 0..765]
 };

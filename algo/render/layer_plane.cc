@@ -131,6 +131,11 @@ bool LayerPlane::stale() const {
 }
 
 void LayerPlane::CommitRow(int32_t y, const uint16_t* layer_of, int32_t offset) {
+  CommitRowShared(y, layer_of, offset);
+  next_row_ = y + 1;
+}
+
+void LayerPlane::CommitRowShared(int32_t y, const uint16_t* layer_of, int32_t offset) {
   ring_tag_[Slot(y)] = y;
   uint64_t* tiles = tiles_ + Slot(y) * layers_;
   uint64_t* pure = pure_ + Slot(y) * layers_;
@@ -149,7 +154,6 @@ void LayerPlane::CommitRow(int32_t y, const uint16_t* layer_of, int32_t offset) 
     }
     if (same) pure[e0 >> 8] |= bit;  // every pixel of the tile wholly in one layer
   }
-  next_row_ = y + 1;
 }
 
 uint64_t LayerPlane::Tiles(Scratch& s, int32_t k, int32_t y0, int32_t y1) const {

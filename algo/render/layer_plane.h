@@ -80,6 +80,10 @@ class LayerPlane {
   // After filling row y: records which columns each layer covers. `layer_of` maps a radius
   // (Q4 + offset) to (first layer << 8 | weight of the next layer Q8).
   void CommitRow(int32_t y, const uint16_t* layer_of, int32_t offset);
+  // CommitRow for rows that several workers fill at once (each row by one of them): it leaves
+  // next_row() alone, and Advance tells it once they are all committed.
+  void CommitRowShared(int32_t y, const uint16_t* layer_of, int32_t offset);
+  void Advance(int32_t next_row) { next_row_ = next_row; }
   int32_t next_row() const { return next_row_; }
   // Whether ring row y still holds plane row y, and whether a strip ever read a row that the
   // ring had already recycled (a sizing bug; checked once per row, reported by the stage).

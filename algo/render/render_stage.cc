@@ -109,10 +109,13 @@ Status RenderStage::Carve(Arena& arena) {
   radii_q4_ = arena.Allocate<int32_t>(static_cast<size_t>(radii_));
   radius_of_layer_ = arena.Allocate<int32_t>(static_cast<size_t>(layers_));
   layer_of_ = arena.Allocate<uint16_t>(static_cast<size_t>(c.max_radius) * 32 + 1);
-  disp_row_ = arena.Allocate<uint16_t>(static_cast<size_t>(c.width));
+  for (int32_t i = 0; i < c.workers; ++i) {
+    disp_row_[i] = arena.Allocate<uint16_t>(static_cast<size_t>(c.width));
+  }
   boost_q8_ = arena.Allocate<uint16_t>(256);
   histogram_ = arena.Allocate<uint32_t>(256);
-  upsampler_.Carve(arena, c.width, c.height, c.working_scale, c.working_width, c.working_height);
+  upsampler_.Carve(arena, c.width, c.height, c.working_scale, c.working_width, c.working_height,
+                   c.workers);
   // The luma ring also serves the chroma rows that the next chroma strip reads ahead.
   const int32_t look_ahead = Max(0, 2 * chroma_reach_ - luma_reach_) + 2;
   LB_RETURN_IF_ERROR(luma_.Carve(arena, c.width, c.height, 1, RenderConfig::kStripRows, 1, radii_q4,
@@ -216,23 +219,23 @@ Status RenderStage::Begin(const ConstPlanarU8& ref, ConstImageU16 disp_q8,
   return Status::Ok();
 }
 
-void RenderStage::FillLumaRow(int32_t y) {
-  upsampler_.Row(y, disp_row_);
+void RenderStage::FillLumaRow(int32_t y, int32_t worker) {
+  uint16_t* disp_row = disp_row_[worker];
+  upsampler_.Row(y, disp_row, worker);
   int16_t* s = luma_.RadiusRow(y);
   int16_t* v = luma_.ValueRow(y, 0);
   const uint8_t* luma = ref_.planes[0].Row(y);
   for (int32_t x = 0; x < config_.width; ++x) {
-    s[x] = static_cast<int16_t>(lens_.SignedRadiusQ4(disp_row_[x]));
+    s[x] = static_cast<int16_t>(lens_.SignedRadiusQ4(disp_row[x]));
     v[x] = static_cast<int16_t>((luma[x] * boost_q8_[luma[x]] + 128) >> 8);
   }
-  luma_.CommitRow(y, layer_of_, config_.max_radius * 16);
+  luma_.CommitRowShared(y, layer_of_, config_.max_radius * 16);
 }
 
 void RenderStage::FillChromaRow(int32_t cy) {
   // The chroma sample's radius is the mean of its 2x2 luma block's; its boost follows the
   // block's mean luma, applied to the chroma's distance from grey.
   const int32_t y0 = 2 * cy, y1 = Min(2 * cy + 1, config_.height - 1);
-  if (!luma_.Holds(y0) || !luma_.Holds(y1)) luma_stale_ = true;
   const int16_t* s0 = luma_.RadiusRow(y0);
   const int16_t* s1 = luma_.RadiusRow(y1);
   const uint8_t* l0 = ref_.planes[0].Row(y0);
@@ -250,7 +253,41 @@ void RenderStage::FillChromaRow(int32_t cy) {
     vb[x] = static_cast<int16_t>(((cb[x] - 128) * gain + 128) >> 8);
     vr[x] = static_cast<int16_t>(((cr[x] - 128) * gain + 128) >> 8);
   }
-  chroma_.CommitRow(cy, layer_of_, config_.max_radius * 16);
+  chroma_.CommitRowShared(cy, layer_of_, config_.max_radius * 16);
+}
+
+void RenderStage::FillRows(int32_t luma_end, int32_t chroma_end) {
+  // Contiguous runs of rows, one per worker: a worker's guide rows (depth_upsample.h) serve the
+  // rows next to each other. Every row's values depend on the row alone.
+  const int32_t tasks = runner_->workers();
+  const int32_t luma_begin = luma_.next_row();
+  if (luma_end > luma_begin) {
+    const int32_t n = luma_end - luma_begin;
+    ParallelFor(*runner_, Min(tasks, n), [&](int32_t t, int32_t worker) {
+      const int32_t parts = Min(tasks, n);
+      for (int32_t y = luma_begin + n * t / parts; y < luma_begin + n * (t + 1) / parts; ++y) {
+        FillLumaRow(y, worker);
+      }
+    });
+    luma_.Advance(luma_end);
+  }
+  const int32_t chroma_begin = chroma_.next_row();
+  if (chroma_end > chroma_begin) {
+    // A chroma row reads its two luma rows from the ring: they must still be there.
+    for (int32_t cy = chroma_begin; cy < chroma_end; ++cy) {
+      const int32_t y0 = 2 * cy, y1 = Min(2 * cy + 1, config_.height - 1);
+      if (!luma_.Holds(y0) || !luma_.Holds(y1)) luma_stale_ = true;
+    }
+    const int32_t n = chroma_end - chroma_begin;
+    ParallelFor(*runner_, Min(tasks, n), [&](int32_t t, int32_t) {
+      const int32_t parts = Min(tasks, n);
+      for (int32_t cy = chroma_begin + n * t / parts; cy < chroma_begin + n * (t + 1) / parts;
+           ++cy) {
+        FillChromaRow(cy);
+      }
+    });
+    chroma_.Advance(chroma_end);
+  }
 }
 
 Status RenderStage::NextStrip(ConstPlanarU8* strip, int32_t* y0, int32_t* rows) {
@@ -285,8 +322,7 @@ Status RenderStage::RenderBatch() {
   const int32_t last_rows = Min(kStrip, h - last_y0);
   const int32_t chroma_end = Min(ch, last_y0 / 2 + (last_rows + 1) / 2 + chroma_reach_);
   const int32_t luma_end = Min(h, Max(last_y0 + last_rows + luma_reach_, 2 * chroma_end));
-  while (luma_.next_row() < luma_end) FillLumaRow(luma_.next_row());
-  while (chroma_.next_row() < chroma_end) FillChromaRow(chroma_.next_row());
+  FillRows(luma_end, chroma_end);
   const int32_t offset = config_.max_radius * 16;
   ParallelFor(*runner_, batch_count_, [&](int32_t i, int32_t worker) {
     const int32_t y0 = batch_y0_ + i * kStrip, rows = Min(kStrip, h - y0);

@@ -109,7 +109,10 @@ class RenderStage {
   Status Carve(Arena& arena);
   Status RenderBatch();
   void FillTables();
-  void FillLumaRow(int32_t y);
+  // The ring rows a batch reads, split over the workers: luma rows first (the chroma rows'
+  // radii are their 2x2 blocks' means).
+  void FillRows(int32_t luma_end, int32_t chroma_end);
+  void FillLumaRow(int32_t y, int32_t worker);
   void FillChromaRow(int32_t y);
 
   RenderConfig config_;
@@ -128,12 +131,12 @@ class RenderStage {
   LayerPlane luma_, chroma_;
   int32_t radii_ = 0, layers_ = 0;
   int32_t luma_reach_ = 0, chroma_reach_ = 0;
-  int32_t* radii_q4_ = nullptr;         // radii_
-  int32_t* radius_of_layer_ = nullptr;  // layers_: kernel index of each layer, far to near
-  uint16_t* layer_of_ = nullptr;        // [signed radius Q4 + max_radius * 16]: layer << 8 | frac
-  uint16_t* disp_row_ = nullptr;        // one upsampled row
-  uint16_t* boost_q8_ = nullptr;        // [luma]: highlight gain, Q8
-  uint32_t* histogram_ = nullptr;       // 256 bins for the focus median
+  int32_t* radii_q4_ = nullptr;           // radii_
+  int32_t* radius_of_layer_ = nullptr;    // layers_: kernel index of each layer, far to near
+  uint16_t* layer_of_ = nullptr;          // [signed radius Q4 + max_radius * 16]: layer << 8 | frac
+  uint16_t* disp_row_[kMaxWorkers] = {};  // per worker: one upsampled row
+  uint16_t* boost_q8_ = nullptr;          // [luma]: highlight gain, Q8
+  uint32_t* histogram_ = nullptr;         // 256 bins for the focus median
 };
 
 }  // namespace lb

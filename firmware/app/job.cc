@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <utility>
 
 #include "algo/motion/camera.h"
 #include "firmware/app/focus.h"
@@ -28,10 +29,16 @@ void FormatExifTime(char* out, size_t size) {
   strftime(out, size, "%Y:%m:%d %H:%M:%S", &local);
 }
 
+Status InsertPending(PendingSegments* pending, JpegWriter* writer) {
+  const std::vector<JpegSegment>* segments = nullptr;
+  LB_RETURN_IF_ERROR(pending->Take(&segments));
+  return writer->InsertSegments(*segments);
+}
+
 }  // namespace
 
 Status WriteStrips(RenderStage* render, StripObserver* observer, JpegWriter* writer,
-                   Progress* progress) {
+                   Progress* progress, PendingSegments* pending) {
   for (;;) {
     ConstPlanarU8 strip;
     int32_t y0 = 0, rows = 0;
@@ -39,11 +46,16 @@ Status WriteStrips(RenderStage* render, StripObserver* observer, JpegWriter* wri
     if (rows == 0) break;
     if (observer) observer->OnStrip(strip, y0, rows);
     LB_RETURN_IF_ERROR(writer->WriteStrip(strip, rows));
+    // As soon as they are built: the writer holds its output in memory until then.
+    if (pending != nullptr && writer->holding() && pending->Ready()) {
+      LB_RETURN_IF_ERROR(InsertPending(pending, writer));
+    }
     if (progress) {
       const int64_t height = render->config().height;
       progress->Update("render", static_cast<int32_t>(100 * (y0 + rows) / height));
     }
   }
+  if (pending != nullptr && writer->holding()) LB_RETURN_IF_ERROR(InsertPending(pending, writer));
   return writer->Finish();
 }
 
@@ -67,6 +79,56 @@ class CountingSink final : public FrameSink {
   FrameSink* next_;
   int32_t frames_, done_ = 0;
   Progress* progress_;
+};
+
+// The refocusable XMP of a photo, built on the job's side thread (or inline without one) from
+// the reference and the disparity, which the render only reads meanwhile.
+class XmpBuild final : public PendingSegments {
+ public:
+  XmpBuild(SideTask* side, const Pipeline& p, const FocusUsed& focus, int quality)
+      : side_(side),
+        reference_(p.reference()),
+        disparity_(p.disparity_q8()),
+        range_{p.disp_min_q8(), p.disp_max_q8()},
+        focus_(focus),
+        quality_(quality) {}
+  void Start() { side_->Post(&XmpBuild::Run, this); }
+  bool Ready() override { return side_->Done(); }
+  Status Take(const std::vector<JpegSegment>** segments) override {
+    const double t0 = Now();
+    side_->Wait();
+    wait_s_ = Now() - t0;
+    *segments = &segments_;
+    return status_;
+  }
+  // After the build: its Status, and its segments handed over.
+  const Status& status() const { return status_; }
+  std::vector<JpegSegment> Release() { return std::move(segments_); }
+  double build_s() const { return build_s_; }
+  double wait_s() const { return wait_s_; }
+
+ private:
+  static void Run(void* self) { static_cast<XmpBuild*>(self)->Build(); }
+  void Build() {
+    const double t0 = Now();
+    std::vector<uint8_t> original;
+    status_ = EncodeYCbCr420(reference_, quality_, &original);
+    if (status_.ok()) {
+      status_ = BuildRefocusableSegments(disparity_, range_, std::move(original), focus_,
+                                         reference_.planes[0].width, &segments_);
+    }
+    build_s_ = Now() - t0;
+  }
+
+  SideTask* side_;
+  ConstPlanarU8 reference_;
+  ConstImageU16 disparity_;
+  DisparityRange range_;
+  FocusUsed focus_;
+  int quality_;
+  Status status_;
+  std::vector<JpegSegment> segments_;
+  double build_s_ = 0, wait_s_ = 0;
 };
 
 // The labeling's moves as the progress line's percentage.
@@ -118,6 +180,13 @@ Status Job::Configure(Sensor* sensor, const JobOptions& options) {
   LB_RETURN_IF_ERROR(pipeline_->Configure(pc, arena_.get(), arena_bytes_));
   if (pool_->workers() != pc.workers) LB_RETURN_IF_ERROR(pool_->Start(pc.workers));
   pipeline_->SetRunner(pool_.get());
+  // The XMP is built beside the render only when threads were given to the job: one thread
+  // means one.
+  if (pc.workers > 1 && options_.refocusable) {
+    LB_RETURN_IF_ERROR(side_.Start());
+  } else {
+    side_.Stop();
+  }
   return Status::Ok();
 }
 
@@ -175,20 +244,31 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
     meta.focal_35mm =
         static_cast<int32_t>(Focal35mmFromPx(mode_.focal_px, mode_.width, mode_.height) + 0.5);
   }
+  // The XMP precedes the image data. With a side thread it is built there while the first
+  // strips render and encode, and the writer holds their bytes until it comes (the file's bytes
+  // are the same); otherwise it is built here first.
+  XmpBuild xmp(&side_, p, FocusOf(p.render(), options_.render, mode_.width, mode_.height),
+               options_.quality);
+  SideTaskGuard joined(&side_);  // declared after `xmp`: its build never outlives it
+  PendingSegments* pending = nullptr;
   if (options_.refocusable) {
-    // The XMP precedes the image data, so it is built before the first strip is encoded.
-    std::vector<uint8_t> original;
-    LB_RETURN_IF_ERROR(EncodeYCbCr420(p.reference(), options_.quality, &original));
-    LB_RETURN_IF_ERROR(
-        BuildRefocusableSegments(p.disparity_q8(), {p.disp_min_q8(), p.disp_max_q8()}, original,
-                                 FocusOf(p.render(), options_.render, mode_.width, mode_.height),
-                                 mode_.width, &meta.extra_segments));
+    if (side_.started()) {
+      xmp.Start();
+      meta.segments_later = true;
+      pending = &xmp;
+    } else {
+      xmp.Start();  // runs here
+      LB_RETURN_IF_ERROR(xmp.status());
+      meta.extra_segments = xmp.Release();
+    }
   }
   AtomicFile file;
   LB_RETURN_IF_ERROR(file.Open(out_path));
   JpegWriter writer;
   LB_RETURN_IF_ERROR(writer.Begin(&file, mode_.width, mode_.height, options_.quality, meta));
-  LB_RETURN_IF_ERROR(WriteStrips(&p.render(), observer, &writer, progress_));
+  LB_RETURN_IF_ERROR(WriteStrips(&p.render(), observer, &writer, progress_, pending));
+  r.metadata_s = xmp.build_s();
+  r.metadata_wait_s = pending != nullptr ? xmp.wait_s() : 0;
   if (progress_ != nullptr) progress_->Update("write", 100);
   LB_RETURN_IF_ERROR(file.Commit());
   r.render_s = Now() - t2;

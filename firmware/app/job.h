@@ -7,9 +7,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "algo/pipeline/pipeline.h"
 #include "firmware/app/progress.h"
+#include "firmware/app/side_task.h"
 #include "hal/sensor.h"
 
 namespace lb {
@@ -36,6 +38,10 @@ struct JobOptions {
 
 struct JobReport {
   double capture_s = 0, depth_s = 0, render_s = 0;  // wall time of each stage
+  // Within render_s: building the refocusable XMP (the original's JPEG, the depth PNG, base64,
+  // MD5), beside the render when there are workers to spare, and how long the writer then waited
+  // for it after the last strip.
+  double metadata_s = 0, metadata_wait_s = 0;
   size_t arena_bytes = 0;
   int32_t focus_disp_q8 = 0;
   int32_t width = 0, height = 0;
@@ -52,12 +58,25 @@ class StripObserver {
 };
 
 class JpegWriter;
+struct JpegSegment;
+
+// Segments still being built (on a SideTask) for a writer begun with
+// JpegMetadata::segments_later.
+class PendingSegments {
+ public:
+  virtual ~PendingSegments() = default;
+  // Whether they are built (never blocks).
+  virtual bool Ready() = 0;
+  // Waits until they are built; the build's Status, and on success the segments.
+  virtual Status Take(const std::vector<JpegSegment>** segments) = 0;
+};
 
 // Encodes every strip `render` gives, showing each to `observer` (may be nullptr) first and
 // telling `progress` (may be nullptr) the rows done, then finishes the image: a burst's photo and
-// a re-render are written the same way.
+// a re-render are written the same way. With `pending`, its segments are inserted after the
+// first strip that finds them built (at the latest before the image is finished).
 Status WriteStrips(RenderStage* render, StripObserver* observer, JpegWriter* writer,
-                   Progress* progress = nullptr);
+                   Progress* progress = nullptr, PendingSegments* pending = nullptr);
 
 class Job {
  public:
@@ -86,6 +105,8 @@ class Job {
   SensorMode mode_;
   std::unique_ptr<Pipeline> pipeline_;
   std::unique_ptr<WorkerPool> pool_;
+  // With more than one worker: where the refocusable XMP is built while the render runs.
+  SideTask side_;
   Progress* progress_ = nullptr;
   std::unique_ptr<uint8_t, FreeDeleter> arena_;
   size_t arena_bytes_ = 0;

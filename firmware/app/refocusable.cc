@@ -1,5 +1,7 @@
 #include "firmware/app/refocusable.h"
 
+#include <utility>
+
 #include "firmware/refocusable/xmp_writer.h"
 
 namespace lb {
@@ -22,10 +24,17 @@ FocusUsed FocusOf(const RenderStage& render, const RenderParams& params, int32_t
 Status BuildRefocusableSegments(ConstImageU16 disp_q8, const DisparityRange& range,
                                 const std::vector<uint8_t>& original_jpeg, const FocusUsed& focus,
                                 int32_t width, std::vector<JpegSegment>* segments) {
+  return BuildRefocusableSegments(disp_q8, range, std::vector<uint8_t>(original_jpeg), focus, width,
+                                  segments);
+}
+
+Status BuildRefocusableSegments(ConstImageU16 disp_q8, const DisparityRange& range,
+                                std::vector<uint8_t>&& original_jpeg, const FocusUsed& focus,
+                                int32_t width, std::vector<JpegSegment>* segments) {
   RefocusableXmp xmp;
   // 16 bits: the stored depth decodes back to exactly the disparity the picture was rendered from.
   LB_RETURN_IF_ERROR(SetDepthFromDisparity(disp_q8, range, 16, &xmp));
-  xmp.image = original_jpeg;
+  xmp.image = std::move(original_jpeg);
   xmp.has_focus = true;
   xmp.focus.focal_distance = DepthForDisparity(focus.focus_disp_q8);
   xmp.focus.blur_at_infinity = focus.blur_at_infinity_px / static_cast<float>(width);

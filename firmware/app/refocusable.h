@@ -29,5 +29,9 @@ FocusUsed FocusOf(const RenderStage& render, const RenderParams& params, int32_t
 Status BuildRefocusableSegments(ConstImageU16 disp_q8, const DisparityRange& range,
                                 const std::vector<uint8_t>& original_jpeg, const FocusUsed& focus,
                                 int32_t width, std::vector<JpegSegment>* segments);
+// The same, taking the original over rather than copying it (a megabyte less at the peak).
+Status BuildRefocusableSegments(ConstImageU16 disp_q8, const DisparityRange& range,
+                                std::vector<uint8_t>&& original_jpeg, const FocusUsed& focus,
+                                int32_t width, std::vector<JpegSegment>* segments);
 
 }  // namespace lb

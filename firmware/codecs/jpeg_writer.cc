@@ -30,6 +30,11 @@ struct JpegWriter::State {
   AtomicFile* file = nullptr;
   std::vector<uint8_t>* memory = nullptr;
   Status sink_status;  // why the destination stopped, when it did
+  // JpegMetadata::segments_later: the output so far, whose first `splice` bytes are the headers
+  // before the late segments.
+  bool holding = false;
+  std::vector<uint8_t> held;
+  size_t splice = 0;
   int32_t width = 0, height = 0, next_row = 0;
   bool copy_rows = false;             // width not a multiple of 16: rows go through `pad`
   JSAMPARRAY pad[3] = {};             // padded copies, from libjpeg's image pool
@@ -52,19 +57,61 @@ JpegWriter::State* StateOf(j_common_ptr cinfo) {
 }
 void OnMessage(j_common_ptr, int) {}  // warnings (e.g. extra rows) are not failures here
 
-// Hands `bytes` of the output buffer to the sink; on failure records why and returns false.
-bool Drain(JpegWriter::State* s, size_t bytes) {
+// Appends to a vector; false when memory runs out.
+bool Append(const uint8_t* data, size_t bytes, std::vector<uint8_t>* out) {
+  try {
+    out->insert(out->end(), data, data + bytes);
+  } catch (const std::bad_alloc&) {
+    return false;
+  }
+  return true;
+}
+
+// Hands `bytes` at `data` to the sink; on failure records why and returns false.
+bool Emit(JpegWriter::State* s, const uint8_t* data, size_t bytes) {
   if (bytes == 0) return true;
   if (s->file != nullptr) {
-    s->sink_status = s->file->Write(s->buffer, bytes);
+    s->sink_status = s->file->Write(data, bytes);
     return s->sink_status.ok();
   }
-  try {
-    s->memory->insert(s->memory->end(), s->buffer, s->buffer + bytes);
-  } catch (const std::bad_alloc&) {
+  if (!Append(data, bytes, s->memory)) {
     s->sink_status =
         Status(Code::kOutOfMemory, "in-memory jpeg: out of memory at %zu bytes", s->memory->size());
     return false;
+  }
+  return true;
+}
+
+// Hands `bytes` of the output buffer on: to the sink, or to the held output while late segments
+// are awaited.
+bool Drain(JpegWriter::State* s, size_t bytes) {
+  if (!s->holding) return Emit(s, s->buffer, bytes);
+  if (!Append(s->buffer, bytes, &s->held)) {
+    s->sink_status = Status(Code::kOutOfMemory,
+                            "jpeg: out of memory holding %zu bytes for the "
+                            "late segments",
+                            s->held.size());
+    return false;
+  }
+  return true;
+}
+
+// An APPn segment's bytes as libjpeg's jpeg_write_marker lays them out.
+bool EmitSegment(JpegWriter::State* s, const JpegSegment& seg) {
+  const size_t length = seg.payload.size() + 2;
+  const uint8_t head[4] = {0xFF, seg.marker, static_cast<uint8_t>(length >> 8),
+                           static_cast<uint8_t>(length & 255)};
+  return Emit(s, head, sizeof(head)) && Emit(s, seg.payload.data(), seg.payload.size());
+}
+
+// Valid APPn segments for jpeg_write_marker.
+bool SegmentsOk(const std::vector<JpegSegment>& segments, const JpegSegment** bad) {
+  for (const JpegSegment& seg : segments) {
+    if (seg.marker < JPEG_APP0 || seg.marker > JPEG_APP0 + 15 ||
+        seg.payload.size() > JpegSegment::kMaxPayload) {
+      *bad = &seg;
+      return false;
+    }
   }
   return true;
 }
@@ -106,6 +153,8 @@ Status JpegWriter::Failed(Status status) {
   if (s->memory != nullptr) s->memory->clear();
   s->file = nullptr;
   s->memory = nullptr;
+  s->holding = false;
+  std::vector<uint8_t>().swap(s->held);
   active_ = false;
   return status;
 }
@@ -151,12 +200,10 @@ Status JpegWriter::Start(int32_t width, int32_t height, int quality, const JpegM
     return Failed(
         Status(Code::kInvalidArgument, "%s: jpeg quality %d not in 1..100", name, quality));
   }
-  for (const JpegSegment& seg : meta.extra_segments) {
-    if (seg.marker < JPEG_APP0 || seg.marker > JPEG_APP0 + 15 ||
-        seg.payload.size() > JpegSegment::kMaxPayload) {
-      return Failed(Status(Code::kInvalidArgument, "%s: bad APP segment (marker 0x%02X, %zu bytes)",
-                           name, seg.marker, seg.payload.size()));
-    }
+  const JpegSegment* bad = nullptr;
+  if (!SegmentsOk(meta.extra_segments, &bad)) {
+    return Failed(Status(Code::kInvalidArgument, "%s: bad APP segment (marker 0x%02X, %zu bytes)",
+                         name, bad->marker, bad->payload.size()));
   }
   std::vector<uint8_t> exif;
   if (meta.has_exif()) {
@@ -168,6 +215,9 @@ Status JpegWriter::Start(int32_t width, int32_t height, int quality, const JpegM
   s->next_row = 0;
   s->copy_rows = width % 16 != 0;
   s->sink_status = Status::Ok();
+  s->holding = false;
+  s->held.clear();
+  s->splice = 0;
   s->cinfo.client_data = s;
   s->cinfo.err = jpeg_std_error(&s->err);
   s->err.error_exit = OnError;
@@ -197,6 +247,16 @@ Status JpegWriter::Start(int32_t width, int32_t height, int quality, const JpegM
   for (const JpegSegment& seg : meta.extra_segments) {
     jpeg_write_marker(&s->cinfo, seg.marker, seg.payload.data(),
                       static_cast<unsigned int>(seg.payload.size()));
+  }
+  if (meta.segments_later) {
+    // Everything so far (SOI, EXIF or JFIF, the segments given now) goes before the late
+    // segments: it moves to the held output, and the splice point is its end. The frame and
+    // scan headers come with the first strip, after it.
+    s->holding = true;
+    if (!Drain(s, kOutputBuffer - s->dest.free_in_buffer)) SinkFailed(&s->cinfo);
+    s->dest.next_output_byte = s->buffer;
+    s->dest.free_in_buffer = kOutputBuffer;
+    s->splice = s->held.size();
   }
   if (s->copy_rows) {
     // libjpeg reads whole blocks, so odd widths go through rows padded by edge replication.
@@ -262,9 +322,38 @@ Status JpegWriter::WriteStrip(const ConstPlanarU8& strip, int32_t rows) {
   return Status::Ok();
 }
 
+bool JpegWriter::holding() const { return active_ && state_->holding; }
+
+Status JpegWriter::InsertSegments(const std::vector<JpegSegment>& segments) {
+  if (!active_) return Status(Code::kInternal, "jpeg writer: InsertSegments without Begin");
+  State* s = state_.get();
+  const char* name = s->file ? s->file->path() : "in-memory jpeg";
+  if (!s->holding) {
+    return Failed(Status(Code::kInternal, "%s: segments inserted twice or not announced", name));
+  }
+  const JpegSegment* bad = nullptr;
+  if (!SegmentsOk(segments, &bad)) {
+    return Failed(Status(Code::kInvalidArgument, "%s: bad APP segment (marker 0x%02X, %zu bytes)",
+                         name, bad->marker, bad->payload.size()));
+  }
+  // The held headers, the segments, then what the strips encoded meanwhile; libjpeg's buffer
+  // holds only bytes after those.
+  bool ok = Emit(s, s->held.data(), s->splice);
+  for (size_t i = 0; ok && i < segments.size(); ++i) ok = EmitSegment(s, segments[i]);
+  ok = ok && Emit(s, s->held.data() + s->splice, s->held.size() - s->splice);
+  s->holding = false;
+  std::vector<uint8_t>().swap(s->held);
+  if (!ok) return Failed(s->sink_status);
+  return Status::Ok();
+}
+
 Status JpegWriter::Finish() {
   if (!active_) return Status(Code::kInternal, "jpeg writer: Finish without Begin");
   State* s = state_.get();
+  if (s->holding) {
+    return Failed(Status(Code::kInvalidArgument, "%s: finished before the late segments came",
+                         s->file ? s->file->path() : "in-memory jpeg"));
+  }
   if (s->next_row != s->height) {
     return Failed(Status(Code::kInvalidArgument, "%s: finished after %d of %d rows",
                          s->file ? s->file->path() : "in-memory jpeg",

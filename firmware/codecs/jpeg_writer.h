@@ -27,6 +27,11 @@ struct JpegSegment {
 // The EXIF tags (written when any is set; otherwise a JFIF header is) and the other segments.
 struct JpegMetadata : ExifTags {
   std::vector<JpegSegment> extra_segments;  // written after the EXIF segment, in order
+  // More segments follow extra_segments, given later by JpegWriter::InsertSegments: the
+  // refocusable XMP is built on another thread while the first strips encode. The writer holds
+  // its output in memory until then (what the strips encoded so far compress to), so the file's
+  // bytes are the same as with every segment given at Begin.
+  bool segments_later = false;
 };
 
 class JpegWriter {
@@ -48,7 +53,14 @@ class JpegWriter {
   // shorter; chroma planes hold (rows + 1) / 2 rows of (width + 1) / 2 samples.
   Status WriteStrip(const ConstPlanarU8& strip, int32_t rows);
 
-  // Writes the end of the image and flushes it; every row must have been written.
+  // The segments announced by JpegMetadata::segments_later, at any point after Begin and
+  // before Finish: they go where Begin's segments end, and the held output follows them.
+  Status InsertSegments(const std::vector<JpegSegment>& segments);
+  // Whether the writer still waits for InsertSegments.
+  bool holding() const;
+
+  // Writes the end of the image and flushes it; every row must have been written, and the
+  // segments announced at Begin inserted.
   Status Finish();
 
   bool active() const { return active_; }

@@ -54,9 +54,13 @@ void AppendBase64(const char* name, const std::vector<uint8_t>& data, std::strin
 }
 
 // One rdf:Description with the fields; `data` puts the two Data blobs in, `fields` the rest.
+size_t Base64Chars(size_t bytes) { return (bytes + 2) / 3 * 4; }
+
 std::string Packet(const RefocusableXmp& xmp, bool fields, bool data, const char* extended_md5,
                    bool wrapper) {
   std::string p;
+  // Reserved whole: a megabyte-long packet grown by doubling would peak at twice its size.
+  p.reserve(4096 + (data ? Base64Chars(xmp.depth.data.size()) + Base64Chars(xmp.image.size()) : 0));
   if (wrapper) p += "<?xpacket begin=\"\xEF\xBB\xBF\" id=\"W5M0MpCehiHzreSzNTczkc9d\"?>\n";
   p += "<x:xmpmeta xmlns:x=\"adobe:ns:meta/\">\n";
   p += " <rdf:RDF xmlns:rdf=\"http://www.w3.org/1999/02/22-rdf-syntax-ns#\">\n";
@@ -156,10 +160,14 @@ Status BuildXmpSegments(const RefocusableXmp& xmp, std::vector<JpegSegment>* seg
     }
   }
   // Everything in one packet when it fits; otherwise the two Data blobs go to extended XMP.
-  const std::string single = Packet(xmp, true, true, nullptr, true);
-  if (single.size() <= kMaxXmpPacket) {
-    segments->push_back(MainSegment(single));
-    return Status::Ok();
+  // Blobs whose base64 alone is larger cannot fit: that packet is not built (megabytes, only to
+  // be measured).
+  if (Base64Chars(d.data.size()) + Base64Chars(xmp.image.size()) <= kMaxXmpPacket) {
+    const std::string single = Packet(xmp, true, true, nullptr, true);
+    if (single.size() <= kMaxXmpPacket) {
+      segments->push_back(MainSegment(single));
+      return Status::Ok();
+    }
   }
   const std::string extended = Packet(xmp, false, true, nullptr, false);
   if (extended.size() > UINT32_MAX) {
@@ -171,6 +179,7 @@ Status BuildXmpSegments(const RefocusableXmp& xmp, std::vector<JpegSegment>* seg
   if (main.size() > kMaxXmpPacket) {
     return Status(Code::kInternal, "depth xmp: main packet of %zu bytes", main.size());
   }
+  segments->reserve(1 + (extended.size() + kExtendedXmpChunk - 1) / kExtendedXmpChunk);
   segments->push_back(MainSegment(main));
   for (size_t offset = 0; offset < extended.size(); offset += kExtendedXmpChunk) {
     const size_t n =

@@ -13,6 +13,7 @@ Status RenderAll(const ConstPlanarU8& ref, ConstImageU16 disp_q8, int32_t scale,
   config.working_width = disp_q8.width;
   config.working_height = disp_q8.height;
   config.max_radius = setup.max_radius;
+  config.workers = setup.workers;
   LB_RETURN_IF_ERROR(RenderStage::Validate(config));
   std::vector<uint8_t> block(RenderStage::RequiredBytes(config) + Arena::kAlign);
   void* base =
@@ -20,6 +21,7 @@ Status RenderAll(const ConstPlanarU8& ref, ConstImageU16 disp_q8, int32_t scale,
   Arena arena(base, block.size() - Arena::kAlign);
   RenderStage stage;
   LB_RETURN_IF_ERROR(stage.Configure(config, arena));
+  stage.SetRunner(setup.runner);
   LB_RETURN_IF_ERROR(stage.Begin(ref, disp_q8, setup.params));
   out->radius_per_disp = stage.radius_per_disp();
   out->focus_disp = static_cast<float>(stage.focus_disp_q8()) / 256.0f;

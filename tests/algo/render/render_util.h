@@ -22,6 +22,8 @@ struct Rendered {
 struct RenderSetup {
   int32_t max_radius = 16;
   RenderParams params;
+  int32_t workers = 1;           // RenderConfig::workers
+  TaskRunner* runner = nullptr;  // borrowed; nullptr: the caller
 };
 
 // Configures a stage for the scene, renders every strip and checks the strip sequence.

@@ -4,8 +4,11 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -150,6 +153,55 @@ TEST_F(Refocusable, NotARefocusableFileIsAClearError) {
   Status s = r.Load(Path("plain.jpg").c_str());
   EXPECT_FALSE(s.ok());
   EXPECT_NE(std::string(s.message()).find("plain.jpg"), std::string::npos) << s.message();
+}
+
+// With threads the XMP is built beside the render and spliced in when it is ready; the file must
+// be the one a single thread writes (the EXIF time of taking aside).
+TEST_F(Refocusable, TheFileIsTheSameWithOneToFourThreads) {
+  auto read = [](const std::string& path) {
+    std::vector<uint8_t> bytes;
+    FILE* f = fopen(path.c_str(), "rb");
+    if (f == nullptr) return bytes;
+    for (int c; (c = fgetc(f)) != EOF;) bytes.push_back(static_cast<uint8_t>(c));
+    fclose(f);
+    return bytes;
+  };
+  // Blanks the DateTimeOriginal value ("YYYY:MM:DD HH:MM:SS"), the one field that may differ.
+  auto without_time = [](std::vector<uint8_t> b) {
+    for (size_t i = 0; i + 19 <= b.size(); ++i) {
+      const char* p = reinterpret_cast<const char*>(&b[i]);
+      if (p[4] == ':' && p[7] == ':' && p[10] == ' ' && p[13] == ':' && p[16] == ':' &&
+          isdigit(p[0]) && isdigit(p[18])) {
+        memset(&b[i], '0', 19);
+        break;
+      }
+    }
+    return b;
+  };
+  std::vector<uint8_t> one;
+  for (int32_t threads = 1; threads <= 4; ++threads) {
+    SCOPED_TRACE(threads);
+    JobOptions o;
+    o.sensor.width = 320;
+    o.sensor.height = 240;
+    o.pipeline.labels = 16;
+    o.threads = threads;
+    SyntheticSensor sensor;
+    Job job;
+    ASSERT_TRUE(job.Configure(&sensor, o).ok());
+    const std::string path = Path("threads.jpg");
+    JobReport report;
+    Status s = job.Run(path.c_str(), &report);
+    ASSERT_TRUE(s.ok()) << s.message();
+    EXPECT_GT(report.metadata_s, 0.0);
+    const std::vector<uint8_t> bytes = without_time(read(path));
+    ASSERT_GT(bytes.size(), 1000u);
+    if (threads == 1) {
+      one = bytes;
+    } else {
+      EXPECT_TRUE(bytes == one);
+    }
+  }
 }
 
 }  // namespace

@@ -211,6 +211,79 @@ TEST(JpegWriterTest, ExtraSegmentsFollowExifInOrder) {
   EXPECT_EQ(b[segs[2].second + 999], 0x5A);
 }
 
+// Segments given late (the refocusable XMP, built beside the render) land where they would have
+// at Begin: the file is the same byte for byte, wherever among the strips they come.
+TEST(JpegWriterTest, LateSegmentsGiveTheSameFile) {
+  JpegSegment xmp;
+  const char kXmp[] = "http://ns.adobe.com/xap/1.0/\0<x:xmpmeta/>";
+  xmp.payload.assign(kXmp, kXmp + sizeof(kXmp) - 1);
+  JpegSegment big;
+  big.marker = 0xE2;
+  big.payload.assign(JpegSegment::kMaxPayload, 0x33);
+  JpegSegment early;
+  early.marker = 0xE3;
+  early.payload.assign(10, 0x44);
+  JpegMetadata meta = CameraMetadata();
+  meta.extra_segments = {early, xmp, big};
+  // A texture large enough that the encoder's 16 KiB buffer drains several times.
+  const Ycc420 img = test::MakeTexture(320, 241);
+  test::ScratchDir dir;
+  ASSERT_TRUE(EncodeToFile(img, dir.Path("at_begin.jpg"), meta).ok());
+  const std::vector<uint8_t> want = test::ReadFile(dir.Path("at_begin.jpg"));
+  for (int32_t after : {0, 1, 7, 16}) {  // strips encoded before the segments come
+    SCOPED_TRACE(after);
+    JpegMetadata later = CameraMetadata();
+    later.extra_segments = {early};
+    later.segments_later = true;
+    AtomicFile file;
+    ASSERT_TRUE(file.Open(dir.Path("late.jpg").c_str()).ok());
+    JpegWriter writer;
+    ASSERT_TRUE(writer.Begin(&file, img.width, img.height, 95, later).ok());
+    int32_t strip = 0;
+    for (int32_t y = 0; y < img.height; y += 16, ++strip) {
+      if (strip == after) {
+        EXPECT_TRUE(writer.holding());
+        ASSERT_TRUE(writer.InsertSegments({xmp, big}).ok());
+      }
+      const int32_t rows = img.height - y < 16 ? img.height - y : 16;
+      ASSERT_TRUE(writer.WriteStrip(img.Strip(y, rows), rows).ok());
+    }
+    if (writer.holding()) {
+      ASSERT_TRUE(writer.InsertSegments({xmp, big}).ok());
+    }
+    EXPECT_FALSE(writer.holding());
+    ASSERT_TRUE(writer.Finish().ok());
+    ASSERT_TRUE(file.Commit().ok());
+    EXPECT_TRUE(test::ReadFile(dir.Path("late.jpg")) == want);
+  }
+}
+
+TEST(JpegWriterTest, LateSegmentsThatNeverComeFailAndLeaveNothing) {
+  const Ycc420 img = test::MakeTexture(64, 48);
+  test::ScratchDir dir;
+  JpegMetadata later = CameraMetadata();
+  later.segments_later = true;
+  {
+    AtomicFile file;
+    ASSERT_TRUE(file.Open(dir.Path("late.jpg").c_str()).ok());
+    JpegWriter writer;
+    ASSERT_TRUE(writer.Begin(&file, img.width, img.height, 95, later).ok());
+    for (int32_t y = 0; y < img.height; y += 16) {
+      ASSERT_TRUE(writer.WriteStrip(img.Strip(y, 16), 16).ok());
+    }
+    EXPECT_EQ(writer.Finish().code(), Code::kInvalidArgument);
+  }
+  {
+    AtomicFile file;
+    ASSERT_TRUE(file.Open(dir.Path("late.jpg").c_str()).ok());
+    JpegWriter writer;
+    ASSERT_TRUE(writer.Begin(&file, img.width, img.height, 95, CameraMetadata()).ok());
+    EXPECT_FALSE(writer.holding());
+    EXPECT_EQ(writer.InsertSegments({}).code(), Code::kInternal);  // none were announced
+  }
+  EXPECT_TRUE(dir.Entries().empty());
+}
+
 TEST(JpegWriterTest, BadArgumentsFailAndAbortTheFile) {
   test::ScratchDir dir;
   const std::string path = dir.Path("bad.jpg");
