@@ -1,5 +1,6 @@
 // Soak: the real refocusd with its web page on, many loopback clients for a few seconds (the
-// gallery's requests, downloads, thumbnails, and refusals), and a shutter press in the middle.
+// gallery's requests, downloads, thumbnails, previews of taps, and refusals), and a shutter press
+// in the middle.
 // The photo is saved while the page is busy, and resident memory and open descriptors are back
 // where they were once the clients stop.
 #include <gtest/gtest.h>
@@ -25,7 +26,7 @@ constexpr char kToken[] = "soak-token-0123456789";
 // Runs `clients` threads of mixed requests until `stop`; counts answers by class.
 struct Load {
   std::atomic<bool> stop{false};
-  std::atomic<int> ok{0}, refused{0}, unanswered{0};
+  std::atomic<int> ok{0}, refused{0}, unanswered{0}, previews{0};
   std::vector<std::thread> threads;
 
   void Start(int port, const std::string& photo, int clients) {
@@ -39,10 +40,21 @@ struct Load {
                                        "/",
                                        "/photos/..%2f..%2fetc%2fpasswd.jpg",
                                        "/api/info/" + photo};
+        const std::string form = auth + "Content-Type: application/x-www-form-urlencoded\r\n";
         for (int i = t; !stop.load(); ++i) {
           const std::string& target = targets[i % 6];
-          // Every seventh request comes without the token.
-          HttpResponse r = Http(port, "GET", target, i % 7 == 0 ? "" : auth, "", 10000);
+          HttpResponse r;
+          if (i % 5 == 4) {
+            // A tap somewhere: the renderer queues a few and answers the rest 503.
+            char body[160];
+            snprintf(body, sizeof(body), "name=%s&x0=0.%d&y0=0.%d&f=2", photo.c_str(), i % 10,
+                     (i / 10) % 10);
+            r = Http(port, "POST", "/api/preview", form, body, 10000);
+            if (r.status == 200 && r.Header("Content-Type") == "image/jpeg") ++previews;
+          } else {
+            // Every seventh request comes without the token.
+            r = Http(port, "GET", target, i % 7 == 0 ? "" : auth, "", 10000);
+          }
           if (r.status == 200) {
             ++ok;
           } else if (r.status != 0) {
@@ -113,11 +125,12 @@ TEST(WebSoakTest, ManyClientsAndAPressMemoryAndFilesStayFlat) {
   const long rss_after = d.ResidentKib();
   const int fds_after = d.OpenFds();
   printf(
-      "load: %d answered 200, %d refused (401/400), %d unanswered; press to saved %.2f s under "
-      "load; before %ld KiB %d fds, after %ld KiB %d fds\n",
-      load.ok.load(), load.refused.load(), load.unanswered.load(), press_s, rss_before, fds_before,
-      rss_after, fds_after);
+      "load: %d answered 200 (%d previews), %d refused (401/400/503), %d unanswered; press to "
+      "saved %.2f s under load; before %ld KiB %d fds, after %ld KiB %d fds\n",
+      load.ok.load(), load.previews.load(), load.refused.load(), load.unanswered.load(), press_s,
+      rss_before, fds_before, rss_after, fds_after);
   EXPECT_GT(load.ok.load(), 100);
+  EXPECT_GT(load.previews.load(), 5) << "the renderer answered the taps";
   EXPECT_GT(load.refused.load(), 20);
   EXPECT_LT(press_s, 10.0) << "a press is never held up by the page";
   ASSERT_GT(rss_before, 0);
