@@ -149,7 +149,12 @@ class DepthStage {
     uint64_t* row_labels = nullptr;
     int32_t* span = nullptr;
     int32_t* prev_span = nullptr;
+    // The rectangles of the move in progress and of the one before (move_rects.cc), at most
+    // rect_capacity each; their cut is exact however they are split (below).
     Rect* rects = nullptr;
+    Rect* prev_rects = nullptr;
+    int32_t rect_count = 0, prev_rect_count = 0, rect_capacity = 0;
+    uint8_t* row_took = nullptr;  // per row, 1 when a pixel of it took alpha (Record)
   };
   void CarveGrid(Arena& arena, Grid& g, int32_t width, int32_t height, bool prev_alpha);
   Grid& grid() { return on_coarse_ ? coarse_ : fine_; }
@@ -179,6 +184,7 @@ class DepthStage {
   // energy.
   bool Expand(int32_t alpha);
   int32_t MoveRects(int32_t alpha);
+  int32_t SplitRect(int32_t i, int32_t count, int32_t lo, int32_t hi);
   int64_t CutRect(int32_t alpha, const Rect& r);  // returns the energy change
   int32_t ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1);
   void PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1);
@@ -204,7 +210,12 @@ class DepthStage {
   // in storage the max-flow does not touch on the blocks' graphs; nullptr when it does not fit.
   uint16_t* block_costs_ = nullptr;
   enum : uint8_t { kFree = 0, kKeep = 1, kTake = 2 };
-  int32_t* move_rows_ = nullptr;                  // the moves' row ring (expansion_move.cc)
+  // A pixel's D in fine_.cost_alpha or prev_alpha where its move did not compute it: no D is
+  // this large (DataTerm::kMaxCost).
+  static constexpr uint16_t kNotComputed = 0xffff;
+  uint16_t CostAt(int32_t label, int32_t x, int32_t y);
+  int32_t* move_rows_ = nullptr;  // the moves' row ring (expansion_move.cc)
+  uint8_t* split_ = nullptr;      // max(width, height) + 2 bytes: SplitRect's column or row marks
   int32_t smooth_[DepthConfig::kMaxLabels] = {};  // min(d, smooth_trunc) for a label distance d
   int32_t prev_label_ = -1;
   uint16_t* below_ = nullptr;  // D_p(f_p - 1), 0xffff when not seen

@@ -263,36 +263,53 @@ bool DepthStage::Expand(int32_t alpha) {
 // Applies the move's switches. On the pixels it also keeps D_p(f_p - 1) and D_p(f_p + 1) for
 // the sub-label fit without another pass of the data term: moves run in label order, so a pixel
 // that keeps label f saw D(f - 1) and D(f + 1) in the moves before and after f, and one that
-// just took alpha saw D(alpha - 1) in the move before (kept in prev_alpha, where that move
-// looked) and will see D(alpha + 1) in the next. A restricted move looks at every pixel within
-// its window, so at every pixel of label alpha - 1 and alpha + 1.
+// just took alpha saw D(alpha - 1) in the move before (kept in prev_alpha) when it lay in the
+// columns that move's run of rows looked at (prev_span), and will see D(alpha + 1) in the next.
+// A restricted move looks at every pixel within its window, so at every pixel of label alpha - 1
+// and alpha + 1. The move before computed D only on its split rectangles (move_rects.cc); a
+// pixel of its columns outside them that now took alpha gets its D(alpha - 1) here (CostAt),
+// so the fit does not depend on how the rectangles were split.
 void DepthStage::Record(int32_t alpha) {
   Grid& g = grid();
-  const int32_t w = g.width, h = g.height;
+  const int32_t w = g.width;
   const bool refine = !on_coarse_;
   const bool have_prev = refine && prev_label_ == alpha - 1;
-  for (int32_t y = 0; y < h; ++y) {
-    const int32_t x0 = g.span[2 * y], x1 = g.span[2 * y + 1];
-    const int32_t px0 = have_prev ? g.prev_span[2 * y] : 0;
-    const int32_t px1 = have_prev ? g.prev_span[2 * y + 1] : 0;
-    bool took = false;
-    for (int32_t x = x0; x < x1; ++x) {
-      const int32_t p = y * w + x;
-      const int32_t f = g.labels[p];
-      if (g.state[p] == kTake) {
-        g.labels[p] = static_cast<uint8_t>(alpha);
-        g.cost[p] = g.cost_alpha[p];
-        took = true;
-        if (!refine) continue;
-        below_[p] = x >= px0 && x < px1 ? g.prev_alpha[p] : 0xffff;
-        above_[p] = 0xffff;
-      } else if (refine && f == alpha + 1) {
-        below_[p] = g.cost_alpha[p];
-      } else if (refine && f + 1 == alpha) {
-        above_[p] = g.cost_alpha[p];
+  for (int32_t i = 0; i < g.rect_count; ++i) {
+    for (int32_t y = g.rects[i].y0; y < g.rects[i].y1; ++y) g.row_took[y] = 0;
+  }
+  for (int32_t i = 0; i < g.rect_count; ++i) {
+    const Rect& r = g.rects[i];
+    for (int32_t y = r.y0; y < r.y1; ++y) {
+      const int32_t px0 = have_prev ? g.prev_span[2 * y] : 0;
+      const int32_t px1 = have_prev ? g.prev_span[2 * y + 1] : 0;
+      uint8_t took = 0;
+      for (int32_t x = r.x0; x < r.x1; ++x) {
+        const int32_t p = y * w + x;
+        const int32_t f = g.labels[p];
+        if (g.state[p] == kTake) {
+          g.labels[p] = static_cast<uint8_t>(alpha);
+          g.cost[p] = g.cost_alpha[p];
+          took = 1;
+          if (!refine) continue;
+          below_[p] = kNotComputed;
+          if (x >= px0 && x < px1) {
+            below_[p] = g.prev_alpha[p] != kNotComputed ? g.prev_alpha[p] : CostAt(alpha - 1, x, y);
+          }
+          above_[p] = kNotComputed;
+        } else if (refine && f == alpha + 1) {
+          below_[p] = g.cost_alpha[p];
+        } else if (refine && f + 1 == alpha) {
+          above_[p] = g.cost_alpha[p];
+        }
       }
+      g.row_took[y] |= took;
     }
-    if (took) RowLabels(g, y);
+  }
+  for (int32_t i = 0; i < g.rect_count; ++i) {
+    for (int32_t y = g.rects[i].y0; y < g.rects[i].y1; ++y) {
+      if (g.row_took[y] != 0) RowLabels(g, y);
+      g.row_took[y] = 0;
+    }
   }
   if (refine) {
     uint16_t* t = g.prev_alpha;
@@ -300,6 +317,15 @@ void DepthStage::Record(int32_t alpha) {
     g.cost_alpha = t;
     prev_label_ = alpha;
   }
+}
+
+// D of one pixel for one label, from the data term's own rows (the same bits as a whole row).
+// Written through below_, whose entry at (x, y) the caller then sets anyway.
+uint16_t DepthStage::CostAt(int32_t label, int32_t x, int32_t y) {
+  const int32_t w = config_.width;
+  UseLabelPlanes(label);
+  data_.ComputeRect(LabelDispQ8(label), x, x + 1, y, y + 1, below_ + y * w, w);
+  return below_[y * w + x];
 }
 
 }  // namespace lb
