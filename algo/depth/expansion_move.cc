@@ -134,13 +134,15 @@ int32_t DepthStage::BuildRow(const Rect& r, int32_t y, int32_t node_row) {
   const int32_t* eu = up != nullptr ? Ring(y - 1, kPairDown) : nullptr;
   const int32_t* hi = Ring(y, kHigh);
   const int32_t base = node_row * (r.x1 - r.x0) - r.x0;
-  int32_t free_pixels = 0;
+  int32_t free_pixels = 0, first = r.x1, last = r.x0 - 1;
   for (int32_t x = r.x0; x < r.x1; ++x) {
     if (st[x] != kFree) {
-      maxflow_.SetNode(base + x, 0, 0, 0);
+      maxflow_.SetIdle(base + x);
       continue;
     }
     ++free_pixels;
+    first = x < first ? x : first;
+    last = x;
     int32_t balance = hi[x];
     int32_t cap_right = 0, cap_down = 0;
     if (x + 1 < r.x1) {
@@ -155,7 +157,12 @@ int32_t DepthStage::BuildRow(const Rect& r, int32_t y, int32_t node_row) {
     if (eu && up[x] != kKeep) balance -= eu[x];
     maxflow_.SetNode(base + x, balance, cap_right, cap_down);
   }
-  maxflow_.RowDone(node_row);
+  // The solver's row passes look only from the first free pixel to the last.
+  if (free_pixels > 0) {
+    maxflow_.RowDone(node_row, first - r.x0, last + 1 - r.x0);
+  } else {
+    maxflow_.RowDone(node_row, 0, 0);
+  }
   return free_pixels;
 }
 
@@ -187,8 +194,8 @@ int64_t DepthStage::CutRect(int32_t alpha, const Rect& r) {
       maxflow_.Begin(gw, r.y1 - g_lo);
     }
     for (; pending > 0; --pending, ++rows) {
-      for (int32_t x = 0; x < gw; ++x) maxflow_.SetNode(rows * gw + x, 0, 0, 0);
-      maxflow_.RowDone(rows);
+      for (int32_t x = 0; x < gw; ++x) maxflow_.SetIdle(rows * gw + x);
+      maxflow_.RowDone(rows, 0, 0);
     }
     free_pixels += BuildRow(r, y - 1, rows++);
   }
