@@ -149,11 +149,18 @@ class DepthStage {
     uint64_t* row_labels = nullptr;
     int32_t* span = nullptr;
     int32_t* prev_span = nullptr;
-    // The rectangles of the move in progress and of the one before (move_rects.cc), at most
-    // rect_capacity each; their cut is exact however they are split (below).
+    // Per row, the columns from the first to the last label near alpha of the move in progress
+    // ([x0, x1) as two entries, x0 >= x1 when none): where its D is needed (ComputeNear).
+    int32_t* near_span = nullptr;
+    // The rectangles of the move in progress (move_rects.cc), at most rect_capacity; their cut
+    // is exact however they are split.
     Rect* rects = nullptr;
-    Rect* prev_rects = nullptr;
-    int32_t rect_count = 0, prev_rect_count = 0, rect_capacity = 0;
+    int32_t rect_count = 0, rect_capacity = 0;
+    // Fine grid: where the D in cost_alpha and in prev_alpha were computed (they swap with
+    // them), at most written_capacity each; a count of -1: anywhere.
+    Rect* written = nullptr;
+    Rect* prev_written = nullptr;
+    int32_t written_count = 0, prev_written_count = 0, written_capacity = 0;
     uint8_t* row_took = nullptr;  // per row, 1 when a pixel of it took alpha (Record)
   };
   void CarveGrid(Arena& arena, Grid& g, int32_t width, int32_t height, bool prev_alpha);
@@ -185,6 +192,16 @@ class DepthStage {
   bool Expand(int32_t alpha);
   int32_t MoveRects(int32_t alpha);
   int32_t SplitRect(int32_t i, int32_t count, int32_t lo, int32_t hi);
+  void ComputeNear(int32_t disp_q8, const Rect& r);
+  // Notes that the fine grid's cost_alpha holds D over r (MoveRects clears it two moves on).
+  void Written(const Rect& r) {
+    Grid& g = fine_;
+    if (g.written_count >= 0 && g.written_count < g.written_capacity) {
+      g.written[g.written_count++] = r;
+    } else {
+      g.written_count = -1;
+    }
+  }
   int64_t CutRect(int32_t alpha, const Rect& r);  // returns the energy change
   int32_t ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1);
   void PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1);

@@ -278,14 +278,50 @@ bool DepthStage::Expand(int32_t alpha) {
       g.cost_alpha = CoarseCosts(alpha);  // the whole grid, from the winner-take-all
     } else if (on_coarse_) {
       BlockCosts(alpha, r, g.cost_alpha);
-    } else {
+    } else if (window_ >= config_.labels - 1) {
       data_.ComputeRect(disp_q8, r.x0, r.x1, r.y0, r.y1, g.cost_alpha + r.y0 * g.width, g.width);
+      Written(r);
+    } else {
+      ComputeNear(disp_q8, r);
     }
     delta += CutRect(alpha, r);
   }
   energy_ += delta;
   Record(alpha);
   return delta < 0;
+}
+
+// A restricted move needs D only at the pixels it may free (a label near alpha in their 3x3
+// neighbourhood): per strip of rows, over the columns next to such a label in the strip's rows
+// and the rows either side. The others keep kNotComputed, which pass 1 never reads (they are
+// fixed as far from alpha whatever their D). Strips of 16 rows: the data term's first two rows
+// of a strip are its overhead.
+void DepthStage::ComputeNear(int32_t disp_q8, const Rect& r) {
+  constexpr int32_t kStrip = 16, kMinWidth = 34;
+  const Grid& g = fine_;
+  const int32_t w = g.width, h = g.height;
+  for (int32_t ys = r.y0; ys < r.y1; ys += kStrip) {
+    const int32_t ye = ys + kStrip < r.y1 ? ys + kStrip : r.y1;
+    int32_t lo = r.x1, hi = r.x0;
+    for (int32_t y = ys > 0 ? ys - 1 : 0; y <= ye && y < h; ++y) {
+      const int32_t a = g.near_span[2 * y], b = g.near_span[2 * y + 1];
+      if (a >= b) continue;
+      lo = a - 1 < lo ? a - 1 : lo;
+      hi = b + 1 > hi ? b + 1 : hi;
+    }
+    lo = lo > r.x0 ? lo : r.x0;
+    hi = hi < r.x1 ? hi : r.x1;
+    if (lo >= hi) continue;
+    // At least kMinWidth columns (beyond the rectangle if need be: a D computed is a D, and
+    // Written keeps where): the SIMD kernels' step, where narrow rows would take the C ones.
+    if (hi - lo < kMinWidth && w >= kMinWidth) {
+      lo = (lo + hi - kMinWidth) / 2;
+      lo = lo < 0 ? 0 : (lo + kMinWidth > w ? w - kMinWidth : lo);
+      hi = lo + kMinWidth;
+    }
+    data_.ComputeRect(disp_q8, lo, hi, ys, ye, g.cost_alpha + ys * w, w);
+    Written(Rect{lo, hi, ys, ye});
+  }
 }
 
 // Applies the move's switches. On the pixels it also keeps D_p(f_p - 1) and D_p(f_p + 1) for
@@ -343,6 +379,12 @@ void DepthStage::Record(int32_t alpha) {
     uint16_t* t = g.prev_alpha;
     g.prev_alpha = g.cost_alpha;
     g.cost_alpha = t;
+    Rect* tw = g.prev_written;
+    g.prev_written = g.written;
+    g.written = tw;
+    const int32_t count = g.prev_written_count;
+    g.prev_written_count = g.written_count;
+    g.written_count = count;
     prev_label_ = alpha;
   }
 }

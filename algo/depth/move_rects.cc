@@ -16,23 +16,21 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
   g.prev_span = g.span;
   g.span = t;
   int32_t* span = g.span;
-  Rect* tr = g.prev_rects;
-  g.prev_rects = g.rects;
-  g.rects = tr;
-  const int32_t older = g.prev_rect_count;  // the move before last's, now in rects
-  g.prev_rect_count = g.rect_count;
-  g.rect_count = older;
   // The pixels' D of this move goes where the move before last left its own (Record swaps the
   // two buffers): back to "not computed" there, so that Record can tell which D the move before
   // this one computed (fine grid only; the coarse grid keeps no D for the refinement).
   if (!on_coarse_) {
-    for (int32_t i = 0; i < g.rect_count; ++i) {
-      const Rect& r = g.rects[i];
+    if (g.written_count < 0) {
+      for (int32_t p = 0; p < w * h; ++p) g.cost_alpha[p] = kNotComputed;
+    }
+    for (int32_t i = 0; i < g.written_count; ++i) {
+      const Rect& r = g.written[i];
       for (int32_t y = r.y0; y < r.y1; ++y) {
         uint16_t* d = g.cost_alpha + y * w;
         for (int32_t x = r.x0; x < r.x1; ++x) d[x] = kNotComputed;
       }
     }
+    g.written_count = 0;
   }
   if (window_ >= config_.labels - 1) {
     for (int32_t y = 0; y < h; ++y) {
@@ -59,8 +57,8 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
       while (outside(f[x0])) ++x0;  // the row holds one
       while (outside(f[x1 - 1])) --x1;
     }
-    span[2 * y] = x0;
-    span[2 * y + 1] = x1;
+    span[2 * y] = g.near_span[2 * y] = x0;
+    span[2 * y + 1] = g.near_span[2 * y + 1] = x1;
   }
   // Runs of rows next to one, over the columns next to one.
   auto row_near = [&](int32_t y) {
@@ -97,8 +95,10 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
     }
   }
   // Each run's rectangle, split until no split is left (or the list is full): the cuts and the
-  // data term then cover far fewer fixed pixels.
-  for (int32_t i = 0; i < count;) {
+  // data term then cover far fewer fixed pixels. Not for the hand-over from the blocks (window
+  // 0, no cut: only D of the pixels), where the many small pieces cost the data term more in
+  // their first rows than they save.
+  for (int32_t i = 0; i < count && window_ > 0;) {
     const int32_t after = SplitRect(i, count, lo, hi);
     if (after < 0) {
       ++i;
