@@ -126,8 +126,8 @@ void DepthStage::PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1) {
 // rectangle keep their labels. Returns the free pixels.
 int32_t DepthStage::BuildRow(const Rect& r, int32_t y, int32_t node_row) {
   const int32_t w = grid().width;
-  uint8_t* st = grid().state + y * w;
-  uint8_t* up = y > r.y0 ? st - w : nullptr;
+  const uint8_t* st = grid().state + y * w;
+  const uint8_t* up = y > r.y0 ? st - w : nullptr;
   const uint8_t* down = y + 1 < r.y1 ? st + w : nullptr;
   const int32_t* er = Ring(y, kPairRight);
   const int32_t* ed = Ring(y, kPairDown);
@@ -140,43 +140,22 @@ int32_t DepthStage::BuildRow(const Rect& r, int32_t y, int32_t node_row) {
       maxflow_.SetIdle(base + x);
       continue;
     }
-    // Pass 1's bounds again, now that the neighbours up and left are settled (free or fixed for
-    // good) and pass 1 fixed some of those right and down: flipping p changes the energy by
-    // hi - (e of the neighbours that take alpha), so at least hi - (e of those that may) and at
-    // most hi - (e of those that surely do). Free neighbours: an arc each (below).
-    const uint8_t s_right = x + 1 < r.x1 ? st[x + 1] : static_cast<uint8_t>(kKeep);
-    const uint8_t s_left = x > r.x0 ? st[x - 1] : static_cast<uint8_t>(kKeep);
-    const uint8_t s_down = down != nullptr ? down[x] : static_cast<uint8_t>(kKeep);
-    const uint8_t s_up = up != nullptr ? up[x] : static_cast<uint8_t>(kKeep);
-    const int32_t e_right = s_right != kKeep ? er[x] : 0;
-    const int32_t e_left = s_left != kKeep ? er[x - 1] : 0;
-    const int32_t e_down = s_down != kKeep ? ed[x] : 0;
-    const int32_t e_up = s_up != kKeep ? eu[x] : 0;
-    const int32_t surely = (s_right == kTake ? e_right : 0) + (s_left == kTake ? e_left : 0) +
-                           (s_down == kTake ? e_down : 0) + (s_up == kTake ? e_up : 0);
-    const int32_t high = hi[x];
-    uint8_t fixed = kFree;
-    if (high - (e_right + e_left + e_down + e_up) > 0) fixed = kKeep;
-    if (high - surely < 0) fixed = kTake;
-    if (fixed != kFree) {
-      // The free neighbours up and left are built: their arcs into p go, and when p takes alpha
-      // the pair's -B lands on their balance, as it would have for a fixed p.
-      st[x] = fixed;
-      maxflow_.SetIdle(base + x);
-      const int32_t take = fixed == kTake ? 1 : 0;
-      if (s_left == kFree) maxflow_.DropArc(base + x - 1, GridMaxflow::kRight, take * e_left);
-      if (s_up == kFree) {
-        maxflow_.DropArc(base + x - (r.x1 - r.x0), GridMaxflow::kDown, take * e_up);
-      }
-      continue;
-    }
     ++free_pixels;
     first = x < first ? x : first;
     last = x;
-    const int32_t balance =
-        high - (s_right == kTake ? e_right : 0) - e_left - (s_down == kTake ? e_down : 0) - e_up;
-    maxflow_.SetNode(base + x, balance, s_right == kFree ? e_right : 0,
-                     s_down == kFree ? e_down : 0);
+    int32_t balance = hi[x];
+    int32_t cap_right = 0, cap_down = 0;
+    if (x + 1 < r.x1) {
+      if (st[x + 1] == kFree) cap_right = er[x];
+      if (st[x + 1] == kTake) balance -= er[x];
+    }
+    if (x > r.x0 && st[x - 1] != kKeep) balance -= er[x - 1];
+    if (down) {
+      if (down[x] == kFree) cap_down = ed[x];
+      if (down[x] == kTake) balance -= ed[x];
+    }
+    if (eu && up[x] != kKeep) balance -= eu[x];
+    maxflow_.SetNode(base + x, balance, cap_right, cap_down);
   }
   // The solver's row passes look only from the first free pixel to the last.
   if (free_pixels > 0) {

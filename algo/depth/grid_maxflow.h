@@ -43,12 +43,6 @@ class GridMaxflow {
   // A node with no balance and no arcs, set as a whole (one store): what SetNode(p, 0, 0, 0)
   // gives, already as the search's free node, so the row passes may skip it (RowDone).
   void SetIdle(int32_t p) { nodes_[p] = Node{}; }
-  // Before row p's RowDone's pushes (p in the row being set or the one before): removes the arc
-  // from p in direction d (to a node that is idle now) and adds to_sink to p's sink capacity.
-  void DropArc(int32_t p, Dir d, int32_t to_sink) {
-    nodes_[p].cap[d] = 0;
-    nodes_[p].tcap -= to_sink;
-  }
   // Every node of rows 0..y is set. With x0..x1: row y's nodes outside columns x0..x1-1 were set
   // with SetIdle, and the row passes skip them.
   void RowDone(int32_t y) { RowDone(y, 0, width_); }
