@@ -149,8 +149,8 @@ class DepthStage {
     uint64_t* row_labels = nullptr;
     int32_t* span = nullptr;
     int32_t* prev_span = nullptr;
-    // Per row, the columns from the first to the last label near alpha of the move in progress
-    // ([x0, x1) as two entries, x0 >= x1 when none): where its D is needed (ComputeNear).
+    // Per row, the columns from the first to the last label within the window of the move in
+    // progress or one above it ([x0, x1) as two entries, x0 >= x1 when none): ComputeNear.
     int32_t* near_span = nullptr;
     // The rectangles of the move in progress (move_rects.cc), at most rect_capacity; their cut
     // is exact however they are split.
@@ -192,7 +192,7 @@ class DepthStage {
   bool Expand(int32_t alpha);
   int32_t MoveRects(int32_t alpha);
   int32_t SplitRect(int32_t i, int32_t count, int32_t lo, int32_t hi);
-  void ComputeNear(int32_t disp_q8, const Rect& r);
+  void ComputeNear(int32_t disp_q8);
   // Notes that the fine grid's cost_alpha holds D over r (MoveRects clears it two moves on).
   void Written(const Rect& r) {
     Grid& g = fine_;

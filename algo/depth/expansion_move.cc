@@ -251,17 +251,17 @@ bool DepthStage::Expand(int32_t alpha) {
   UseLabelPlanes(alpha);
   const int32_t disp_q8 = LabelDispQ8(alpha);
   int64_t delta = 0;
+  const bool near = !on_coarse_ && window_ < config_.labels - 1;
+  if (near && count > 0) ComputeNear(disp_q8);
   for (int32_t i = 0; i < count; ++i) {
     const Rect& r = g.rects[i];
     if (on_coarse_ && block_costs_ != nullptr) {
       g.cost_alpha = CoarseCosts(alpha);  // the whole grid, from the winner-take-all
     } else if (on_coarse_) {
       BlockCosts(alpha, r, g.cost_alpha);
-    } else if (window_ >= config_.labels - 1) {
+    } else if (!near) {
       data_.ComputeRect(disp_q8, r.x0, r.x1, r.y0, r.y1, g.cost_alpha + r.y0 * g.width, g.width);
       Written(r);
-    } else {
-      ComputeNear(disp_q8, r);
     }
     delta += CutRect(alpha, r);
   }
@@ -271,28 +271,28 @@ bool DepthStage::Expand(int32_t alpha) {
 }
 
 // A restricted move needs D only at the pixels it may free (a label near alpha in their 3x3
-// neighbourhood): per strip of rows, over the columns next to such a label in the strip's rows
-// and the rows either side. The others keep kNotComputed, which pass 1 never reads (they are
-// fixed as far from alpha whatever their D). Strips of 16 rows: the data term's first two rows
-// of a strip are its overhead.
-void DepthStage::ComputeNear(int32_t disp_q8, const Rect& r) {
+// neighbourhood) and, for the sub-label fit, at those that may take alpha + 1 next (near_span,
+// MoveRects): per strip of rows, over the columns next to such a label in the strip's rows and
+// the rows either side. The others keep kNotComputed, which pass 1 never reads (they are fixed
+// as far from alpha whatever their D). Strips of 16 rows: the data term's first two rows of a
+// strip are its overhead.
+void DepthStage::ComputeNear(int32_t disp_q8) {
   constexpr int32_t kStrip = 16, kMinWidth = 34;
   const Grid& g = fine_;
   const int32_t w = g.width, h = g.height;
-  for (int32_t ys = r.y0; ys < r.y1; ys += kStrip) {
-    const int32_t ye = ys + kStrip < r.y1 ? ys + kStrip : r.y1;
-    int32_t lo = r.x1, hi = r.x0;
+  for (int32_t ys = 0; ys < h; ys += kStrip) {
+    const int32_t ye = ys + kStrip < h ? ys + kStrip : h;
+    int32_t lo = w, hi = 0;
     for (int32_t y = ys > 0 ? ys - 1 : 0; y <= ye && y < h; ++y) {
       const int32_t a = g.near_span[2 * y], b = g.near_span[2 * y + 1];
       if (a >= b) continue;
       lo = a - 1 < lo ? a - 1 : lo;
       hi = b + 1 > hi ? b + 1 : hi;
     }
-    lo = lo > r.x0 ? lo : r.x0;
-    hi = hi < r.x1 ? hi : r.x1;
+    lo = lo > 0 ? lo : 0;
+    hi = hi < w ? hi : w;
     if (lo >= hi) continue;
-    // At least kMinWidth columns (beyond the rectangle if need be: a D computed is a D, and
-    // Written keeps where): the SIMD kernels' step, where narrow rows would take the C ones.
+    // At least kMinWidth columns: the SIMD kernels' step, where narrow rows take the C ones.
     if (hi - lo < kMinWidth && w >= kMinWidth) {
       lo = (lo + hi - kMinWidth) / 2;
       lo = lo < 0 ? 0 : (lo + kMinWidth > w ? w - kMinWidth : lo);

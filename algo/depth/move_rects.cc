@@ -57,8 +57,30 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
       while (outside(f[x0])) ++x0;  // the row holds one
       while (outside(f[x1 - 1])) --x1;
     }
-    span[2 * y] = g.near_span[2 * y] = x0;
-    span[2 * y + 1] = g.near_span[2 * y + 1] = x1;
+    span[2 * y] = x0;
+    span[2 * y + 1] = x1;
+  }
+  // Where the move computes D (ComputeNear): next to a label within the window or one above it.
+  // A pixel that takes alpha + 1 in the next move is next to a label within the window of
+  // alpha + 1 after this move, so next to one in lo..hi + 1 now or to a pixel that takes alpha
+  // now; either way its D(alpha) for the sub-label fit is then mostly at hand (Record).
+  {
+    const int32_t top = hi + 1 < config_.labels ? hi + 1 : hi;
+    uint64_t more[4] = {want[0], want[1], want[2], want[3]};
+    more[top >> 6] |= uint64_t{1} << (top & 63);
+    for (int32_t y = 0; y < h; ++y) {
+      const uint64_t* m = g.row_labels + 4 * y;
+      int32_t x0 = w, x1 = 0;
+      if (((m[0] & more[0]) | (m[1] & more[1]) | (m[2] & more[2]) | (m[3] & more[3])) != 0) {
+        const uint8_t* f = g.labels + y * w;
+        x0 = 0;
+        x1 = w;
+        while (f[x0] < lo || f[x0] > top) ++x0;
+        while (f[x1 - 1] < lo || f[x1 - 1] > top) --x1;
+      }
+      g.near_span[2 * y] = x0;
+      g.near_span[2 * y + 1] = x1;
+    }
   }
   // Runs of rows next to one, over the columns next to one.
   auto row_near = [&](int32_t y) {
