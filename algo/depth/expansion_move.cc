@@ -8,6 +8,14 @@
 
 #include "algo/core/int_math.h"
 
+// Pass 1 is plain C++ written to vectorize: on x86-64 it is also compiled for AVX2 (twice the
+// lanes), chosen at load time by the CPU; the same source, so the same bits.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define LB_CLONES_AVX2 __attribute__((target_clones("avx2", "default")))
+#else
+#define LB_CLONES_AVX2
+#endif
+
 namespace lb {
 
 // Pass 1: pixels whose choice does not depend on their neighbours are fixed before the cut.
@@ -21,7 +29,7 @@ namespace lb {
 // with b_p = V(fp, alpha) / w_pq, so u_p + sum(C - A) = u_p - b_p sum(w_pq) + sum(e_pq): one
 // branch-free pass per row. Row y keeps its e_pq to the right and down and that sum in the ring
 // slot y % 3 for pass 2. Returns kRowFree | kRowTake for the states present in the row.
-int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1) {
+LB_CLONES_AVX2 int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1) {
   Grid& g = grid();
   const int32_t w = g.width, h = g.height;
   const int32_t k = config_.smooth_trunc;
