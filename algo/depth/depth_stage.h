@@ -256,6 +256,10 @@ struct DepthStageProbe {
     return stage.Expand(alpha);
   }
   static int64_t Energy(DepthStage& stage, const uint8_t* labels);
+  // D of one label for every pixel (row stride = width), from scratch.
+  static void Costs(DepthStage& stage, int32_t label, uint16_t* out) {
+    stage.LabelCosts(label, out);
+  }
 };
 
 }  // namespace lb
