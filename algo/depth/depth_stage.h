@@ -202,17 +202,16 @@ class DepthStage {
       g.written_count = -1;
     }
   }
-  int64_t CutRect(int32_t alpha, const Rect& r);  // returns the energy change
+  void CutRect(int32_t alpha, const Rect& r);
   int32_t ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1);
   void PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1);
   int32_t BuildRow(const Rect& r, int32_t y, int32_t node_row);
-  int64_t MoveDelta(int32_t alpha, const Rect& r, int32_t y_lo, int32_t y_hi);
   void RowLabels(Grid& g, int32_t y);
   enum : int32_t { kPairRight = 0, kPairDown = 1, kHigh = 2, kRowFree = 1, kRowTake = 2 };
   int32_t* Ring(int32_t y, int32_t kind) {
     return move_rows_ + ((y % 3) * 3 + kind) * config_.width;
   }
-  void Record(int32_t alpha);
+  int64_t Record(int32_t alpha);  // returns the energy change
   void Refine(ImageU16 disp_q8);
 
   DepthConfig config_;

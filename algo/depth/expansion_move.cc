@@ -175,7 +175,7 @@ int32_t DepthStage::BuildRow(const Rect& r, int32_t y, int32_t node_row) {
 }
 
 // Classifies and builds the rectangle's rows, cuts the graph and settles its free pixels.
-int64_t DepthStage::CutRect(int32_t alpha, const Rect& r) {
+void DepthStage::CutRect(int32_t alpha, const Rect& r) {
   Grid& g = grid();
   const int32_t w = g.width, gw = r.x1 - r.x0;
   if (r.y0 > 0) PairsDown(alpha, r.y0 - 1, r.x0, r.x1);
@@ -207,7 +207,7 @@ int64_t DepthStage::CutRect(int32_t alpha, const Rect& r) {
     }
     free_pixels += BuildRow(r, y - 1, rows++);
   }
-  if (y_hi < 0) return 0;
+  if (y_hi < 0) return;
   stats_.cut_pixels += free_pixels;
   if (free_pixels > 0) {
     maxflow_.Truncate(rows);
@@ -219,38 +219,6 @@ int64_t DepthStage::CutRect(int32_t alpha, const Rect& r) {
       }
     }
   }
-  return MoveDelta(alpha, r, y_lo, y_hi);
-}
-
-// The energy change from the pixels that switch and their pair terms.
-int64_t DepthStage::MoveDelta(int32_t alpha, const Rect& r, int32_t y_lo, int32_t y_hi) {
-  const Grid& g = grid();
-  const int32_t w = g.width, h = g.height;
-  const uint8_t* state = g.state;
-  const uint8_t* labels = g.labels;
-  int64_t delta = 0;
-  for (int32_t y = y_lo; y <= y_hi; ++y) {
-    for (int32_t x = r.x0; x < r.x1; ++x) {
-      const int32_t p = y * w + x;
-      if (state[p] != kTake) continue;
-      const int32_t fp = labels[p];
-      delta += g.cost_alpha[p] - g.cost[p];
-      // Pairs with an unchanged neighbour; a pair of two switching nodes goes from
-      // V(fp, fq) to 0 and is counted once, from its left or upper node.
-      auto pair = [&](int32_t q, int32_t wpq, bool first, bool inside) {
-        const bool takes = inside && state[q] == kTake;
-        if (takes && !first) return;
-        const int32_t fq = labels[q];
-        const int32_t after = takes ? 0 : smooth_[Abs(alpha - fq)];
-        delta += int64_t{wpq} * (after - smooth_[Abs(fp - fq)]);
-      };
-      if (x + 1 < w) pair(p + 1, g.weight_right[p], true, x + 1 < r.x1);
-      if (x > 0) pair(p - 1, g.weight_right[p - 1], false, x > r.x0);
-      if (y + 1 < h) pair(p + w, g.weight_down[p], true, y + 1 < r.y1);
-      if (y > 0) pair(p - w, g.weight_down[p - w], false, y > r.y0);
-    }
-  }
-  return delta;
 }
 
 bool DepthStage::Expand(int32_t alpha) {
@@ -258,7 +226,6 @@ bool DepthStage::Expand(int32_t alpha) {
   const int32_t count = MoveRects(alpha);
   UseLabelPlanes(alpha);
   const int32_t disp_q8 = LabelDispQ8(alpha);
-  int64_t delta = 0;
   const bool near = !on_coarse_ && window_ < config_.labels - 1;
   if (near && count > 0) ComputeNear(disp_q8);
   for (int32_t i = 0; i < count; ++i) {
@@ -271,10 +238,10 @@ bool DepthStage::Expand(int32_t alpha) {
       data_.ComputeRect(disp_q8, r.x0, r.x1, r.y0, r.y1, g.cost_alpha + r.y0 * g.width, g.width);
       Written(r);
     }
-    delta += CutRect(alpha, r);
+    CutRect(alpha, r);
   }
+  const int64_t delta = Record(alpha);
   energy_ += delta;
-  Record(alpha);
   return delta < 0;
 }
 
@@ -320,9 +287,15 @@ void DepthStage::ComputeNear(int32_t disp_q8) {
 // and alpha + 1. The move before computed D only on its split rectangles (move_rects.cc); a
 // pixel of its columns outside them that now took alpha gets its D(alpha - 1) here (CostAt),
 // so the fit does not depend on how the rectangles were split.
-void DepthStage::Record(int32_t alpha) {
+//
+// Returns the energy change: each switching pixel's D, and its pairs with the neighbours that
+// keep their labels; a pair of two switching pixels goes from V(fp, fq) to 0 and is counted once,
+// from its left or upper pixel, whose labels are still the old ones then (the rectangles' rings
+// never switch, so a neighbour outside the rectangle keeps its label).
+int64_t DepthStage::Record(int32_t alpha) {
   Grid& g = grid();
-  const int32_t w = g.width;
+  const int32_t w = g.width, h = g.height;
+  int64_t delta = 0;
   const bool refine = !on_coarse_;
   const bool have_prev = refine && prev_label_ == alpha - 1;
   for (int32_t i = 0; i < g.rect_count; ++i) {
@@ -338,6 +311,18 @@ void DepthStage::Record(int32_t alpha) {
         const int32_t p = y * w + x;
         const int32_t f = g.labels[p];
         if (g.state[p] == kTake) {
+          delta += g.cost_alpha[p] - g.cost[p];
+          auto pair = [&](int32_t q, int32_t wpq, bool first, bool inside) {
+            const bool takes = inside && g.state[q] == kTake;
+            if (takes && !first) return;
+            const int32_t fq = g.labels[q];
+            const int32_t after = takes ? 0 : smooth_[Abs(alpha - fq)];
+            delta += int64_t{wpq} * (after - smooth_[Abs(f - fq)]);
+          };
+          if (x + 1 < w) pair(p + 1, g.weight_right[p], true, x + 1 < r.x1);
+          if (x > 0) pair(p - 1, g.weight_right[p - 1], false, x > r.x0);
+          if (y + 1 < h) pair(p + w, g.weight_down[p], true, y + 1 < r.y1);
+          if (y > 0) pair(p - w, g.weight_down[p - w], false, y > r.y0);
           g.labels[p] = static_cast<uint8_t>(alpha);
           g.cost[p] = g.cost_alpha[p];
           took = 1;
@@ -374,6 +359,7 @@ void DepthStage::Record(int32_t alpha) {
     g.written_count = count;
     prev_label_ = alpha;
   }
+  return delta;
 }
 
 // D of one pixel for one label, from the data term's own rows (the same bits as a whole row).
