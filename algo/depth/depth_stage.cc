@@ -82,7 +82,17 @@ void DepthStage::CarveGrid(Arena& arena, Grid& g, int32_t width, int32_t height,
   g.row_labels = arena.Allocate<uint64_t>(4 * rows);
   g.span = arena.Allocate<int32_t>(2 * rows);
   g.prev_span = arena.Allocate<int32_t>(2 * rows);
-  g.rects = arena.Allocate<Rect>(rows);
+  g.near_span = arena.Allocate<int32_t>(2 * rows);
+  // A restricted move's runs of rows are at most one per 2 rows; the splits of each run into
+  // smaller rectangles stop when the list is full (a larger rectangle is as exact).
+  g.rect_capacity = 4 * height + 64;
+  g.rects = arena.Allocate<Rect>(static_cast<size_t>(g.rect_capacity));
+  g.rect_count = 0;
+  g.written_capacity = prev_alpha ? g.rect_capacity + height : 0;
+  g.written = arena.Allocate<Rect>(static_cast<size_t>(g.written_capacity));
+  g.prev_written = arena.Allocate<Rect>(static_cast<size_t>(g.written_capacity));
+  g.written_count = g.prev_written_count = 0;
+  g.row_took = arena.Allocate<uint8_t>(rows);
 }
 
 Status DepthStage::Carve(Arena& arena) {
@@ -93,6 +103,7 @@ Status DepthStage::Carve(Arena& arena) {
   maxflow_.Carve(arena, w, h);
   CarveGrid(arena, fine_, w, h, true);
   move_rows_ = arena.Allocate<int32_t>(11 * static_cast<size_t>(w));
+  split_ = arena.Allocate<uint8_t>(static_cast<size_t>(w > h ? w : h) + 2);
   // The coarse grid is done with before the fine moves record anything in below_ and above_,
   // so it lives in their memory (enlarged for the smallest images, where alignment dominates).
   Arena plan;
@@ -251,8 +262,11 @@ int64_t DepthStageProbe::Energy(DepthStage& s, const uint8_t* labels) {
   }
   // The smoothness part with zero data costs: reuse LabelEnergy over a zero cost image.
   for (int32_t p = 0; p < w * h; ++p) scratch[p] = 0;
-  return data + LabelEnergy(labels, scratch, s.fine_.weight_right, s.fine_.weight_down, w, h,
-                            s.config_.smooth_trunc);
+  const int64_t e = data + LabelEnergy(labels, scratch, s.fine_.weight_right, s.fine_.weight_down,
+                                       w, h, s.config_.smooth_trunc);
+  for (int32_t p = 0; p < w * h; ++p) scratch[p] = DepthStage::kNotComputed;  // as the moves expect
+  s.fine_.written_count = 0;
+  return e;
 }
 
 // Sub-label disparity: a parabola through D at f_p - 1, f_p, f_p + 1 (as recorded by the
@@ -320,7 +334,11 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
     energy_ = GridEnergy(fine_);
     stats_.initial_energy = energy_;
   }
-  for (int32_t p = 0; p < w * h; ++p) below_[p] = above_[p] = 0xffff;
+  for (int32_t p = 0; p < w * h; ++p) {
+    below_[p] = above_[p] = 0xffff;
+    fine_.cost_alpha[p] = fine_.prev_alpha[p] = kNotComputed;  // as MoveRects keeps them
+  }
+  fine_.written_count = fine_.prev_written_count = 0;
   for (int32_t y = 0; y < h; ++y) fine_.span[2 * y] = fine_.span[2 * y + 1] = 0;
   if (coarse && !c.coarse_blocks) {
     for (int32_t alpha = 0; alpha < c.labels; alpha += c.coarse_step) {

@@ -149,7 +149,19 @@ class DepthStage {
     uint64_t* row_labels = nullptr;
     int32_t* span = nullptr;
     int32_t* prev_span = nullptr;
+    // Per row, the columns from the first to the last label within the window of the move in
+    // progress or one above it ([x0, x1) as two entries, x0 >= x1 when none): ComputeNear.
+    int32_t* near_span = nullptr;
+    // The rectangles of the move in progress (move_rects.cc), at most rect_capacity; their cut
+    // is exact however they are split.
     Rect* rects = nullptr;
+    int32_t rect_count = 0, rect_capacity = 0;
+    // Fine grid: where the D in cost_alpha and in prev_alpha were computed (they swap with
+    // them), at most written_capacity each; a count of -1: anywhere.
+    Rect* written = nullptr;
+    Rect* prev_written = nullptr;
+    int32_t written_count = 0, prev_written_count = 0, written_capacity = 0;
+    uint8_t* row_took = nullptr;  // per row, 1 when a pixel of it took alpha (Record)
   };
   void CarveGrid(Arena& arena, Grid& g, int32_t width, int32_t height, bool prev_alpha);
   Grid& grid() { return on_coarse_ ? coarse_ : fine_; }
@@ -179,17 +191,27 @@ class DepthStage {
   // energy.
   bool Expand(int32_t alpha);
   int32_t MoveRects(int32_t alpha);
-  int64_t CutRect(int32_t alpha, const Rect& r);  // returns the energy change
+  int32_t SplitRect(int32_t i, int32_t count, int32_t lo, int32_t hi);
+  void ComputeNear(int32_t disp_q8);
+  // Notes that the fine grid's cost_alpha holds D over r (MoveRects clears it two moves on).
+  void Written(const Rect& r) {
+    Grid& g = fine_;
+    if (g.written_count >= 0 && g.written_count < g.written_capacity) {
+      g.written[g.written_count++] = r;
+    } else {
+      g.written_count = -1;
+    }
+  }
+  void CutRect(int32_t alpha, const Rect& r);
   int32_t ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1);
   void PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1);
   int32_t BuildRow(const Rect& r, int32_t y, int32_t node_row);
-  int64_t MoveDelta(int32_t alpha, const Rect& r, int32_t y_lo, int32_t y_hi);
   void RowLabels(Grid& g, int32_t y);
   enum : int32_t { kPairRight = 0, kPairDown = 1, kHigh = 2, kRowFree = 1, kRowTake = 2 };
   int32_t* Ring(int32_t y, int32_t kind) {
     return move_rows_ + ((y % 3) * 3 + kind) * config_.width;
   }
-  void Record(int32_t alpha);
+  int64_t Record(int32_t alpha);  // returns the energy change
   void Refine(ImageU16 disp_q8);
 
   DepthConfig config_;
@@ -204,7 +226,12 @@ class DepthStage {
   // in storage the max-flow does not touch on the blocks' graphs; nullptr when it does not fit.
   uint16_t* block_costs_ = nullptr;
   enum : uint8_t { kFree = 0, kKeep = 1, kTake = 2 };
-  int32_t* move_rows_ = nullptr;                  // the moves' row ring (expansion_move.cc)
+  // A pixel's D in fine_.cost_alpha or prev_alpha where its move did not compute it: no D is
+  // this large (DataTerm::kMaxCost).
+  static constexpr uint16_t kNotComputed = 0xffff;
+  uint16_t CostAt(int32_t label, int32_t x, int32_t y);
+  int32_t* move_rows_ = nullptr;  // the moves' row ring (expansion_move.cc)
+  uint8_t* split_ = nullptr;      // max(width, height) + 2 bytes: SplitRect's column or row marks
   int32_t smooth_[DepthConfig::kMaxLabels] = {};  // min(d, smooth_trunc) for a label distance d
   int32_t prev_label_ = -1;
   uint16_t* below_ = nullptr;  // D_p(f_p - 1), 0xffff when not seen
@@ -228,6 +255,10 @@ struct DepthStageProbe {
     return stage.Expand(alpha);
   }
   static int64_t Energy(DepthStage& stage, const uint8_t* labels);
+  // D of one label for every pixel (row stride = width), from scratch.
+  static void Costs(DepthStage& stage, int32_t label, uint16_t* out) {
+    stage.LabelCosts(label, out);
+  }
 };
 
 }  // namespace lb

@@ -8,6 +8,14 @@
 
 #include "algo/core/int_math.h"
 
+// Pass 1 is plain C++ written to vectorize: on x86-64 it is also compiled for AVX2 (twice the
+// lanes), chosen at load time by the CPU; the same source, so the same bits.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define LB_CLONES_AVX2 __attribute__((target_clones("avx2", "default")))
+#else
+#define LB_CLONES_AVX2
+#endif
+
 namespace lb {
 
 // Pass 1: pixels whose choice does not depend on their neighbours are fixed before the cut.
@@ -21,7 +29,7 @@ namespace lb {
 // with b_p = V(fp, alpha) / w_pq, so u_p + sum(C - A) = u_p - b_p sum(w_pq) + sum(e_pq): one
 // branch-free pass per row. Row y keeps its e_pq to the right and down and that sum in the ring
 // slot y % 3 for pass 2. Returns kRowFree | kRowTake for the states present in the row.
-int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1) {
+LB_CLONES_AVX2 int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1) {
   Grid& g = grid();
   const int32_t w = g.width, h = g.height;
   const int32_t k = config_.smooth_trunc;
@@ -134,13 +142,15 @@ int32_t DepthStage::BuildRow(const Rect& r, int32_t y, int32_t node_row) {
   const int32_t* eu = up != nullptr ? Ring(y - 1, kPairDown) : nullptr;
   const int32_t* hi = Ring(y, kHigh);
   const int32_t base = node_row * (r.x1 - r.x0) - r.x0;
-  int32_t free_pixels = 0;
+  int32_t free_pixels = 0, first = r.x1, last = r.x0 - 1;
   for (int32_t x = r.x0; x < r.x1; ++x) {
     if (st[x] != kFree) {
-      maxflow_.SetNode(base + x, 0, 0, 0);
+      maxflow_.SetIdle(base + x);
       continue;
     }
     ++free_pixels;
+    first = x < first ? x : first;
+    last = x;
     int32_t balance = hi[x];
     int32_t cap_right = 0, cap_down = 0;
     if (x + 1 < r.x1) {
@@ -155,12 +165,17 @@ int32_t DepthStage::BuildRow(const Rect& r, int32_t y, int32_t node_row) {
     if (eu && up[x] != kKeep) balance -= eu[x];
     maxflow_.SetNode(base + x, balance, cap_right, cap_down);
   }
-  maxflow_.RowDone(node_row);
+  // The solver's row passes look only from the first free pixel to the last.
+  if (free_pixels > 0) {
+    maxflow_.RowDone(node_row, first - r.x0, last + 1 - r.x0);
+  } else {
+    maxflow_.RowDone(node_row, 0, 0);
+  }
   return free_pixels;
 }
 
 // Classifies and builds the rectangle's rows, cuts the graph and settles its free pixels.
-int64_t DepthStage::CutRect(int32_t alpha, const Rect& r) {
+void DepthStage::CutRect(int32_t alpha, const Rect& r) {
   Grid& g = grid();
   const int32_t w = g.width, gw = r.x1 - r.x0;
   if (r.y0 > 0) PairsDown(alpha, r.y0 - 1, r.x0, r.x1);
@@ -187,12 +202,12 @@ int64_t DepthStage::CutRect(int32_t alpha, const Rect& r) {
       maxflow_.Begin(gw, r.y1 - g_lo);
     }
     for (; pending > 0; --pending, ++rows) {
-      for (int32_t x = 0; x < gw; ++x) maxflow_.SetNode(rows * gw + x, 0, 0, 0);
-      maxflow_.RowDone(rows);
+      for (int32_t x = 0; x < gw; ++x) maxflow_.SetIdle(rows * gw + x);
+      maxflow_.RowDone(rows, 0, 0);
     }
     free_pixels += BuildRow(r, y - 1, rows++);
   }
-  if (y_hi < 0) return 0;
+  if (y_hi < 0) return;
   stats_.cut_pixels += free_pixels;
   if (free_pixels > 0) {
     maxflow_.Truncate(rows);
@@ -204,38 +219,6 @@ int64_t DepthStage::CutRect(int32_t alpha, const Rect& r) {
       }
     }
   }
-  return MoveDelta(alpha, r, y_lo, y_hi);
-}
-
-// The energy change from the pixels that switch and their pair terms.
-int64_t DepthStage::MoveDelta(int32_t alpha, const Rect& r, int32_t y_lo, int32_t y_hi) {
-  const Grid& g = grid();
-  const int32_t w = g.width, h = g.height;
-  const uint8_t* state = g.state;
-  const uint8_t* labels = g.labels;
-  int64_t delta = 0;
-  for (int32_t y = y_lo; y <= y_hi; ++y) {
-    for (int32_t x = r.x0; x < r.x1; ++x) {
-      const int32_t p = y * w + x;
-      if (state[p] != kTake) continue;
-      const int32_t fp = labels[p];
-      delta += g.cost_alpha[p] - g.cost[p];
-      // Pairs with an unchanged neighbour; a pair of two switching nodes goes from
-      // V(fp, fq) to 0 and is counted once, from its left or upper node.
-      auto pair = [&](int32_t q, int32_t wpq, bool first, bool inside) {
-        const bool takes = inside && state[q] == kTake;
-        if (takes && !first) return;
-        const int32_t fq = labels[q];
-        const int32_t after = takes ? 0 : smooth_[Abs(alpha - fq)];
-        delta += int64_t{wpq} * (after - smooth_[Abs(fp - fq)]);
-      };
-      if (x + 1 < w) pair(p + 1, g.weight_right[p], true, x + 1 < r.x1);
-      if (x > 0) pair(p - 1, g.weight_right[p - 1], false, x > r.x0);
-      if (y + 1 < h) pair(p + w, g.weight_down[p], true, y + 1 < r.y1);
-      if (y > 0) pair(p - w, g.weight_down[p - w], false, y > r.y0);
-    }
-  }
-  return delta;
 }
 
 bool DepthStage::Expand(int32_t alpha) {
@@ -243,63 +226,149 @@ bool DepthStage::Expand(int32_t alpha) {
   const int32_t count = MoveRects(alpha);
   UseLabelPlanes(alpha);
   const int32_t disp_q8 = LabelDispQ8(alpha);
-  int64_t delta = 0;
+  const bool near = !on_coarse_ && window_ < config_.labels - 1;
+  if (near && count > 0) ComputeNear(disp_q8);
   for (int32_t i = 0; i < count; ++i) {
     const Rect& r = g.rects[i];
     if (on_coarse_ && block_costs_ != nullptr) {
       g.cost_alpha = CoarseCosts(alpha);  // the whole grid, from the winner-take-all
     } else if (on_coarse_) {
       BlockCosts(alpha, r, g.cost_alpha);
-    } else {
+    } else if (!near) {
       data_.ComputeRect(disp_q8, r.x0, r.x1, r.y0, r.y1, g.cost_alpha + r.y0 * g.width, g.width);
+      Written(r);
     }
-    delta += CutRect(alpha, r);
+    CutRect(alpha, r);
   }
+  const int64_t delta = Record(alpha);
   energy_ += delta;
-  Record(alpha);
   return delta < 0;
+}
+
+// A restricted move needs D only at the pixels it may free (a label near alpha in their 3x3
+// neighbourhood) and, for the sub-label fit, at those that may take alpha + 1 next (near_span,
+// MoveRects): per strip of rows, over the columns next to such a label in the strip's rows and
+// the rows either side. The others keep kNotComputed, which pass 1 never reads (they are fixed
+// as far from alpha whatever their D). Strips of 16 rows: the data term's first two rows of a
+// strip are its overhead.
+void DepthStage::ComputeNear(int32_t disp_q8) {
+  constexpr int32_t kStrip = 16, kMinWidth = 34;
+  const Grid& g = fine_;
+  const int32_t w = g.width, h = g.height;
+  for (int32_t ys = 0; ys < h; ys += kStrip) {
+    const int32_t ye = ys + kStrip < h ? ys + kStrip : h;
+    int32_t lo = w, hi = 0;
+    for (int32_t y = ys > 0 ? ys - 1 : 0; y <= ye && y < h; ++y) {
+      const int32_t a = g.near_span[2 * y], b = g.near_span[2 * y + 1];
+      if (a >= b) continue;
+      lo = a - 1 < lo ? a - 1 : lo;
+      hi = b + 1 > hi ? b + 1 : hi;
+    }
+    lo = lo > 0 ? lo : 0;
+    hi = hi < w ? hi : w;
+    if (lo >= hi) continue;
+    // At least kMinWidth columns: the SIMD kernels' step, where narrow rows take the C ones.
+    if (hi - lo < kMinWidth && w >= kMinWidth) {
+      lo = (lo + hi - kMinWidth) / 2;
+      lo = lo < 0 ? 0 : (lo + kMinWidth > w ? w - kMinWidth : lo);
+      hi = lo + kMinWidth;
+    }
+    data_.ComputeRect(disp_q8, lo, hi, ys, ye, g.cost_alpha + ys * w, w);
+    Written(Rect{lo, hi, ys, ye});
+  }
 }
 
 // Applies the move's switches. On the pixels it also keeps D_p(f_p - 1) and D_p(f_p + 1) for
 // the sub-label fit without another pass of the data term: moves run in label order, so a pixel
 // that keeps label f saw D(f - 1) and D(f + 1) in the moves before and after f, and one that
-// just took alpha saw D(alpha - 1) in the move before (kept in prev_alpha, where that move
-// looked) and will see D(alpha + 1) in the next. A restricted move looks at every pixel within
-// its window, so at every pixel of label alpha - 1 and alpha + 1.
-void DepthStage::Record(int32_t alpha) {
+// just took alpha saw D(alpha - 1) in the move before (kept in prev_alpha) when it lay in the
+// columns that move's run of rows looked at (prev_span), and will see D(alpha + 1) in the next.
+// A restricted move looks at every pixel within its window, so at every pixel of label alpha - 1
+// and alpha + 1. The move before computed D only on its split rectangles (move_rects.cc); a
+// pixel of its columns outside them that now took alpha gets its D(alpha - 1) here (CostAt),
+// so the fit does not depend on how the rectangles were split.
+//
+// Returns the energy change: each switching pixel's D, and its pairs with the neighbours that
+// keep their labels; a pair of two switching pixels goes from V(fp, fq) to 0 and is counted once,
+// from its left or upper pixel, whose labels are still the old ones then (the rectangles' rings
+// never switch, so a neighbour outside the rectangle keeps its label).
+int64_t DepthStage::Record(int32_t alpha) {
   Grid& g = grid();
   const int32_t w = g.width, h = g.height;
+  int64_t delta = 0;
   const bool refine = !on_coarse_;
   const bool have_prev = refine && prev_label_ == alpha - 1;
-  for (int32_t y = 0; y < h; ++y) {
-    const int32_t x0 = g.span[2 * y], x1 = g.span[2 * y + 1];
-    const int32_t px0 = have_prev ? g.prev_span[2 * y] : 0;
-    const int32_t px1 = have_prev ? g.prev_span[2 * y + 1] : 0;
-    bool took = false;
-    for (int32_t x = x0; x < x1; ++x) {
-      const int32_t p = y * w + x;
-      const int32_t f = g.labels[p];
-      if (g.state[p] == kTake) {
-        g.labels[p] = static_cast<uint8_t>(alpha);
-        g.cost[p] = g.cost_alpha[p];
-        took = true;
-        if (!refine) continue;
-        below_[p] = x >= px0 && x < px1 ? g.prev_alpha[p] : 0xffff;
-        above_[p] = 0xffff;
-      } else if (refine && f == alpha + 1) {
-        below_[p] = g.cost_alpha[p];
-      } else if (refine && f + 1 == alpha) {
-        above_[p] = g.cost_alpha[p];
+  for (int32_t i = 0; i < g.rect_count; ++i) {
+    for (int32_t y = g.rects[i].y0; y < g.rects[i].y1; ++y) g.row_took[y] = 0;
+  }
+  for (int32_t i = 0; i < g.rect_count; ++i) {
+    const Rect& r = g.rects[i];
+    for (int32_t y = r.y0; y < r.y1; ++y) {
+      const int32_t px0 = have_prev ? g.prev_span[2 * y] : 0;
+      const int32_t px1 = have_prev ? g.prev_span[2 * y + 1] : 0;
+      uint8_t took = 0;
+      for (int32_t x = r.x0; x < r.x1; ++x) {
+        const int32_t p = y * w + x;
+        const int32_t f = g.labels[p];
+        if (g.state[p] == kTake) {
+          delta += g.cost_alpha[p] - g.cost[p];
+          auto pair = [&](int32_t q, int32_t wpq, bool first, bool inside) {
+            const bool takes = inside && g.state[q] == kTake;
+            if (takes && !first) return;
+            const int32_t fq = g.labels[q];
+            const int32_t after = takes ? 0 : smooth_[Abs(alpha - fq)];
+            delta += int64_t{wpq} * (after - smooth_[Abs(f - fq)]);
+          };
+          if (x + 1 < w) pair(p + 1, g.weight_right[p], true, x + 1 < r.x1);
+          if (x > 0) pair(p - 1, g.weight_right[p - 1], false, x > r.x0);
+          if (y + 1 < h) pair(p + w, g.weight_down[p], true, y + 1 < r.y1);
+          if (y > 0) pair(p - w, g.weight_down[p - w], false, y > r.y0);
+          g.labels[p] = static_cast<uint8_t>(alpha);
+          g.cost[p] = g.cost_alpha[p];
+          took = 1;
+          if (!refine) continue;
+          below_[p] = kNotComputed;
+          if (x >= px0 && x < px1) {
+            below_[p] = g.prev_alpha[p] != kNotComputed ? g.prev_alpha[p] : CostAt(alpha - 1, x, y);
+          }
+          above_[p] = kNotComputed;
+        } else if (refine && f == alpha + 1) {
+          below_[p] = g.cost_alpha[p];
+        } else if (refine && f + 1 == alpha) {
+          above_[p] = g.cost_alpha[p];
+        }
       }
+      g.row_took[y] |= took;
     }
-    if (took) RowLabels(g, y);
+  }
+  for (int32_t i = 0; i < g.rect_count; ++i) {
+    for (int32_t y = g.rects[i].y0; y < g.rects[i].y1; ++y) {
+      if (g.row_took[y] != 0) RowLabels(g, y);
+      g.row_took[y] = 0;
+    }
   }
   if (refine) {
     uint16_t* t = g.prev_alpha;
     g.prev_alpha = g.cost_alpha;
     g.cost_alpha = t;
+    Rect* tw = g.prev_written;
+    g.prev_written = g.written;
+    g.written = tw;
+    const int32_t count = g.prev_written_count;
+    g.prev_written_count = g.written_count;
+    g.written_count = count;
     prev_label_ = alpha;
   }
+  return delta;
+}
+
+// D of one pixel for one label, from the data term's own rows (the same bits as a whole row).
+// Written through below_, whose entry at (x, y) the caller then sets anyway.
+uint16_t DepthStage::CostAt(int32_t label, int32_t x, int32_t y) {
+  const int32_t w = config_.width;
+  UseLabelPlanes(label);
+  data_.ComputeRect(LabelDispQ8(label), x, x + 1, y, y + 1, below_ + y * w, w);
+  return below_[y * w + x];
 }
 
 }  // namespace lb

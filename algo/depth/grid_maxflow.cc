@@ -18,6 +18,7 @@ void GridMaxflow::Carve(Arena& arena, int32_t max_width, int32_t max_height) {
       arena.Allocate<Node>(static_cast<size_t>(max_nodes_) + 2 * static_cast<size_t>(max_width));
   orphans_ = arena.Allocate<int32_t>(static_cast<size_t>(max_nodes_));
   queue_ = arena.Allocate<int32_t>(static_cast<size_t>(max_nodes_));
+  live_ = arena.Allocate<int32_t>(2 * static_cast<size_t>(max_height));
 }
 
 uint8_t* GridMaxflow::Spare(int32_t width, int32_t height, size_t* bytes) const {
@@ -59,6 +60,10 @@ void GridMaxflowProbe::Reset(GridMaxflow& mf, int32_t width, int32_t height) {
   mf.Start(width, height);
   memset(static_cast<void*>(mf.storage_), 0,
          sizeof(GridMaxflow::Node) * static_cast<size_t>(mf.count_ + 2 * width));
+  for (int32_t y = 0; y < height; ++y) {
+    mf.live_[2 * y] = 0;
+    mf.live_[2 * y + 1] = width;
+  }
 }
 
 void GridMaxflow::Activate(int32_t p) {
@@ -242,9 +247,13 @@ void GridMaxflow::PushRow(int32_t y) {
     flow_ += d;
   };
   Node* row = nodes_ + y * w;
-  ChainRow(row, w);
+  const int32_t x0 = live_[2 * y], x1 = live_[2 * y + 1];
+  if (x1 - x0 >= 2) ChainRow(row + x0, x1 - x0);
   if (y + 1 >= height_) return;
-  for (int32_t x = 0; x < w; ++x) {
+  // A pair needs two nodes with balances: both within their rows' live columns.
+  const int32_t lo = x0 > live_[2 * y + 2] ? x0 : live_[2 * y + 2];
+  const int32_t hi = x1 < live_[2 * y + 3] ? x1 : live_[2 * y + 3];
+  for (int32_t x = lo; x < hi; ++x) {
     Node& n = row[x];
     Node& m = row[x + w];
     if (n.tcap > 0 && m.tcap < 0)
@@ -289,7 +298,7 @@ void GridMaxflow::ChainRow(Node* row, int32_t w) {
 void GridMaxflow::InitRow(int32_t y) {
   const int32_t w = width_;
   Node* row = nodes_ + y * w;
-  for (int32_t x = 0; x < w; ++x) {
+  for (int32_t x = live_[2 * y]; x < live_[2 * y + 1]; ++x) {
     Node& n = row[x];
     n.queued = 0;
     n.ts = 0;

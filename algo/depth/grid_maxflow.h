@@ -40,8 +40,15 @@ class GridMaxflow {
     n.cap[kUp] = 0;
     n.tcap = balance;
   }
-  // Every node of rows 0..y is set.
-  void RowDone(int32_t y) {
+  // A node with no balance and no arcs, set as a whole (one store): what SetNode(p, 0, 0, 0)
+  // gives, already as the search's free node, so the row passes may skip it (RowDone).
+  void SetIdle(int32_t p) { nodes_[p] = Node{}; }
+  // Every node of rows 0..y is set. With x0..x1: row y's nodes outside columns x0..x1-1 were set
+  // with SetIdle, and the row passes skip them.
+  void RowDone(int32_t y) { RowDone(y, 0, width_); }
+  void RowDone(int32_t y, int32_t x0, int32_t x1) {
+    live_[2 * y] = x0;
+    live_[2 * y + 1] = x1;
     if (y >= 1) PushRow(pushed_++);
     if (y >= 2) InitRow(inited_++);
   }
@@ -69,13 +76,13 @@ class GridMaxflow {
   static constexpr int32_t kNotActive = -1;
 
   struct Node {
-    int32_t cap[4];  // residual capacity of the arc to each neighbour
-    int32_t tcap;    // residual terminal capacity: > 0 from the source, < 0 to the sink
-    int32_t queued;  // 1 while in the active queue
-    int32_t ts;      // time stamp of the last verified distance to a terminal
-    uint16_t dist;   // distance to the terminal (saturating; only a heuristic)
-    uint8_t parent;  // a Dir, kTerminal or kOrphan
-    uint8_t tree;    // kFree, kSourceTree or kSinkTree
+    int32_t cap[4] = {};       // residual capacity of the arc to each neighbour
+    int32_t tcap = 0;          // residual terminal capacity: > 0 from the source, < 0 to the sink
+    int32_t queued = 0;        // 1 while in the active queue
+    int32_t ts = 0;            // time stamp of the last verified distance to a terminal
+    uint16_t dist = 1;         // distance to the terminal (saturating; only a heuristic)
+    uint8_t parent = kOrphan;  // a Dir, kTerminal or kOrphan
+    uint8_t tree = kFree;      // kFree, kSourceTree or kSinkTree
   };
   static_assert(sizeof(Node) == 32);
 
@@ -98,6 +105,7 @@ class GridMaxflow {
   // FIFO of active nodes, max_nodes_ entries (a node is queued at most once): unlike a linked
   // list, it shows the nodes to come, which are prefetched.
   int32_t* queue_ = nullptr;
+  int32_t* live_ = nullptr;  // per row, the columns x0, x1 the row passes look at (RowDone)
   int32_t max_nodes_ = 0, max_width_ = 0;
   int32_t width_ = 0, height_ = 0, count_ = 0;
   int32_t offset_[4] = {};           // node index step in each direction

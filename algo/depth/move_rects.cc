@@ -16,12 +16,29 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
   g.prev_span = g.span;
   g.span = t;
   int32_t* span = g.span;
+  // The pixels' D of this move goes where the move before last left its own (Record swaps the
+  // two buffers): back to "not computed" there, so that Record can tell which D the move before
+  // this one computed (fine grid only; the coarse grid keeps no D for the refinement).
+  if (!on_coarse_) {
+    if (g.written_count < 0) {
+      for (int32_t p = 0; p < w * h; ++p) g.cost_alpha[p] = kNotComputed;
+    }
+    for (int32_t i = 0; i < g.written_count; ++i) {
+      const Rect& r = g.written[i];
+      for (int32_t y = r.y0; y < r.y1; ++y) {
+        uint16_t* d = g.cost_alpha + y * w;
+        for (int32_t x = r.x0; x < r.x1; ++x) d[x] = kNotComputed;
+      }
+    }
+    g.written_count = 0;
+  }
   if (window_ >= config_.labels - 1) {
     for (int32_t y = 0; y < h; ++y) {
       span[2 * y] = 0;
       span[2 * y + 1] = w;
     }
     g.rects[0] = Rect{0, w, 0, h};
+    g.rect_count = 1;
     return 1;
   }
   const int32_t lo = alpha - window_ > 0 ? alpha - window_ : 0;
@@ -42,6 +59,28 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
     }
     span[2 * y] = x0;
     span[2 * y + 1] = x1;
+  }
+  // Where the move computes D (ComputeNear): next to a label within the window or one above it.
+  // A pixel that takes alpha + 1 in the next move is next to a label within the window of
+  // alpha + 1 after this move, so next to one in lo..hi + 1 now or to a pixel that takes alpha
+  // now; either way its D(alpha) for the sub-label fit is then mostly at hand (Record).
+  {
+    const int32_t top = hi + 1 < config_.labels ? hi + 1 : hi;
+    uint64_t more[4] = {want[0], want[1], want[2], want[3]};
+    more[top >> 6] |= uint64_t{1} << (top & 63);
+    for (int32_t y = 0; y < h; ++y) {
+      const uint64_t* m = g.row_labels + 4 * y;
+      int32_t x0 = w, x1 = 0;
+      if (((m[0] & more[0]) | (m[1] & more[1]) | (m[2] & more[2]) | (m[3] & more[3])) != 0) {
+        const uint8_t* f = g.labels + y * w;
+        x0 = 0;
+        x1 = w;
+        while (f[x0] < lo || f[x0] > top) ++x0;
+        while (f[x1 - 1] < lo || f[x1 - 1] > top) --x1;
+      }
+      g.near_span[2 * y] = x0;
+      g.near_span[2 * y + 1] = x1;
+    }
   }
   // Runs of rows next to one, over the columns next to one.
   auto row_near = [&](int32_t y) {
@@ -77,7 +116,96 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
       span[2 * y + 1] = g.rects[i].x1;
     }
   }
+  // Each run's rectangle, split until no split is left (or the list is full): the cuts and the
+  // data term then cover far fewer fixed pixels. Not for the hand-over from the blocks (window
+  // 0, no cut: only D of the pixels), where the many small pieces cost the data term more in
+  // their first rows than they save.
+  for (int32_t i = 0; i < count && window_ > 0;) {
+    const int32_t after = SplitRect(i, count, lo, hi);
+    if (after < 0) {
+      ++i;
+    } else {
+      count = after;
+    }
+  }
+  g.rect_count = count;
   return count;
+}
+
+// A rectangle R of a restricted move holds every pixel within one of a label near alpha (the
+// set S) among its own, and the ring of pixels around it holds no such pixel. A column of R
+// with no S in it or in the columns either side (within R) then holds no pixel the move may
+// free, nor does a row likewise; and the pixels of R either side of such a line are never
+// neighbours of each other nor of S on the other side. So R can be cut into the runs of the
+// other columns (or rows), each again such a rectangle, and the cuts over them together are
+// the cut over R: the same labels. Returns the new count of rectangles when rects[i] changed
+// (it is to be looked at again), or -1 when it cannot be split.
+int32_t DepthStage::SplitRect(int32_t i, int32_t count, int32_t lo, int32_t hi) {
+  Grid& g = grid();
+  const int32_t w = g.width;
+  const uint8_t width = static_cast<uint8_t>(hi - lo);
+  const uint8_t base = static_cast<uint8_t>(lo);
+  const Rect r = g.rects[i];
+  uint8_t* mark = split_ + 1;  // mark[-1] and mark[n] are 0
+  for (int pass = 0; pass < 2; ++pass) {
+    const bool columns = pass == 0;
+    const int32_t a0 = columns ? r.x0 : r.y0, a1 = columns ? r.x1 : r.y1;
+    mark[a0 - 1] = mark[a1] = 0;
+    if (columns) {
+      for (int32_t x = r.x0; x < r.x1; ++x) mark[x] = 0;
+      for (int32_t y = r.y0; y < r.y1; ++y) {
+        const uint8_t* f = g.labels + y * w;
+        for (int32_t x = r.x0; x < r.x1; ++x)
+          mark[x] |= static_cast<uint8_t>(static_cast<uint8_t>(f[x] - base) <= width);
+      }
+    } else {
+      for (int32_t y = r.y0; y < r.y1; ++y) {
+        const uint8_t* f = g.labels + y * w;
+        uint8_t any = 0;
+        for (int32_t x = r.x0; x < r.x1; ++x)
+          any |= static_cast<uint8_t>(static_cast<uint8_t>(f[x] - base) <= width);
+        mark[y] = any;
+      }
+    }
+    // The runs of lines next to a marked one.
+    int32_t pieces = 0, first0 = a1, first1 = a1, last = -1;  // last: R's last piece so far
+    for (int32_t k = a0; k < a1;) {
+      if ((mark[k - 1] | mark[k] | mark[k + 1]) == 0) {
+        ++k;
+        continue;
+      }
+      const int32_t k0 = k;
+      while (k < a1 && (mark[k - 1] | mark[k] | mark[k + 1]) != 0) ++k;
+      if (pieces == 0) {
+        first0 = k0;
+        first1 = k;
+      } else {
+        Rect piece = r;
+        (columns ? piece.x0 : piece.y0) = k0;
+        (columns ? piece.x1 : piece.y1) = k;
+        if (count < g.rect_capacity) {
+          last = count;
+          g.rects[count++] = piece;
+        } else if (last >= 0) {  // full: R's last piece takes in the rest
+          (columns ? g.rects[last].x1 : g.rects[last].y1) = k;
+        } else {
+          first1 = k;
+        }
+      }
+      ++pieces;
+    }
+    if (pieces == 0) {  // no pixel to free (cannot happen for a run; kept safe)
+      g.rects[i] = g.rects[count - 1];
+      return count - 1;
+    }
+    if (first0 != a0 || first1 != a1) {
+      Rect& first = g.rects[i];
+      (columns ? first.x0 : first.y0) = first0;
+      (columns ? first.x1 : first.y1) = first1;
+      return count;
+    }
+  }
+  return -1;
 }
 
 }  // namespace lb

@@ -174,6 +174,41 @@ TEST(DepthStageTest, MoveResultBeatsEverySinglePixelSwitch) {
   }
 }
 
+// The sub-label fit reads D(f - 1), D(f) and D(f + 1) that the moves kept on the way (each
+// move computes D only next to labels near its own, on pieces of its rectangles): wherever the
+// output leaves a label's disparity, it must be the parabola through the true D, recomputed
+// here from scratch for every label; and the fit must have happened on most pixels.
+TEST(DepthStageTest, SubLabelFitUsesTheTrueCosts) {
+  for (uint32_t seed : {5u, 21u}) {
+    const synth::Burst b = synth::MakeBurst(64, 40, 5, 2, 2, 6, 20, 44, 10, 30, seed);
+    const DepthConfig c = SmallConfig(b, 33, 64);  // coarse to fine, subpixel: the defaults
+    Stage s;
+    ASSERT_TRUE(s.Configure(c).ok());
+    ASSERT_TRUE(s.Compute(b).ok());
+    const size_t n = static_cast<size_t>(b.width) * b.height;
+    std::vector<std::vector<uint16_t>> d(static_cast<size_t>(c.labels), std::vector<uint16_t>(n));
+    for (int32_t l = 0; l < c.labels; ++l) DepthStageProbe::Costs(s.depth, l, d[l].data());
+    int32_t fitted = 0, inner = 0;
+    for (size_t p = 0; p < n; ++p) {
+      const int32_t f = s.depth.labels()[p];
+      const int32_t label_q8 = s.depth.LabelDispQ8(f) + DepthStage::MapBiasQ8(c);
+      if (f == 0 || f + 1 == c.labels) {
+        EXPECT_EQ(s.disp[p], label_q8) << "pixel " << p;
+        continue;
+      }
+      ++inner;
+      if (s.disp[p] == label_q8) continue;  // not fitted, or a vertex on the label
+      ++fitted;
+      const int32_t cm = d[f - 1][p], c0 = d[f][p], cp = d[f + 1][p];
+      const int32_t curvature = cm + cp - 2 * c0;
+      ASSERT_TRUE(c0 <= cm && c0 <= cp && curvature > 0) << "pixel " << p;
+      const int32_t step_q8 = (s.depth.LabelDispQ8(f + 1) - s.depth.LabelDispQ8(f - 1)) / 2;
+      EXPECT_EQ(s.disp[p], label_q8 + ((cm - cp) * step_q8) / (2 * curvature)) << "pixel " << p;
+    }
+    EXPECT_GT(fitted, inner / 8) << "seed " << seed;  // about a quarter here
+  }
+}
+
 TEST(DepthStageTest, RecoversTwoLayers) {
   const synth::Burst b = synth::MakeBurst(64, 40, 5, 2, 2, 6, 20, 44, 10, 30, 21u);
   DepthConfig c = SmallConfig(b, 33, 64);  // 0 .. 8 px per step in quarter pixels
