@@ -20,6 +20,7 @@
 #include "algo/core/status.h"
 #include "algo/render/render_stage.h"
 #include "firmware/refocusable/depth_encoding.h"
+#include "firmware/refocusable/refocusable_reader.h"
 
 namespace lb {
 
@@ -88,7 +89,6 @@ class RefocusEngine {
   int64_t paused_strips() const { return paused_strips_; }
 
  private:
-  struct Chunk;
   Status LoadFile(const char* path);
   Status ParseAndDecode(const char* path, size_t size);
   Status MakePreviewInputs();
@@ -105,11 +105,12 @@ class RefocusEngine {
   // The file's bytes while it loads, then the output JPEG (capacity kept: never reallocated).
   std::vector<uint8_t> scratch_;
   size_t output_size_ = 0;
-  std::vector<uint8_t> extended_;  // the reassembled extended XMP
-  std::vector<Chunk> chunks_;      // extended-XMP chunk descriptors (capacity fixed)
-  std::vector<uint8_t> png_;       // GDepth:Data (base64-decoded, capacity fixed)
-  std::vector<uint8_t> original_;  // GImage:Data, the all-in-focus JPEG (capacity fixed)
-  std::vector<uint8_t> rgb_rows_;  // two decoded rows
+  std::vector<uint8_t> extended_;         // the reassembled extended XMP
+  std::vector<ExtendedXmpChunk> chunks_;  // the reader's extended-XMP chunk descriptors
+  std::vector<uint8_t> png_;              // GDepth:Data (base64-decoded, capacity fixed)
+  std::vector<uint8_t> original_;         // GImage:Data, the all-in-focus JPEG (capacity fixed)
+  std::vector<uint8_t> strip_;            // the image readers' rows (a strip of the widest photo)
+  std::vector<uint8_t> rgb_rows_;         // two RGB rows of the original, for its 4:2:0 chroma
   std::vector<uint8_t> y_, cb_, cr_;
   std::vector<uint16_t> depth_values_, disp_q8_;
   int32_t depth_w_ = 0, depth_h_ = 0;

@@ -155,6 +155,19 @@ Status ReadImageMemory(const uint8_t* data, size_t size, const char* name, Image
   return s;
 }
 
+Status StreamImageMemory(const uint8_t* data, size_t size, const char* name, int32_t index,
+                         FrameSink& sink, const ImageReadMemory& memory, ImageFileType type) {
+  codecs::MemorySource src(data, size);
+  ImageFileInfo info;
+  codecs::DecodeRequest request;
+  request.name = name;
+  request.info = &info;
+  request.sink = &sink;
+  request.index = index;
+  request.memory = &memory;
+  return Decode(src, type, request);
+}
+
 Status ProbeImageMemory(const uint8_t* data, size_t size, const char* name, ImageFileInfo* info,
                         ImageFileType type) {
   codecs::MemorySource src(data, size);
