@@ -91,6 +91,17 @@ struct DecodeRequest {
   const ImageReadMemory* memory = nullptr;
 };
 
+// A request to stream the pixels into `sink` as frame `index`, the header recorded in `info`.
+inline DecodeRequest StreamRequest(const char* name, ImageFileInfo* info, FrameSink* sink,
+                                   int32_t index = 0) {
+  DecodeRequest request;
+  request.name = name;
+  request.info = info;
+  request.sink = sink;
+  request.index = index;
+  return request;
+}
+
 Status DecodePnm(ByteSource& src, const DecodeRequest& request);
 Status DecodePng(ByteSource& src, const DecodeRequest& request);
 Status DecodeJpeg(ByteSource& src, const DecodeRequest& request);

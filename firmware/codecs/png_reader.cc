@@ -208,10 +208,7 @@ Status DecodeGray(const uint8_t* data, size_t size, const char* name, int32_t ma
   }
   MemorySource src(data, size);
   ImageFileInfo info;
-  DecodeRequest request;
-  request.name = name;
-  request.info = &info;
-  request.sink = values;
+  DecodeRequest request = StreamRequest(name, &info, values);
   request.max_side = max_side;
   request.width = width;
   request.height = height;
