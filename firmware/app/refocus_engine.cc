@@ -13,7 +13,6 @@
 #include <ctime>
 #include <string_view>
 
-#include "algo/core/color.h"
 #include "firmware/app/focus.h"
 #include "firmware/app/job.h"
 #include "firmware/app/rerender.h"
@@ -28,45 +27,6 @@ namespace lb {
 void RefocusEngine::FreeDeleter::operator()(void* p) const { free(p); }
 
 namespace {
-
-// The all-in-focus original's rows (from the JPEG reader, a strip at a time) into YCbCr 4:2:0:
-// the conversion the pipeline applies to a sensor's reference frame, as the Rerenderer does.
-class YccSink final : public FrameSink {
- public:
-  YccSink(const char* path, uint8_t* y, uint8_t* cb, uint8_t* cr, uint8_t* rgb)
-      : path_(path), y_(y), cb_(cb), cr_(cr), rgb_(rgb) {}
-  Status BeginFrame(const FrameInfo& info) override {
-    if (info.width < 16 || info.height < 16) {
-      return Status(Code::kUnsupported, "%s: GImage: a %dx%d original is too small to render",
-                    path_, info.width, info.height);
-    }
-    frame_ = info;
-    return Status::Ok();
-  }
-  Status Rows(const FrameRows& rows) override {
-    const int32_t w = frame_.width, cw = (w + 1) / 2;
-    for (int32_t i = 0; i < rows.height; ++i) {
-      const int32_t y = rows.y0 + i;
-      uint8_t* row = rgb_ + static_cast<size_t>(y & 1) * w * 3;
-      RowToRgb8(frame_.format, rows.planes[0] + i * rows.strides[0], nullptr, w, row);
-      RowRgb8ToY(row, w, y_ + static_cast<size_t>(y) * w);
-      if ((y & 1) || y == frame_.height - 1) {
-        const uint8_t* above = (y & 1) ? rgb_ : row;
-        RowsRgb8ToCbCr420(above, row, w, cb_ + static_cast<size_t>(y / 2) * cw,
-                          cr_ + static_cast<size_t>(y / 2) * cw);
-      }
-    }
-    return Status::Ok();
-  }
-  Status EndFrame() override { return Status::Ok(); }
-
-  FrameInfo frame_;
-
- private:
-  const char* path_;
-  uint8_t *y_, *cb_, *cr_;
-  uint8_t* rgb_;  // two rows of RGB8
-};
 
 // Mean of a step x step block of `src` (clamped at its edges) into each pixel of `dst`.
 void BoxDown(const uint8_t* src, int32_t sw, int32_t sh, int32_t step, uint8_t* dst, int32_t dw,
@@ -271,10 +231,14 @@ Status RefocusEngine::ParseAndDecode(const char* path, size_t size) {
   strip.strip_bytes = strip_.size();
   strip.max_width = config_.max_width;
   strip.max_height = config_.max_height;
-  YccSink ycc(path, y_.data(), cb_.data(), cr_.data(), rgb_rows_.data());
+  Ycc420Sink ycc(y_.data(), cb_.data(), cr_.data(), rgb_rows_.data());
   LB_RETURN_IF_ERROR(
       StreamImageMemory(f.image, f.image_size, what, 0, ycc, strip, ImageFileType::kJpeg));
-  const int32_t width = ycc.frame_.width, height = ycc.frame_.height;
+  const int32_t width = ycc.frame().width, height = ycc.frame().height;
+  if (width < 16 || height < 16) {
+    return Status(Code::kUnsupported, "%s: a %dx%d original is too small to render", what, width,
+                  height);
+  }
 
   DepthPngName(path, what, sizeof(what));
   GrayPngBuffer depth;
