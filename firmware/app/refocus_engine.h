@@ -2,10 +2,12 @@
 // refocus), in memory sized once. Configure takes the largest photo the camera makes and sizes
 // every buffer then: the file's bytes (also the output JPEG's, once the file is decoded), the
 // reassembled extended XMP, the all-in-focus original (JPEG bytes and YCbCr 4:2:0 planes), the
-// depth map, a downscaled copy of both for previews, and the render arenas. Load, RenderPreview,
-// RenderFull allocate nothing after that (the codec libraries' own scratch memory aside), so the
-// daemon's memory stays flat however the page is used; Save shares `refocus rerender`'s writing
-// code (WriteRerendered), which builds the file's metadata on the heap and frees it.
+// depth map, a downscaled copy of both for previews, the readers' strip and the render arenas.
+// Load reads through the product's one reader per format (refocusable_reader, the JPEG and PNG
+// readers) into those buffers. Load, RenderPreview, RenderFull allocate nothing after Configure
+// (the codec libraries' own scratch memory aside), so the daemon's memory stays flat however the
+// page is used; Save shares `refocus rerender`'s writing code (WriteRerendered), which builds the
+// file's metadata on the heap and frees it.
 //
 // The camera comes first: between strips every render waits while `camera_busy` is set, so a
 // capture is slowed by at most one strip of web work.
