@@ -7,324 +7,26 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
-#include <csetjmp>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <string_view>
 
-// clang-format off: jpeglib.h needs <cstdio> first and jerror.h after it.
-#include <jerror.h>
-#include <jpeglib.h>
-// clang-format on
-#include <png.h>
-
-#include "algo/core/color.h"
 #include "firmware/app/focus.h"
 #include "firmware/app/job.h"
 #include "firmware/app/rerender.h"
-#include "firmware/codecs/exif.h"
+#include "firmware/codecs/image_file.h"
 #include "firmware/codecs/jpeg_writer.h"
+#include "firmware/codecs/png_reader.h"
 #include "firmware/platform/worker_pool.h"
-#include "firmware/refocusable/base64.h"
-#include "firmware/refocusable/xmp_writer.h"
+#include "firmware/refocusable/refocusable_reader.h"
 
 namespace lb {
-
-struct RefocusEngine::Chunk {
-  const uint8_t* guid;  // 32 bytes
-  uint32_t offset, full;
-  const uint8_t* bytes;
-  size_t size;
-};
 
 void RefocusEngine::FreeDeleter::operator()(void* p) const { free(p); }
 
 namespace {
-
-constexpr size_t kExtendedHeader = sizeof(kExtendedXmpSignature) + 32 + 4 + 4;
-
-uint32_t BigEndian32(const uint8_t* p) {
-  return (uint32_t{p[0]} << 24) | (uint32_t{p[1]} << 16) | (uint32_t{p[2]} << 8) | p[3];
-}
-
-bool IsSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
-
-// XMP lookups over a packet's text without copying it (the file reader's rules: a field is an
-// attribute prefix:name="v" or a simple element <prefix:name>v</prefix:name>, the prefix the one
-// an xmlns attribute binds to the namespace).
-bool Quoted(std::string_view text, size_t pos, std::string_view* value) {
-  while (pos < text.size() && IsSpace(text[pos])) ++pos;
-  if (pos >= text.size() || (text[pos] != '"' && text[pos] != '\'')) return false;
-  const size_t end = text.find(text[pos], pos + 1);
-  if (end == std::string_view::npos) return false;
-  *value = text.substr(pos + 1, end - pos - 1);
-  return true;
-}
-
-std::string_view PrefixOf(std::string_view text, std::string_view uri) {
-  size_t pos = 0;
-  while ((pos = text.find("xmlns:", pos)) != std::string_view::npos) {
-    pos += 6;
-    const size_t eq = text.find('=', pos);
-    if (eq == std::string_view::npos || eq - pos > 64) continue;
-    size_t end = eq;
-    while (end > pos && IsSpace(text[end - 1])) --end;
-    std::string_view value;
-    if (Quoted(text, eq + 1, &value) && value == uri) return text.substr(pos, end - pos);
-  }
-  return {};
-}
-
-bool FindIn(std::string_view text, std::string_view uri, std::string_view name,
-            std::string_view* value) {
-  const std::string_view prefix = PrefixOf(text, uri);
-  if (prefix.empty()) return false;
-  const size_t qsize = prefix.size() + 1 + name.size();
-  size_t pos = 0;
-  while ((pos = text.find(prefix, pos)) != std::string_view::npos) {
-    const size_t start = pos, after = pos + qsize;
-    pos += prefix.size();
-    if (start == 0 || after >= text.size() || text[start + prefix.size()] != ':' ||
-        text.substr(start + prefix.size() + 1, name.size()) != name) {
-      continue;
-    }
-    const bool element = text[start - 1] == '<';
-    if (!element && !IsSpace(text[start - 1])) continue;
-    if (element) {
-      if (text[after] != '>') continue;
-      size_t close = after + 1;
-      while ((close = text.find("</", close)) != std::string_view::npos) {
-        if (text.substr(close + 2, qsize) == text.substr(start, qsize)) break;
-        close += 2;
-      }
-      if (close == std::string_view::npos) return false;
-      *value = text.substr(after + 1, close - after - 1);
-      return true;
-    }
-    size_t eq = after;
-    while (eq < text.size() && IsSpace(text[eq])) ++eq;
-    if (eq >= text.size() || text[eq] != '=') continue;
-    return Quoted(text, eq + 1, value);
-  }
-  return false;
-}
-
-struct Packets {
-  std::string_view main, extended;
-  bool Find(const char* uri, const char* name, std::string_view* value) const {
-    return FindIn(main, uri, name, value) || FindIn(extended, uri, name, value);
-  }
-  bool Has(const char* uri, const char* name) const {
-    std::string_view v;
-    return Find(uri, name, &v);
-  }
-};
-
-Status Number(const Packets& p, const char* path, const char* uri, const char* name, double* out) {
-  std::string_view v;
-  if (!p.Find(uri, name, &v)) return Status(Code::kCorruptData, "%s: %s missing", path, name);
-  while (!v.empty() && IsSpace(v.front())) v.remove_prefix(1);
-  while (!v.empty() && IsSpace(v.back())) v.remove_suffix(1);
-  char text[64];
-  if (v.empty() || v.size() >= sizeof(text)) {
-    return Status(Code::kCorruptData, "%s: %s is not a number", path, name);
-  }
-  memcpy(text, v.data(), v.size());
-  text[v.size()] = '\0';
-  char* end = nullptr;
-  errno = 0;
-  *out = strtod(text, &end);
-  if (end != text + v.size() || errno != 0 || !std::isfinite(*out)) {
-    return Status(Code::kCorruptData, "%s: %s is not a number", path, name);
-  }
-  return Status::Ok();
-}
-
-// Base64 into a vector whose capacity was reserved: more than that is kOutOfMemory, checked
-// before decoding so the vector never grows.
-Status Base64Into(const Packets& p, const char* path, const char* uri, const char* name,
-                  std::vector<uint8_t>* out) {
-  std::string_view v;
-  if (!p.Find(uri, name, &v)) return Status(Code::kUnsupported, "%s: no %s", path, name);
-  if (v.size() / 4 * 3 > out->capacity()) {
-    return Status(Code::kOutOfMemory, "%s: %s of %zu bytes is larger than the engine takes", path,
-                  name, v.size() / 4 * 3);
-  }
-  Status s = Base64Decode(v.data(), v.size(), out);
-  if (!s.ok()) s.Prefix("%s: %s: ", path, name);
-  return s;
-}
-
-// --- libjpeg: the all-in-focus original, row by row into YCbCr 4:2:0 (the conversion the
-// pipeline applies to a sensor's reference frame, as the Rerenderer does).
-struct JpegError {
-  jpeg_error_mgr pub;
-  jmp_buf jump;
-  char message[JMSG_LENGTH_MAX];
-};
-
-[[noreturn]] void JpegFail(j_common_ptr cinfo) {
-  auto* e = reinterpret_cast<JpegError*>(cinfo->err);
-  (*cinfo->err->format_message)(cinfo, e->message);
-  longjmp(e->jump, 1);
-}
-
-void JpegMessage(j_common_ptr cinfo, int level) {
-  if (level >= 0) return;
-  const int code = cinfo->err->msg_code;
-  if (code == JWRN_JFIF_MAJOR || code == JWRN_ADOBE_XFORM || code == JWRN_BOGUS_ICC) return;
-  JpegFail(cinfo);  // corrupt data: never shown as grey padding
-}
-
-struct YccOut {
-  uint8_t *y, *cb, *cr;
-  uint8_t* rgb;  // two rows of max_width RGB8, then one grey row
-  int32_t max_width, max_height;
-  int32_t width, height;
-};
-
-Status DecodeOriginal(const char* path, const uint8_t* data, size_t size, YccOut* out) {
-  jpeg_decompress_struct cinfo;
-  JpegError err;
-  memset(&cinfo, 0, sizeof(cinfo));
-  cinfo.err = jpeg_std_error(&err.pub);
-  err.pub.error_exit = JpegFail;
-  err.pub.emit_message = JpegMessage;
-  err.message[0] = '\0';
-  Code code = Code::kCorruptData;
-  char why[96] = "";
-  if (setjmp(err.jump) != 0) {
-    jpeg_destroy_decompress(&cinfo);
-    return Status(Code::kCorruptData, "%s: GImage: JPEG %s", path, err.message);
-  }
-  jpeg_create_decompress(&cinfo);
-  jpeg_mem_src(&cinfo, data, static_cast<unsigned long>(size));
-  jpeg_read_header(&cinfo, TRUE);
-  const int32_t w = static_cast<int32_t>(cinfo.image_width);
-  const int32_t h = static_cast<int32_t>(cinfo.image_height);
-  if (w > out->max_width || h > out->max_height) {
-    code = Code::kOutOfMemory;
-    snprintf(why, sizeof(why), "a %dx%d original, larger than the %dx%d the engine takes", w, h,
-             out->max_width, out->max_height);
-  } else if (w < 16 || h < 16) {
-    code = Code::kUnsupported;
-    snprintf(why, sizeof(why), "a %dx%d original is too small to render", w, h);
-  } else if (cinfo.jpeg_color_space != JCS_GRAYSCALE && cinfo.jpeg_color_space != JCS_YCbCr &&
-             cinfo.jpeg_color_space != JCS_RGB) {
-    code = Code::kUnsupported;
-    snprintf(why, sizeof(why), "colour space %d", static_cast<int>(cinfo.jpeg_color_space));
-  }
-  if (why[0] != '\0') {
-    jpeg_destroy_decompress(&cinfo);
-    return Status(code, "%s: GImage: %s", path, why);
-  }
-  const bool gray = cinfo.jpeg_color_space == JCS_GRAYSCALE;
-  cinfo.out_color_space = gray ? JCS_GRAYSCALE : JCS_RGB;
-  jpeg_start_decompress(&cinfo);
-  const int32_t cw = (w + 1) / 2;
-  uint8_t* gray_row = out->rgb + static_cast<size_t>(out->max_width) * 6;
-  for (int32_t y = 0; y < h; ++y) {
-    uint8_t* row = out->rgb + static_cast<size_t>(y & 1) * w * 3;
-    JSAMPROW target = gray ? gray_row : row;
-    if (jpeg_read_scanlines(&cinfo, &target, 1) != 1) {
-      jpeg_destroy_decompress(&cinfo);
-      return Status(Code::kCorruptData, "%s: GImage: no row %d", path, y);
-    }
-    if (gray) RowToRgb8(PixelFormat::kGray8, gray_row, nullptr, w, row);
-    RowRgb8ToY(row, w, out->y + static_cast<size_t>(y) * w);
-    if ((y & 1) || y == h - 1) {
-      const uint8_t* above = (y & 1) ? out->rgb : row;
-      RowsRgb8ToCbCr420(above, row, w, out->cb + static_cast<size_t>(y / 2) * cw,
-                        out->cr + static_cast<size_t>(y / 2) * cw);
-    }
-  }
-  jpeg_finish_decompress(&cinfo);
-  jpeg_destroy_decompress(&cinfo);
-  out->width = w;
-  out->height = h;
-  return Status::Ok();
-}
-
-// --- libpng: the grey depth image (8 or 16 bit, not interlaced) into 16-bit values.
-struct PngInput {
-  jmp_buf jump;
-  char message[128];
-  const uint8_t* data;
-  size_t size, pos;
-};
-
-[[noreturn]] void PngFail(png_structp png, png_const_charp message) {
-  auto* in = static_cast<PngInput*>(png_get_error_ptr(png));
-  snprintf(in->message, sizeof(in->message), "%s", message);
-  longjmp(in->jump, 1);
-}
-void PngWarn(png_structp, png_const_charp) {}
-void PngRead(png_structp png, png_bytep out, png_size_t n) {
-  auto* in = static_cast<PngInput*>(png_get_io_ptr(png));
-  if (n > in->size - in->pos) png_error(png, "truncated");
-  memcpy(out, in->data + in->pos, n);
-  in->pos += n;
-}
-
-Status DecodeDepthPng(const char* path, const std::vector<uint8_t>& bytes, int32_t max_w,
-                      int32_t max_h, size_t max_values, uint16_t* values, uint8_t* row8,
-                      int32_t* width, int32_t* height, int* bits) {
-  PngInput in;
-  in.message[0] = '\0';
-  in.data = bytes.data();
-  in.size = bytes.size();
-  in.pos = 0;
-  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &in, PngFail, PngWarn);
-  if (png == nullptr) return Status(Code::kOutOfMemory, "%s: GDepth: no PNG decoder", path);
-  png_infop info = png_create_info_struct(png);
-  char why[96] = "";
-  if (info == nullptr || setjmp(in.jump) != 0) {
-    png_destroy_read_struct(&png, &info, nullptr);
-    return Status(Code::kCorruptData, "%s: GDepth: PNG %s", path, in.message);
-  }
-  png_set_read_fn(png, &in, PngRead);
-  png_read_info(png, info);
-  png_uint_32 w = 0, h = 0;
-  int depth = 0, color = 0, interlace = 0;
-  png_get_IHDR(png, info, &w, &h, &depth, &color, &interlace, nullptr, nullptr);
-  if (color != PNG_COLOR_TYPE_GRAY || interlace != PNG_INTERLACE_NONE ||
-      (depth != 8 && depth != 16)) {
-    snprintf(why, sizeof(why), "not an 8 or 16 bit grey, non-interlaced image");
-  } else if (w < 1 || h < 1 || w > static_cast<png_uint_32>(max_w) ||
-             h > static_cast<png_uint_32>(max_h)) {
-    snprintf(why, sizeof(why), "a %ux%u depth map for a %dx%d photo", static_cast<unsigned>(w),
-             static_cast<unsigned>(h), max_w, max_h);
-  } else if (static_cast<size_t>(w) * h > max_values) {
-    snprintf(why, sizeof(why), "a %ux%u depth map, larger than the engine takes",
-             static_cast<unsigned>(w), static_cast<unsigned>(h));
-  }
-  if (why[0] != '\0') {
-    png_destroy_read_struct(&png, &info, nullptr);
-    return Status(Code::kUnsupported, "%s: GDepth: %s", path, why);
-  }
-  const uint16_t probe = 1;
-  uint8_t first = 0;
-  memcpy(&first, &probe, 1);
-  if (depth == 16 && first == 1) png_set_swap(png);  // PNG is big-endian
-  png_read_update_info(png, info);
-  for (png_uint_32 y = 0; y < h; ++y) {
-    uint16_t* out = values + static_cast<size_t>(y) * w;
-    if (depth == 16) {
-      png_read_row(png, reinterpret_cast<png_bytep>(out), nullptr);
-    } else {
-      png_read_row(png, row8, nullptr);
-      for (png_uint_32 x = 0; x < w; ++x) out[x] = row8[x];
-    }
-  }
-  png_read_end(png, nullptr);
-  png_destroy_read_struct(&png, &info, nullptr);
-  *width = static_cast<int32_t>(w);
-  *height = static_cast<int32_t>(h);
-  *bits = depth;
-  return Status::Ok();
-}
 
 // Mean of a step x step block of `src` (clamped at its edges) into each pixel of `dst`.
 void BoxDown(const uint8_t* src, int32_t sw, int32_t sh, int32_t step, uint8_t* dst, int32_t dw,
@@ -385,14 +87,17 @@ Status RefocusEngine::Configure(const RefocusEngineConfig& config) {
   const size_t pcpx = static_cast<size_t>((pw + 1) / 2) * ((ph + 1) / 2);
   scratch_.reserve(file);
   extended_.resize(file);
-  chunks_.reserve(file / kExtendedXmpChunk + 2);
+  // As many chunks as the writer makes of a file this size (more: kOutOfMemory).
+  chunks_.resize(file / kExtendedXmpChunk + 2);
   // Base64 in the extended XMP: at most 3/4 of the file; a 16-bit depth PNG, at most its
   // values' bytes and a little (stored rows of 64 KiB deflate blocks).
   const size_t depth_px =
       std::min(pixels, static_cast<size_t>(std::max(1, config.max_depth_pixels)));
   png_.reserve(std::min(file / 4 * 3, depth_px * 2 + depth_px / 64 + 65536));
   original_.reserve(file / 4 * 3);
-  rgb_rows_.resize(static_cast<size_t>(W) * 7);
+  rgb_rows_.resize(static_cast<size_t>(W) * 6);
+  // The readers' strip: the original's RGB rows, then the depth PNG's 16-bit ones.
+  strip_.resize(ImageStripBytes(W, PixelFormat::kRgb8));
   y_.resize(pixels);
   cb_.resize(cpx);
   cr_.resize(cpx);
@@ -437,7 +142,8 @@ Status RefocusEngine::Configure(const RefocusEngineConfig& config) {
   pool_ = std::make_unique<WorkerPool>();
   LB_RETURN_IF_ERROR(pool_->Start(workers));
   reserved_bytes_ = scratch_.capacity() + extended_.size() + png_.capacity() +
-                    original_.capacity() + rgb_rows_.size() + pixels + 2 * cpx +
+                    original_.capacity() + rgb_rows_.size() + strip_.size() +
+                    chunks_.size() * sizeof(ExtendedXmpChunk) + pixels + 2 * cpx +
                     4 * depth_values_.size() + ppx * 3 + 2 * pcpx + full_bytes_ + preview_bytes_;
   configured_ = true;
   return Status::Ok();
@@ -487,143 +193,88 @@ Status RefocusEngine::Load(const char* path) {
 }
 
 Status RefocusEngine::ParseAndDecode(const char* path, size_t size) {
-  const uint8_t* data = scratch_.data();
-  if (size < 4 || data[0] != 0xFF || data[1] != 0xD8) {
-    return Status(Code::kUnsupported, "%s: not a JPEG", path);
-  }
-  // The segments before the image data: the main XMP packet and the extended-XMP chunks.
-  Packets packets;
-  bool have_main = false, have_scan = false;
-  chunks_.clear();
-  size_t pos = 2;
-  while (!have_scan) {
-    if (pos >= size || data[pos] != 0xFF) {
-      return Status(Code::kCorruptData, "%s: no marker at offset %zu", path, pos);
-    }
-    while (pos < size && data[pos] == 0xFF) ++pos;
-    if (pos >= size) return Status(Code::kCorruptData, "%s: ends in a marker", path);
-    const uint8_t marker = data[pos++];
-    if (marker == 0xD9) return Status(Code::kCorruptData, "%s: no image data", path);
-    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) continue;
-    if (size - pos < 2) return Status(Code::kCorruptData, "%s: ends in a marker", path);
-    const size_t length = (size_t{data[pos]} << 8) | data[pos + 1];
-    if (length < 2 || length > size - pos) {
-      return Status(Code::kCorruptData, "%s: segment 0x%02X truncated", path, marker);
-    }
-    const uint8_t* p = data + pos + 2;
-    const size_t n = length - 2;
-    pos += length;
-    if (marker == 0xDA) have_scan = true;
-    if (marker != 0xE1) continue;
-    if (!have_main && n >= sizeof(kXmpSignature) &&
-        memcmp(p, kXmpSignature, sizeof(kXmpSignature)) == 0) {
-      packets.main = std::string_view(reinterpret_cast<const char*>(p) + sizeof(kXmpSignature),
-                                      n - sizeof(kXmpSignature));
-      have_main = true;
-    } else if (n >= kExtendedHeader &&
-               memcmp(p, kExtendedXmpSignature, sizeof(kExtendedXmpSignature)) == 0) {
-      const uint8_t* h = p + sizeof(kExtendedXmpSignature) + 32;
-      const uint32_t full = BigEndian32(h), offset = BigEndian32(h + 4);
-      const size_t bytes = n - kExtendedHeader;
-      if (offset > full || bytes > full - offset) {
-        return Status(Code::kCorruptData, "%s: extended XMP chunk overruns", path);
-      }
-      if (chunks_.size() == chunks_.capacity()) {
-        return Status(Code::kOutOfMemory, "%s: more extended XMP than the engine takes", path);
-      }
-      chunks_.push_back(
-          {p + sizeof(kExtendedXmpSignature), offset, full, p + kExtendedHeader, bytes});
-    }
-  }
-  if (!have_main) return Status(Code::kUnsupported, "%s: no XMP (not a refocusable JPEG)", path);
-  std::string_view guid;
-  if (FindIn(packets.main, kXmpNoteNs, "HasExtendedXMP", &guid)) {
-    if (guid.size() != 32) return Status(Code::kCorruptData, "%s: bad HasExtendedXMP", path);
-    // This packet's chunks in offset order, contiguous, then checked against the MD5.
-    auto mine = std::partition(chunks_.begin(), chunks_.end(), [&](const Chunk& c) {
-      return memcmp(c.guid, guid.data(), 32) == 0;
-    });
-    std::sort(chunks_.begin(), mine,
-              [](const Chunk& a, const Chunk& b) { return a.offset < b.offset; });
-    size_t expected = 0;
-    for (auto c = chunks_.begin(); c != mine; ++c) {
-      if (c->offset != expected || c->full != chunks_.front().full) {
-        return Status(Code::kCorruptData, "%s: extended XMP chunks do not fit together", path);
-      }
-      memcpy(extended_.data() + expected, c->bytes, c->size);
-      expected += c->size;
-    }
-    if (chunks_.begin() == mine || expected != chunks_.front().full) {
-      return Status(Code::kCorruptData, "%s: extended XMP incomplete", path);
-    }
-    char md5[33];
-    Md5Hex(extended_.data(), expected, md5);
-    if (guid != std::string_view(md5, 32)) {
-      return Status(Code::kCorruptData, "%s: extended XMP does not match its MD5", path);
-    }
-    packets.extended = std::string_view(reinterpret_cast<const char*>(extended_.data()), expected);
-  }
-
-  // GDepth: a RangeInverse PNG, back to the disparity it was rendered from.
-  std::string_view text;
-  if (!packets.Find(kGDepthNs, "Format", &text)) {
-    return Status(Code::kUnsupported, "%s: no depth map (GDepth)", path);
-  }
-  if (text != "RangeInverse") {
+  // The shared reader, into the buffers Configure sized (base64 outputs at full capacity, then
+  // cut to what was decoded: neither ever reallocates).
+  png_.resize(png_.capacity());
+  original_.resize(original_.capacity());
+  RefocusableBuffers memory;
+  memory.chunks = chunks_.data();
+  memory.chunk_capacity = chunks_.size();
+  memory.extended = extended_.data();
+  memory.extended_capacity = extended_.size();
+  memory.depth_png = png_.data();
+  memory.depth_png_capacity = png_.size();
+  memory.image = original_.data();
+  memory.image_capacity = original_.size();
+  RefocusableFields f;
+  Status s = ReadRefocusableFields(scratch_.data(), size, path, memory, &f);
+  png_.resize(f.depth_png_size);
+  original_.resize(f.image_size);
+  // No XMP or no depth map: a photo, but not one to refocus (kNotFound is for missing files).
+  if (s.code() == Code::kNotFound) return Status(Code::kUnsupported, "%s", s.message());
+  LB_RETURN_IF_ERROR(s);
+  if (f.depth_format != "RangeInverse") {
     return Status(Code::kUnsupported, "%s: GDepth:Format '%.*s' (only RangeInverse)", path,
-                  static_cast<int>(std::min<size_t>(text.size(), 32)), text.data());
+                  static_cast<int>(std::min<size_t>(f.depth_format.size(), 32)),
+                  f.depth_format.data());
   }
-  if (!packets.Find(kGImageNs, "Data", &text)) {
+  if (f.image == nullptr) {
     return Status(Code::kUnsupported, "%s: no all-in-focus original (GImage)", path);
   }
-  double near_depth = 0, far_depth = 0;
-  LB_RETURN_IF_ERROR(Number(packets, path, kGDepthNs, "Near", &near_depth));
-  LB_RETURN_IF_ERROR(Number(packets, path, kGDepthNs, "Far", &far_depth));
-  Status s = DisparityRangeFromNearFar(near_depth, far_depth, &range_);
+  s = DisparityRangeFromNearFar(f.near_depth, f.far_depth, &range_);
   if (!s.ok()) return s.Prefix("%s: ", path);
-  LB_RETURN_IF_ERROR(Base64Into(packets, path, kGDepthNs, "Data", &png_));
-  LB_RETURN_IF_ERROR(Base64Into(packets, path, kGImageNs, "Data", &original_));
-  double fx = 0.5, fy = 0.5, blur_inf = 0, focal_distance = 0;
-  const bool has_focus = packets.Has(kGFocusNs, "FocalPointX");
-  if (has_focus) {
-    LB_RETURN_IF_ERROR(Number(packets, path, kGFocusNs, "FocalPointX", &fx));
-    LB_RETURN_IF_ERROR(Number(packets, path, kGFocusNs, "FocalPointY", &fy));
-    LB_RETURN_IF_ERROR(Number(packets, path, kGFocusNs, "BlurAtInfinity", &blur_inf));
-    LB_RETURN_IF_ERROR(Number(packets, path, kGFocusNs, "FocalDistance", &focal_distance));
-  }
-  const int32_t orientation = ExifOrientation(data, size);
 
-  YccOut ycc = {y_.data(),         cb_.data(),         cr_.data(), rgb_rows_.data(),
-                config_.max_width, config_.max_height, 0,          0};
-  LB_RETURN_IF_ERROR(DecodeOriginal(path, original_.data(), original_.size(), &ycc));
-  int32_t dw = 0, dh = 0;
-  int bits = 0;
-  LB_RETURN_IF_ERROR(DecodeDepthPng(path, png_, ycc.width, ycc.height, depth_values_.size(),
-                                    depth_values_.data(), rgb_rows_.data(), &dw, &dh, &bits));
-  const int32_t scale = ycc.width / dw;
-  if (scale < 1 || dw * scale > ycc.width || dh * scale > ycc.height || ycc.height / scale != dh) {
+  char what[300];
+  snprintf(what, sizeof(what), "%s: GImage", path);
+  ImageReadMemory strip;
+  strip.strip = strip_.data();
+  strip.strip_bytes = strip_.size();
+  strip.max_width = config_.max_width;
+  strip.max_height = config_.max_height;
+  Ycc420Sink ycc(y_.data(), cb_.data(), cr_.data(), rgb_rows_.data());
+  LB_RETURN_IF_ERROR(
+      StreamImageMemory(f.image, f.image_size, what, 0, ycc, strip, ImageFileType::kJpeg));
+  const int32_t width = ycc.frame().width, height = ycc.frame().height;
+  if (width < 16 || height < 16) {
+    return Status(Code::kUnsupported, "%s: a %dx%d original is too small to render", what, width,
+                  height);
+  }
+
+  DepthPngName(path, what, sizeof(what));
+  GrayPngBuffer depth;
+  depth.values = depth_values_.data();
+  depth.capacity = depth_values_.size();
+  depth.strip = strip_.data();
+  depth.strip_bytes = strip_.size();
+  LB_RETURN_IF_ERROR(DecodeGrayPngInto(f.depth_png, f.depth_png_size, what, f.depth_max_side,
+                                       f.depth_width, f.depth_height, &depth));
+  const int32_t dw = depth.width, dh = depth.height;
+  const int32_t scale = width / dw;
+  if (scale < 1 || dw * scale > width || dh * scale > height || height / scale != dh) {
     return Status(Code::kUnsupported,
                   "%s: depth map %dx%d is not a whole-number fraction of the %dx%d original", path,
-                  dw, dh, ycc.width, ycc.height);
+                  dw, dh, width, height);
   }
   LB_RETURN_IF_ERROR(DecodeDepthMap(MakeView<const uint16_t>(depth_values_.data(), dw, dh), range_,
-                                    bits, MakeView(disp_q8_.data(), dw, dh)));
+                                    depth.bits, MakeView(disp_q8_.data(), dw, dh)));
   depth_w_ = dw;
   depth_h_ = dh;
   photo_ = EnginePhoto();
-  photo_.width = ycc.width;
-  photo_.height = ycc.height;
-  photo_.orientation = orientation;
+  photo_.width = width;
+  photo_.height = height;
+  photo_.orientation = f.orientation;
   photo_.working_scale = scale;
   // What it was rendered with: lens_model.h's blur at infinity is 2 * (2.8 / f) * scale * d_focus
   // px, d_focus = 1 / FocalDistance, so the f-number comes back from the two.
   RenderParams& cur = photo_.current;
-  cur.focus =
-      FocusAtPoint(static_cast<int32_t>(fx * ycc.width), static_cast<int32_t>(fy * ycc.height));
+  const GFocusInfo& focus = f.focus;
+  const double fx = f.has_focus ? focus.focal_point_x : 0.5;
+  const double fy = f.has_focus ? focus.focal_point_y : 0.5;
+  cur.focus = FocusAtPoint(static_cast<int32_t>(fx * width), static_cast<int32_t>(fy * height));
   cur.f_number = 2.8f;
-  if (has_focus && blur_inf > 0 && focal_distance > 0) {
-    const double f = 5.6 * scale / (focal_distance * blur_inf * ycc.width);
-    if (std::isfinite(f)) cur.f_number = static_cast<float>(std::clamp(f, 1.4, 16.0));
+  if (f.has_focus && focus.blur_at_infinity > 0 && focus.focal_distance > 0) {
+    const double fn = 5.6 * scale / (focus.focal_distance * focus.blur_at_infinity * width);
+    if (std::isfinite(fn)) cur.f_number = static_cast<float>(std::clamp(fn, 1.4, 16.0));
   }
   return Status::Ok();
 }

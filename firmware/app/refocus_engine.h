@@ -2,10 +2,12 @@
 // refocus), in memory sized once. Configure takes the largest photo the camera makes and sizes
 // every buffer then: the file's bytes (also the output JPEG's, once the file is decoded), the
 // reassembled extended XMP, the all-in-focus original (JPEG bytes and YCbCr 4:2:0 planes), the
-// depth map, a downscaled copy of both for previews, and the render arenas. Load, RenderPreview,
-// RenderFull allocate nothing after that (the codec libraries' own scratch memory aside), so the
-// daemon's memory stays flat however the page is used; Save shares `refocus rerender`'s writing
-// code (WriteRerendered), which builds the file's metadata on the heap and frees it.
+// depth map, a downscaled copy of both for previews, the readers' strip and the render arenas.
+// Load reads through the product's one reader per format (refocusable_reader, the JPEG and PNG
+// readers) into those buffers. Load, RenderPreview, RenderFull allocate nothing after Configure
+// (the codec libraries' own scratch memory aside), so the daemon's memory stays flat however the
+// page is used; Save shares `refocus rerender`'s writing code (WriteRerendered), which builds the
+// file's metadata on the heap and frees it.
 //
 // The camera comes first: between strips every render waits while `camera_busy` is set, so a
 // capture is slowed by at most one strip of web work.
@@ -20,6 +22,7 @@
 #include "algo/core/status.h"
 #include "algo/render/render_stage.h"
 #include "firmware/refocusable/depth_encoding.h"
+#include "firmware/refocusable/refocusable_reader.h"
 
 namespace lb {
 
@@ -88,7 +91,6 @@ class RefocusEngine {
   int64_t paused_strips() const { return paused_strips_; }
 
  private:
-  struct Chunk;
   Status LoadFile(const char* path);
   Status ParseAndDecode(const char* path, size_t size);
   Status MakePreviewInputs();
@@ -105,11 +107,12 @@ class RefocusEngine {
   // The file's bytes while it loads, then the output JPEG (capacity kept: never reallocated).
   std::vector<uint8_t> scratch_;
   size_t output_size_ = 0;
-  std::vector<uint8_t> extended_;  // the reassembled extended XMP
-  std::vector<Chunk> chunks_;      // extended-XMP chunk descriptors (capacity fixed)
-  std::vector<uint8_t> png_;       // GDepth:Data (base64-decoded, capacity fixed)
-  std::vector<uint8_t> original_;  // GImage:Data, the all-in-focus JPEG (capacity fixed)
-  std::vector<uint8_t> rgb_rows_;  // two decoded rows
+  std::vector<uint8_t> extended_;         // the reassembled extended XMP
+  std::vector<ExtendedXmpChunk> chunks_;  // the reader's extended-XMP chunk descriptors
+  std::vector<uint8_t> png_;              // GDepth:Data (base64-decoded, capacity fixed)
+  std::vector<uint8_t> original_;         // GImage:Data, the all-in-focus JPEG (capacity fixed)
+  std::vector<uint8_t> strip_;            // the image readers' rows (a strip of the widest photo)
+  std::vector<uint8_t> rgb_rows_;         // two RGB rows of the original, for its 4:2:0 chroma
   std::vector<uint8_t> y_, cb_, cr_;
   std::vector<uint16_t> depth_values_, disp_q8_;
   int32_t depth_w_ = 0, depth_h_ = 0;

@@ -32,41 +32,61 @@ Status Rerenderer::Load(const char* path) {
                   "%s: GImage: a %dx%d original, larger than the %dx%d refocus renders", path,
                   info.width, info.height, PipelineConfig::kMaxWidth, PipelineConfig::kMaxHeight);
   }
-  std::vector<uint8_t> pixels;
-  s = ReadImageMemory(file.xmp.image.data(), file.xmp.image.size(), "GImage", &info, &pixels,
-                      ImageFileType::kJpeg);
-  if (!s.ok()) return s.Prefix("%s: ", path);
-  orientation_ = file.orientation;
-  depth_w_ = file.depth.width;
-  depth_h_ = file.depth.height;
+  // Straight into the planes, a strip at a time (the same reader and conversion as the web
+  // page's engine).
   width_ = info.width;
   height_ = info.height;
-  scale_ = depth_w_ > 0 ? width_ / depth_w_ : 0;
-  if (scale_ < 1 || depth_h_ * scale_ > height_ || depth_w_ * scale_ > width_ ||
-      height_ / scale_ != depth_h_) {
-    return Status(Code::kUnsupported,
-                  "%s: depth map %dx%d is not a whole-number fraction of the %dx%d original", path,
-                  depth_w_, depth_h_, width_, height_);
-  }
-  // The same conversion the pipeline applies to a sensor's reference frame.
   const int32_t cw = (width_ + 1) / 2, ch = (height_ + 1) / 2;
   y_.assign(static_cast<size_t>(width_) * height_, 0);
   cb_.assign(static_cast<size_t>(cw) * ch, 0);
   cr_.assign(static_cast<size_t>(cw) * ch, 0);
   std::vector<uint8_t> rgb(static_cast<size_t>(width_) * 3 * 2);
-  const int bpp = BytesPerPixel(info.format);
-  for (int32_t y = 0; y < height_; ++y) {
-    uint8_t* row = rgb.data() + (y & 1) * width_ * 3;
-    RowToRgb8(info.format, pixels.data() + static_cast<size_t>(y) * width_ * bpp, nullptr, width_,
-              row);
-    RowRgb8ToY(row, width_, y_.data() + static_cast<size_t>(y) * width_);
-    if ((y & 1) || y == height_ - 1) {
-      const uint8_t* above = (y & 1) ? rgb.data() : row;
-      RowsRgb8ToCbCr420(above, row, width_, cb_.data() + static_cast<size_t>(y / 2) * cw,
-                        cr_.data() + static_cast<size_t>(y / 2) * cw);
-    }
+  std::vector<uint8_t> strip(ImageStripBytes(width_, PixelFormat::kRgb8));
+  ImageReadMemory memory;
+  memory.strip = strip.data();
+  memory.strip_bytes = strip.size();
+  memory.max_width = width_;
+  memory.max_height = height_;
+  Ycc420Sink ycc(y_.data(), cb_.data(), cr_.data(), rgb.data());
+  s = StreamImageMemory(file.xmp.image.data(), file.xmp.image.size(), "GImage", 0, ycc, memory,
+                        ImageFileType::kJpeg);
+  if (!s.ok()) {
+    width_ = 0;  // nothing loaded: Render refuses
+    return s.Prefix("%s: ", path);
+  }
+  orientation_ = file.orientation;
+  depth_w_ = file.depth.width;
+  depth_h_ = file.depth.height;
+  scale_ = depth_w_ > 0 ? width_ / depth_w_ : 0;
+  if (scale_ < 1 || depth_h_ * scale_ > height_ || depth_w_ * scale_ > width_ ||
+      height_ / scale_ != depth_h_) {
+    width_ = 0;
+    return Status(Code::kUnsupported,
+                  "%s: depth map %dx%d is not a whole-number fraction of the %dx%d original", path,
+                  depth_w_, depth_h_, width_, height_);
   }
   original_jpeg_ = std::move(file.xmp.image);
+  return Status::Ok();
+}
+
+Status Ycc420Sink::BeginFrame(const FrameInfo& info) {
+  frame_ = info;
+  return Status::Ok();
+}
+
+Status Ycc420Sink::Rows(const FrameRows& rows) {
+  const int32_t w = frame_.width, cw = (w + 1) / 2;
+  for (int32_t i = 0; i < rows.height; ++i) {
+    const int32_t y = rows.y0 + i;
+    uint8_t* row = rgb_ + static_cast<size_t>(y & 1) * w * 3;
+    RowToRgb8(frame_.format, rows.planes[0] + i * rows.strides[0], nullptr, w, row);
+    RowRgb8ToY(row, w, y_ + static_cast<size_t>(y) * w);
+    if ((y & 1) || y == frame_.height - 1) {
+      const uint8_t* above = (y & 1) ? rgb_ : row;
+      RowsRgb8ToCbCr420(above, row, w, cb_ + static_cast<size_t>(y / 2) * cw,
+                        cr_ + static_cast<size_t>(y / 2) * cw);
+    }
+  }
   return Status::Ok();
 }
 

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "algo/core/frame.h"
 #include "algo/core/image.h"
 #include "algo/render/render_stage.h"
 #include "firmware/app/job.h"
@@ -38,6 +39,23 @@ struct RerenderSource {
 Status WriteRerendered(RenderStage* render, const RenderParams& params,
                        const RerenderSource& source, int quality, const char* software,
                        StripObserver* observer, Progress* progress, const char* out_path);
+
+// The all-in-focus original's rows, as an image reader streams them, into YCbCr 4:2:0 planes
+// (the conversion the pipeline applies to a sensor's reference frame): `y` holds width x height
+// bytes, `cb` and `cr` a quarter each (rounded up), `rgb` two rows of RGB8. Nothing allocated.
+class Ycc420Sink final : public FrameSink {
+ public:
+  Ycc420Sink(uint8_t* y, uint8_t* cb, uint8_t* cr, uint8_t* rgb)
+      : y_(y), cb_(cb), cr_(cr), rgb_(rgb) {}
+  Status BeginFrame(const FrameInfo& info) override;
+  Status Rows(const FrameRows& rows) override;
+  Status EndFrame() override { return Status::Ok(); }
+  const FrameInfo& frame() const { return frame_; }
+
+ private:
+  FrameInfo frame_;
+  uint8_t *y_, *cb_, *cr_, *rgb_;
+};
 
 class Rerenderer {
  public:

@@ -79,6 +79,29 @@ Status DeliverRows(const DecodeRequest& request, const uint8_t* rows, size_t row
   return request.sink->Rows(strip);
 }
 
+Status RowBuffer(const DecodeRequest& request, uint64_t bytes, Buffer* heap, uint8_t** rows) {
+  const ImageFileInfo& info = *request.info;
+  const ImageReadMemory* memory = request.memory;
+  if (memory == nullptr) {
+    if (!heap->Allocate(bytes)) {
+      return Status(Code::kOutOfMemory, "%s: no memory for %" PRIu64 " bytes of %dx%d rows",
+                    request.name, bytes, info.width, info.height);
+    }
+    *rows = heap->data();
+    return Status::Ok();
+  }
+  if (info.width > memory->max_width || info.height > memory->max_height) {
+    return Status(Code::kOutOfMemory, "%s: a %dx%d image, larger than the %dx%d this reader takes",
+                  request.name, info.width, info.height, memory->max_width, memory->max_height);
+  }
+  if (bytes > memory->strip_bytes) {
+    return Status(Code::kOutOfMemory, "%s: %" PRIu64 " bytes of rows, more than the %zu given",
+                  request.name, bytes, memory->strip_bytes);
+  }
+  *rows = memory->strip;
+  return Status::Ok();
+}
+
 Status CheckImageSize(const char* name, int64_t width, int64_t height, int32_t max_side) {
   if (width <= 0 || height <= 0) {
     return Status(Code::kCorruptData, "%s: bad image size %" PRId64 "x%" PRId64, name, width,

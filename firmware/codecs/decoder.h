@@ -87,7 +87,20 @@ struct DecodeRequest {
   int32_t width = 0;
   int32_t height = 0;
   bool plain_gray = false;  // PNG only: grey without alpha, not interlaced
+  // The caller's memory (StreamImageMemory): no heap buffer, and a size limit. Null: allocate.
+  const ImageReadMemory* memory = nullptr;
 };
+
+// A request to stream the pixels into `sink` as frame `index`, the header recorded in `info`.
+inline DecodeRequest StreamRequest(const char* name, ImageFileInfo* info, FrameSink* sink,
+                                   int32_t index = 0) {
+  DecodeRequest request;
+  request.name = name;
+  request.info = info;
+  request.sink = sink;
+  request.index = index;
+  return request;
+}
 
 Status DecodePnm(ByteSource& src, const DecodeRequest& request);
 Status DecodePng(ByteSource& src, const DecodeRequest& request);
@@ -104,6 +117,10 @@ Status DeliverRows(const DecodeRequest& request, const uint8_t* rows, size_t row
 inline int32_t StripRows(int32_t y0, int32_t height) {
   return height - y0 < kImageStripRows ? height - y0 : kImageStripRows;
 }
+
+// The buffer of `bytes` a reader decodes rows into: the caller's strip when it gave one (after
+// checking the header's size against its limits), else `heap`. kOutOfMemory when neither fits.
+Status RowBuffer(const DecodeRequest& request, uint64_t bytes, Buffer* heap, uint8_t** rows);
 
 // Checks the header's size against `max_side` (kMaxImageSide for a file).
 Status CheckImageSize(const char* name, int64_t width, int64_t height,

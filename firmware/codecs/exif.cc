@@ -184,4 +184,36 @@ int32_t ExifOrientation(const uint8_t* data, size_t size) {
   return ShortTag(exif, EXIF_IFD_0, EXIF_TAG_ORIENTATION, 1, 8);
 }
 
+namespace {
+
+// Each orientation as a transpose (5..8) followed by mirroring the displayed axes: 2 mirrors x,
+// 3 both, 4 y; 5 is the transpose alone, 6 (90 degrees clockwise) then mirrors x, 7 both, 8 y.
+struct Turn {
+  bool swap, flip_x, flip_y;
+};
+
+Turn TurnOf(int32_t o) {
+  static constexpr Turn kTurns[9] = {
+      {false, false, false}, {false, false, false}, {false, true, false},
+      {false, true, true},   {false, false, true},  {true, false, false},
+      {true, true, false},   {true, true, true},    {true, false, true}};
+  return o >= 1 && o <= 8 ? kTurns[o] : kTurns[0];
+}
+
+}  // namespace
+
+void ExifStoredToDisplayed(int32_t o, double s, double t, double* u, double* v) {
+  const Turn turn = TurnOf(o);
+  const double a = turn.swap ? t : s, b = turn.swap ? s : t;
+  *u = turn.flip_x ? 1 - a : a;
+  *v = turn.flip_y ? 1 - b : b;
+}
+
+void ExifDisplayedToStored(int32_t o, double u, double v, double* s, double* t) {
+  const Turn turn = TurnOf(o);
+  const double a = turn.flip_x ? 1 - u : u, b = turn.flip_y ? 1 - v : v;
+  *s = turn.swap ? b : a;
+  *t = turn.swap ? a : b;
+}
+
 }  // namespace lb

@@ -41,4 +41,12 @@ int32_t ExifOrientation(const char* path);
 // The same from a whole file already in memory.
 int32_t ExifOrientation(const uint8_t* data, size_t size);
 
+// How a viewer turns the stored pixels for EXIF Orientation `o`, on points given as fractions
+// of the image's sides: stored (s, t) -> displayed (u, v), and back. Orientations outside 1..8
+// (0: none recorded) leave points as stored.
+void ExifStoredToDisplayed(int32_t o, double s, double t, double* u, double* v);
+void ExifDisplayedToStored(int32_t o, double u, double v, double* s, double* t);
+// True for 5..8: the displayed width is the stored height.
+inline bool ExifSwapsSides(int32_t o) { return o >= 5 && o <= 8; }
+
 }  // namespace lb

@@ -127,12 +127,7 @@ Status ProbeImageFile(const char* path, ImageFileInfo* info) {
 
 Status StreamImageFile(const char* path, int32_t index, FrameSink& sink) {
   ImageFileInfo info;
-  codecs::DecodeRequest request;
-  request.name = path;
-  request.info = &info;
-  request.sink = &sink;
-  request.index = index;
-  return DecodeFile(path, request);
+  return DecodeFile(path, codecs::StreamRequest(path, &info, &sink, index));
 }
 
 Status ReadImageFile(const char* path, ImageFileInfo* info, std::vector<uint8_t>* pixels) {
@@ -146,13 +141,18 @@ Status ReadImageMemory(const uint8_t* data, size_t size, const char* name, Image
                        std::vector<uint8_t>* pixels, ImageFileType type) {
   CollectSink collect(name, info, pixels);
   codecs::MemorySource src(data, size);
-  codecs::DecodeRequest request;
-  request.name = name;
-  request.info = info;
-  request.sink = &collect;
-  Status s = Decode(src, type, request);
+  Status s = Decode(src, type, codecs::StreamRequest(name, info, &collect));
   if (!s.ok()) pixels->clear();
   return s;
+}
+
+Status StreamImageMemory(const uint8_t* data, size_t size, const char* name, int32_t index,
+                         FrameSink& sink, const ImageReadMemory& memory, ImageFileType type) {
+  codecs::MemorySource src(data, size);
+  ImageFileInfo info;
+  codecs::DecodeRequest request = codecs::StreamRequest(name, &info, &sink, index);
+  request.memory = &memory;
+  return Decode(src, type, request);
 }
 
 Status ProbeImageMemory(const uint8_t* data, size_t size, const char* name, ImageFileInfo* info,

@@ -42,9 +42,31 @@ Status ReadImageMemory(const uint8_t* data, size_t size, const char* name, Image
 Status ProbeImageMemory(const uint8_t* data, size_t size, const char* name, ImageFileInfo* info,
                         ImageFileType type = ImageFileType::kAuto);
 
+// Memory a caller sized once, for a read that must not allocate (the web page's engine): the
+// reader decodes each strip into `strip` instead of a heap buffer, and an image wider or taller
+// than the caller takes is kOutOfMemory before any pixel is decoded.
+struct ImageReadMemory {
+  uint8_t* strip = nullptr;  // at least ImageStripBytes(max_width, the widest format expected)
+  size_t strip_bytes = 0;
+  int32_t max_width = 0;
+  int32_t max_height = 0;
+};
+
+// StreamImageFile over bytes in memory, with the caller's strip (the codec libraries' own state
+// aside, nothing is allocated). Interlaced PNGs need the whole image at once: kOutOfMemory unless
+// the strip holds it.
+Status StreamImageMemory(const uint8_t* data, size_t size, const char* name, int32_t index,
+                         FrameSink& sink, const ImageReadMemory& memory,
+                         ImageFileType type = ImageFileType::kAuto);
+
 // Frames are capped at this size in each direction (a corrupt header cannot ask for gigabytes).
 inline constexpr int32_t kMaxImageSide = 16384;
 // Streaming readers deliver strips of at most this many rows.
 inline constexpr int32_t kImageStripRows = 16;
+
+// The strip a reader decodes into for an image `width` pixels wide of `format`.
+inline size_t ImageStripBytes(int32_t width, PixelFormat format) {
+  return static_cast<size_t>(width) * static_cast<size_t>(BytesPerPixel(format)) * kImageStripRows;
+}
 
 }  // namespace lb

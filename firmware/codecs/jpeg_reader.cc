@@ -178,13 +178,12 @@ Status JpegReader::Decode() {
                   height, channels);
   }
   const size_t row_bytes = static_cast<size_t>(cinfo_.output_width) * channels;
-  if (!rows_.Allocate(static_cast<uint64_t>(row_bytes) * kImageStripRows)) {
-    return Status(Code::kOutOfMemory, "%s: no memory for a strip of %ux%d", name,
-                  cinfo_.output_width, kImageStripRows);
-  }
+  uint8_t* rows = nullptr;
+  LB_RETURN_IF_ERROR(
+      RowBuffer(request_, static_cast<uint64_t>(row_bytes) * kImageStripRows, &rows_, &rows));
   JSAMPROW pointers[kImageStripRows];
   for (int32_t y = 0; y < kImageStripRows; ++y) {
-    pointers[y] = rows_.data() + row_bytes * static_cast<size_t>(y);
+    pointers[y] = rows + row_bytes * static_cast<size_t>(y);
   }
 
   LB_RETURN_IF_ERROR(BeginFrame(request_));
@@ -199,7 +198,7 @@ Status JpegReader::Decode() {
       }
       done += static_cast<int32_t>(got);
     }
-    LB_RETURN_IF_ERROR(DeliverRows(request_, rows_.data(), row_bytes, y0, n));
+    LB_RETURN_IF_ERROR(DeliverRows(request_, rows, row_bytes, y0, n));
   }
   // Reads on to the EOI marker, so corrupt or missing data after the last row is still an error.
   jpeg_finish_decompress(&cinfo_);

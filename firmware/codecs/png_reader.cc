@@ -108,28 +108,29 @@ Status PngReader::Decode() {
   }
   // Interlaced images need every pass before any row is final: hold the whole image then.
   const int32_t buffer_rows = passes > 1 ? static_cast<int32_t>(height) : kImageStripRows;
-  if (!rows_.Allocate(static_cast<uint64_t>(row_bytes_) * static_cast<uint64_t>(buffer_rows))) {
-    return Status(Code::kOutOfMemory, "%s: no memory for %ux%d PNG rows", name, width, buffer_rows);
-  }
+  uint8_t* buffer = nullptr;
+  LB_RETURN_IF_ERROR(
+      RowBuffer(request_, static_cast<uint64_t>(row_bytes_) * static_cast<uint64_t>(buffer_rows),
+                &rows_, &buffer));
 
   LB_RETURN_IF_ERROR(BeginFrame(request_));
   if (passes > 1) {
     for (int pass = 0; pass < passes; ++pass) {
       for (int32_t y = 0; y < rows; ++y) {
-        png_read_row(png_, rows_.data() + row_bytes_ * static_cast<size_t>(y), nullptr);
+        png_read_row(png_, buffer + row_bytes_ * static_cast<size_t>(y), nullptr);
       }
     }
     for (int32_t y0 = 0; y0 < rows; y0 += kImageStripRows) {
-      const uint8_t* strip = rows_.data() + row_bytes_ * static_cast<size_t>(y0);
+      const uint8_t* strip = buffer + row_bytes_ * static_cast<size_t>(y0);
       LB_RETURN_IF_ERROR(DeliverRows(request_, strip, row_bytes_, y0, StripRows(y0, rows)));
     }
   } else {
     for (int32_t y0 = 0; y0 < rows; y0 += kImageStripRows) {
       const int32_t n = StripRows(y0, rows);
       for (int32_t y = 0; y < n; ++y) {
-        png_read_row(png_, rows_.data() + row_bytes_ * static_cast<size_t>(y), nullptr);
+        png_read_row(png_, buffer + row_bytes_ * static_cast<size_t>(y), nullptr);
       }
-      LB_RETURN_IF_ERROR(DeliverRows(request_, rows_.data(), row_bytes_, y0, n));
+      LB_RETURN_IF_ERROR(DeliverRows(request_, buffer, row_bytes_, y0, n));
     }
   }
   // Reads up to IEND, so a broken CRC after the image data is still an error.
@@ -154,33 +155,67 @@ Status PngReader::CheckPlainGray(png_uint_32 width, png_uint_32 height, int colo
   return Status::Ok();
 }
 
-// Gathers grey rows (8 or 16 bits, native-endian) as 16-bit values, growing with the rows
-// actually decoded so a header that lies about its size costs nothing.
+// Gathers grey rows (8 or 16 bits, native-endian) as 16-bit values: into the caller's fixed
+// array (checked against the header), or growing a vector with the rows actually decoded so a
+// header that lies about its size costs nothing.
 class GrayValues final : public FrameSink {
  public:
-  explicit GrayValues(GrayPng* out) : out_(out) {}
+  GrayValues(const char* name, std::vector<uint16_t>* grow, uint16_t* fixed, size_t capacity)
+      : name_(name), grow_(grow), fixed_(fixed), capacity_(capacity) {}
   Status BeginFrame(const FrameInfo& info) override {
-    out_->width = info.width;
-    out_->height = info.height;
-    out_->bits = info.format == PixelFormat::kGray16 ? 16 : 8;
+    width = info.width;
+    height = info.height;
+    bits = info.format == PixelFormat::kGray16 ? 16 : 8;
+    if (grow_ == nullptr && static_cast<uint64_t>(width) * height > capacity_) {
+      return Status(Code::kOutOfMemory, "%s: a %dx%d PNG, more than the %zu values it may fill",
+                    name_, width, height, capacity_);
+    }
     return Status::Ok();
   }
   Status Rows(const FrameRows& rows) override {
     for (int32_t y = 0; y < rows.height; ++y) {
       const uint8_t* row = rows.planes[0] + y * rows.strides[0];
-      for (int32_t x = 0; x < out_->width; ++x) {
+      uint16_t* out = fixed_ ? fixed_ + static_cast<size_t>(rows.y0 + y) * width : nullptr;
+      for (int32_t x = 0; x < width; ++x) {
         uint16_t v = row[x];
-        if (out_->bits == 16) memcpy(&v, row + 2 * x, 2);
-        out_->values.push_back(v);
+        if (bits == 16) memcpy(&v, row + 2 * x, 2);
+        if (grow_ != nullptr) {
+          grow_->push_back(v);
+        } else {
+          out[x] = v;
+        }
       }
     }
     return Status::Ok();
   }
   Status EndFrame() override { return Status::Ok(); }
 
+  int32_t width = 0, height = 0;  // the frame's, once it has begun
+  int bits = 0;
+
  private:
-  GrayPng* out_;
+  const char* name_;
+  std::vector<uint16_t>* grow_;
+  uint16_t* fixed_;
+  size_t capacity_;
 };
+
+Status DecodeGray(const uint8_t* data, size_t size, const char* name, int32_t max_side,
+                  int32_t width, int32_t height, const ImageReadMemory* memory,
+                  GrayValues* values) {
+  if (size < 8 || png_sig_cmp(data, 0, 8) != 0) {
+    return Status(Code::kCorruptData, "%s: not a PNG", name);
+  }
+  MemorySource src(data, size);
+  ImageFileInfo info;
+  DecodeRequest request = StreamRequest(name, &info, values);
+  request.max_side = max_side;
+  request.width = width;
+  request.height = height;
+  request.plain_gray = true;
+  request.memory = memory;
+  return DecodePng(src, request);
+}
 
 }  // namespace
 
@@ -194,23 +229,32 @@ Status DecodePng(ByteSource& src, const DecodeRequest& request) {
 Status DecodeGrayPng(const uint8_t* data, size_t size, const char* name, int32_t max_side,
                      int32_t width, int32_t height, GrayPng* out) {
   *out = GrayPng();
-  if (size < 8 || png_sig_cmp(data, 0, 8) != 0) {
-    return Status(Code::kCorruptData, "%s: not a PNG", name);
+  codecs::GrayValues values(name, &out->values, nullptr, 0);
+  Status s = codecs::DecodeGray(data, size, name, max_side, width, height, nullptr, &values);
+  if (!s.ok()) {
+    *out = GrayPng();
+    return s;
   }
-  codecs::MemorySource src(data, size);
-  ImageFileInfo info;
-  codecs::GrayValues values(out);
-  codecs::DecodeRequest request;
-  request.name = name;
-  request.info = &info;
-  request.sink = &values;
-  request.max_side = max_side;
-  request.width = width;
-  request.height = height;
-  request.plain_gray = true;
-  Status s = codecs::DecodePng(src, request);
-  if (!s.ok()) *out = GrayPng();
+  out->width = values.width;
+  out->height = values.height;
+  out->bits = values.bits;
   return s;
+}
+
+Status DecodeGrayPngInto(const uint8_t* data, size_t size, const char* name, int32_t max_side,
+                         int32_t width, int32_t height, GrayPngBuffer* out) {
+  out->width = out->height = out->bits = 0;
+  ImageReadMemory memory;
+  memory.strip = out->strip;
+  memory.strip_bytes = out->strip_bytes;
+  memory.max_width = memory.max_height = max_side;
+  codecs::GrayValues values(name, nullptr, out->values, out->capacity);
+  LB_RETURN_IF_ERROR(
+      codecs::DecodeGray(data, size, name, max_side, width, height, &memory, &values));
+  out->width = values.width;
+  out->height = values.height;
+  out->bits = values.bits;
+  return Status::Ok();
 }
 
 }  // namespace lb

@@ -141,17 +141,16 @@ Status DecodePnm(ByteSource& src, const DecodeRequest& request) {
   const size_t samples = static_cast<size_t>(width) * static_cast<size_t>(channels);
   const size_t row_bytes = samples * (wide ? 2 : 1);
   const uint64_t total = static_cast<uint64_t>(row_bytes) * height;
-  Buffer strip;
-  if (!strip.Allocate(static_cast<uint64_t>(row_bytes) * kImageStripRows)) {
-    return Status(Code::kOutOfMemory, "%s: no memory for a strip of %ux%d", name, width,
-                  kImageStripRows);
-  }
+  Buffer heap;
+  uint8_t* strip = nullptr;
+  LB_RETURN_IF_ERROR(
+      RowBuffer(request, static_cast<uint64_t>(row_bytes) * kImageStripRows, &heap, &strip));
 
   LB_RETURN_IF_ERROR(BeginFrame(request));
   for (int32_t y0 = 0; y0 < height_rows; y0 += kImageStripRows) {
     const int32_t rows = StripRows(y0, height_rows);
     const size_t want = row_bytes * static_cast<size_t>(rows);
-    const size_t got = src.Read(strip.data(), want);
+    const size_t got = src.Read(strip, want);
     if (got != want) {
       if (src.error() != 0) {
         return Status(Code::kIoError, "%s: read error: %s", name, strerror(src.error()));
@@ -161,10 +160,10 @@ Status DecodePnm(ByteSource& src, const DecodeRequest& request) {
                     total);
     }
     for (int32_t y = 0; y < rows; ++y) {
-      LB_RETURN_IF_ERROR(ConvertRow(strip.data() + row_bytes * static_cast<size_t>(y), samples,
-                                    maxval, name, y0 + y));
+      LB_RETURN_IF_ERROR(
+          ConvertRow(strip + row_bytes * static_cast<size_t>(y), samples, maxval, name, y0 + y));
     }
-    LB_RETURN_IF_ERROR(DeliverRows(request, strip.data(), row_bytes, y0, rows));
+    LB_RETURN_IF_ERROR(DeliverRows(request, strip, row_bytes, y0, rows));
   }
   return request.sink->EndFrame();
 }

@@ -41,9 +41,14 @@ void Base64Encode(const uint8_t* data, size_t size, std::string* out) {
   }
 }
 
-Status Base64Decode(const char* text, size_t size, std::vector<uint8_t>* out) {
-  out->clear();
-  out->reserve(size / 4 * 3);
+Status Base64DecodeInto(const char* text, size_t size, uint8_t* out, size_t capacity,
+                        size_t* written) {
+  *written = 0;
+  if (Base64MaxDecoded(size) > capacity) {
+    return Status(Code::kOutOfMemory, "base64: %zu characters, more than %zu bytes may hold", size,
+                  capacity);
+  }
+  size_t n = 0;
   uint32_t quad = 0;
   int have = 0;     // sextets in `quad`
   int padding = 0;  // '=' seen; only more '=' and whitespace may follow
@@ -65,9 +70,9 @@ Status Base64Decode(const char* text, size_t size, std::vector<uint8_t>* out) {
     if (padding > 0) return Status(Code::kCorruptData, "base64: data after '=' at offset %zu", i);
     quad = (quad << 6) | static_cast<uint32_t>(v);
     if (++have == 4) {
-      out->push_back(static_cast<uint8_t>(quad >> 16));
-      out->push_back(static_cast<uint8_t>(quad >> 8));
-      out->push_back(static_cast<uint8_t>(quad));
+      out[n++] = static_cast<uint8_t>(quad >> 16);
+      out[n++] = static_cast<uint8_t>(quad >> 8);
+      out[n++] = static_cast<uint8_t>(quad);
       quad = 0;
       have = 0;
     }
@@ -78,12 +83,21 @@ Status Base64Decode(const char* text, size_t size, std::vector<uint8_t>* out) {
   if (have == 1 || (have != 0 && padding == 0)) {
     return Status(Code::kCorruptData, "base64: %zu characters are not whole quads", size);
   }
-  if (have == 2) out->push_back(static_cast<uint8_t>(quad >> 4));
+  if (have == 2) out[n++] = static_cast<uint8_t>(quad >> 4);
   if (have == 3) {
-    out->push_back(static_cast<uint8_t>(quad >> 10));
-    out->push_back(static_cast<uint8_t>(quad >> 2));
+    out[n++] = static_cast<uint8_t>(quad >> 10);
+    out[n++] = static_cast<uint8_t>(quad >> 2);
   }
+  *written = n;
   return Status::Ok();
+}
+
+Status Base64Decode(const char* text, size_t size, std::vector<uint8_t>* out) {
+  out->resize(Base64MaxDecoded(size));
+  size_t written = 0;
+  Status s = Base64DecodeInto(text, size, out->data(), out->size(), &written);
+  out->resize(written);
+  return s;
 }
 
 void Md5Hex(const uint8_t* data, size_t size, char out[33]) {

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <string>
 #include <string_view>
 
 #include "firmware/codecs/exif.h"
@@ -21,13 +22,6 @@ constexpr int32_t kMaxDepthSide = 8192;
 constexpr size_t kMaxFileBytes = size_t{512} << 20;
 constexpr size_t kExtendedHeader = sizeof(kExtendedXmpSignature) + 32 + 4 + 4;
 
-struct Chunk {
-  const uint8_t* guid;  // 32 bytes
-  uint32_t offset;
-  const uint8_t* bytes;
-  size_t size;
-};
-
 uint32_t BigEndian32(const uint8_t* p) {
   return (uint32_t{p[0]} << 24) | (uint32_t{p[1]} << 16) | (uint32_t{p[2]} << 8) | p[3];
 }
@@ -38,66 +32,65 @@ bool StartsWith(const uint8_t* p, size_t n, const char* sig, size_t sig_size) {
 
 bool IsSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
 
-// One XMP packet with the prefixes it binds to our namespaces.
-class Packet {
- public:
-  explicit Packet(std::string_view text) : text_(text) {}
+// XMP lookups over a packet's text, without copying it (no allocation): a field is an attribute
+// prefix:name="value" or a simple element <prefix:name>value</prefix:name>, the prefix the one an
+// xmlns attribute binds to the namespace (none bound: nothing matches).
+bool Quoted(std::string_view text, size_t pos, std::string_view* value) {
+  while (pos < text.size() && IsSpace(text[pos])) ++pos;
+  if (pos >= text.size() || (text[pos] != '"' && text[pos] != '\'')) return false;
+  const size_t end = text.find(text[pos], pos + 1);
+  if (end == std::string_view::npos) return false;
+  *value = text.substr(pos + 1, end - pos - 1);
+  return true;
+}
 
-  // The prefix bound to `uri` by an xmlns attribute; empty when none is (nothing matches then).
-  std::string Prefix(const char* uri) const {
-    size_t pos = 0;
-    while ((pos = text_.find("xmlns:", pos)) != std::string_view::npos) {
-      pos += 6;
-      const size_t eq = text_.find('=', pos);
-      if (eq == std::string_view::npos || eq - pos > 64) continue;
-      size_t end = eq;
-      while (end > pos && IsSpace(text_[end - 1])) --end;
-      std::string_view value;
-      if (QuotedAt(eq + 1, &value) && value == uri)
-        return std::string(text_.substr(pos, end - pos));
-    }
-    return std::string();
+std::string_view PrefixOf(std::string_view text, std::string_view uri) {
+  size_t pos = 0;
+  while ((pos = text.find("xmlns:", pos)) != std::string_view::npos) {
+    pos += 6;
+    const size_t eq = text.find('=', pos);
+    if (eq == std::string_view::npos || eq - pos > 64) continue;
+    size_t end = eq;
+    while (end > pos && IsSpace(text[end - 1])) --end;
+    std::string_view value;
+    if (Quoted(text, eq + 1, &value) && value == uri) return text.substr(pos, end - pos);
   }
+  return {};
+}
 
-  // `prefix:name` as an attribute (prefix:name="value") or a simple element
-  // (<prefix:name>value</prefix:name>).
-  bool Find(const std::string& prefix, const char* name, std::string_view* value) const {
-    if (prefix.empty()) return false;
-    const std::string qname = prefix + ":" + name;
-    size_t pos = 0;
-    while ((pos = text_.find(qname, pos)) != std::string_view::npos) {
-      const size_t start = pos, after = pos + qname.size();
-      pos = after;
-      if (start == 0 || after >= text_.size()) continue;
-      const bool element = text_[start - 1] == '<';
-      if (!element && !IsSpace(text_[start - 1])) continue;  // part of a longer name
-      if (element) {
-        if (text_[after] != '>') continue;
-        const size_t close = text_.find("</" + qname, after + 1);
-        if (close == std::string_view::npos) return false;
-        *value = text_.substr(after + 1, close - after - 1);
-        return true;
+bool FindIn(std::string_view text, std::string_view uri, std::string_view name,
+            std::string_view* value) {
+  const std::string_view prefix = PrefixOf(text, uri);
+  if (prefix.empty()) return false;
+  const size_t qsize = prefix.size() + 1 + name.size();
+  size_t pos = 0;
+  while ((pos = text.find(prefix, pos)) != std::string_view::npos) {
+    const size_t start = pos, after = pos + qsize;
+    pos += prefix.size();
+    if (start == 0 || after >= text.size() || text[start + prefix.size()] != ':' ||
+        text.substr(start + prefix.size() + 1, name.size()) != name) {
+      continue;
+    }
+    const bool element = text[start - 1] == '<';
+    if (!element && !IsSpace(text[start - 1])) continue;  // part of a longer name
+    if (element) {
+      if (text[after] != '>') continue;
+      size_t close = after + 1;
+      while ((close = text.find("</", close)) != std::string_view::npos) {
+        if (text.substr(close + 2, qsize) == text.substr(start, qsize)) break;
+        close += 2;
       }
-      size_t eq = after;
-      while (eq < text_.size() && IsSpace(text_[eq])) ++eq;
-      if (eq >= text_.size() || text_[eq] != '=') continue;
-      return QuotedAt(eq + 1, value);
+      if (close == std::string_view::npos) return false;
+      *value = text.substr(after + 1, close - after - 1);
+      return true;
     }
-    return false;
+    size_t eq = after;
+    while (eq < text.size() && IsSpace(text[eq])) ++eq;
+    if (eq >= text.size() || text[eq] != '=') continue;
+    return Quoted(text, eq + 1, value);
   }
-
- private:
-  bool QuotedAt(size_t pos, std::string_view* value) const {
-    while (pos < text_.size() && IsSpace(text_[pos])) ++pos;
-    if (pos >= text_.size() || (text_[pos] != '"' && text_[pos] != '\'')) return false;
-    const size_t end = text_.find(text_[pos], pos + 1);
-    if (end == std::string_view::npos) return false;
-    *value = text_.substr(pos + 1, end - pos - 1);
-    return true;
-  }
-
-  std::string_view text_;
-};
+  return false;
+}
 
 // Looks a field up in the main packet, then in the extended one. `prefix` (the usual one) only
 // names the field in messages; lookups go by namespace.
@@ -140,51 +133,58 @@ class Fields {
     return Status::Ok();
   }
 
-  Status Base64(const char* uri, const char* prefix, const char* field,
-                std::vector<uint8_t>* out) const {
+  // Decodes into memory.Bytes(part): kOutOfMemory when the text could need more than it gives.
+  Status Base64(const char* uri, const char* prefix, const char* field, RefocusableMemory& memory,
+                RefocusableMemory::Part part, const uint8_t** data, size_t* size) const {
     std::string_view v;
     LB_RETURN_IF_ERROR(Text(uri, prefix, field, &v));
-    Status status = Base64Decode(v.data(), v.size(), out);
-    if (!status.ok()) status.Prefix("%s: %s:%s: ", name_, prefix, field);
+    const size_t most = Base64MaxDecoded(v.size());
+    uint8_t* out = memory.Bytes(part, most);
+    if (out == nullptr) {
+      return Status(Code::kOutOfMemory, "%s: %s:%s: %zu bytes, more than the reader was given",
+                    name_, prefix, field, most);
+    }
+    Status status = Base64DecodeInto(v.data(), v.size(), out, most, size);
+    if (!status.ok()) return status.Prefix("%s: %s:%s: ", name_, prefix, field);
+    *data = out;
     return status;
   }
 
  private:
   bool Lookup(const char* uri, const char* field, std::string_view* v) const {
-    for (std::string_view text : {main_, extended_}) {
-      const Packet packet(text);
-      if (packet.Find(packet.Prefix(uri), field, v)) return true;
-    }
-    return false;
+    return FindIn(main_, uri, field, v) || FindIn(extended_, uri, field, v);
   }
 
   const char* name_;
   std::string_view main_, extended_;
 };
 
-Status ReadDepth(const char* name, const Fields& f, RefocusableImage* out) {
-  GDepthInfo& d = out->xmp.depth;
+Status ReadDepth(const char* name, const Fields& f, RefocusableMemory& memory,
+                 RefocusableFields* out) {
   std::string_view text;
   LB_RETURN_IF_ERROR(f.Text(kGDepthNs, "GDepth", "Format", &text));
   if (text != "RangeInverse" && text != "RangeLinear") {
     return Status(Code::kUnsupported, "%s: GDepth:Format '%.*s' (RangeInverse or RangeLinear)",
                   name, static_cast<int>(text.size() < 32 ? text.size() : 32), text.data());
   }
-  d.format = std::string(text);
-  LB_RETURN_IF_ERROR(f.Number(kGDepthNs, "GDepth", "Near", &d.near_depth));
-  LB_RETURN_IF_ERROR(f.Number(kGDepthNs, "GDepth", "Far", &d.far_depth));
-  const bool inverse = d.format == "RangeInverse";
-  if (!(d.far_depth > d.near_depth && (inverse ? d.near_depth > 0.0 : d.near_depth >= 0.0))) {
+  out->depth_format = text;
+  LB_RETURN_IF_ERROR(f.Number(kGDepthNs, "GDepth", "Near", &out->near_depth));
+  LB_RETURN_IF_ERROR(f.Number(kGDepthNs, "GDepth", "Far", &out->far_depth));
+  const bool inverse = text == "RangeInverse";
+  const double near_depth = out->near_depth, far_depth = out->far_depth;
+  if (!(far_depth > near_depth && (inverse ? near_depth > 0.0 : near_depth >= 0.0))) {
     return Status(Code::kCorruptData, "%s: GDepth:Near %g and Far %g are not a valid range", name,
-                  d.near_depth, d.far_depth);
+                  near_depth, far_depth);
   }
   LB_RETURN_IF_ERROR(f.Text(kGDepthNs, "GDepth", "Mime", &text));
   if (text != "image/png") {
     return Status(Code::kUnsupported, "%s: GDepth:Mime '%.*s' (only image/png)", name,
                   static_cast<int>(text.size() < 32 ? text.size() : 32), text.data());
   }
-  d.mime = std::string(text);
-  LB_RETURN_IF_ERROR(f.Base64(kGDepthNs, "GDepth", "Data", &d.data));
+  out->depth_mime = text;
+  LB_RETURN_IF_ERROR(f.Base64(kGDepthNs, "GDepth", "Data", memory,
+                              RefocusableMemory::Part::kDepthPng, &out->depth_png,
+                              &out->depth_png_size));
   const bool has_w = f.Has(kGDepthNs, "GDepth", "ImageWidth");
   const bool has_h = f.Has(kGDepthNs, "GDepth", "ImageHeight");
   if (has_w != has_h) {
@@ -200,101 +200,100 @@ Status ReadDepth(const char* name, const Fields& f, RefocusableImage* out) {
       return Status(Code::kCorruptData, "%s: GDepth:ImageWidth/Height %gx%g out of range", name, w,
                     h);
     }
-    d.width = static_cast<int32_t>(w);
-    d.height = static_cast<int32_t>(h);
-    if (out->width > 0 && (d.width > out->width || d.height > out->height)) {
+    out->depth_width = static_cast<int32_t>(w);
+    out->depth_height = static_cast<int32_t>(h);
+    if (out->width > 0 && (out->depth_width > out->width || out->depth_height > out->height)) {
       return Status(Code::kCorruptData, "%s: GDepth: a %dx%d depth map in a %dx%d photo", name,
-                    d.width, d.height, out->width, out->height);
+                    out->depth_width, out->depth_height, out->width, out->height);
     }
   }
-  char what[300];
-  snprintf(what, sizeof(what), "%s: GDepth:Data", name);
-  // The size is checked against the PNG's header before any pixel is decoded; a depth map is
-  // never larger than the photo it belongs to.
+  // Checked against the PNG's header before any pixel is decoded: a depth map is never larger
+  // than the photo it belongs to.
   const int32_t photo_side = std::max(out->width, out->height);
-  const int32_t max_side = photo_side > 0 ? std::min(photo_side, kMaxDepthSide) : kMaxDepthSide;
-  return DecodeGrayPng(d.data.data(), d.data.size(), what, max_side, d.width, d.height,
-                       &out->depth);
+  out->depth_max_side = photo_side > 0 ? std::min(photo_side, kMaxDepthSide) : kMaxDepthSide;
+  return Status::Ok();
 }
 
-Status ReadImage(const char* name, const Fields& f, RefocusableImage* out) {
+Status ReadImage(const char* name, const Fields& f, RefocusableMemory& memory,
+                 RefocusableFields* out) {
   if (!f.Has(kGImageNs, "GImage", "Data")) return Status::Ok();  // optional
-  std::string_view mime;
-  LB_RETURN_IF_ERROR(f.Text(kGImageNs, "GImage", "Mime", &mime));
-  out->xmp.image_mime = std::string(mime);
-  LB_RETURN_IF_ERROR(f.Base64(kGImageNs, "GImage", "Data", &out->xmp.image));
-  if (mime == "image/jpeg" &&
-      (out->xmp.image.size() < 4 || out->xmp.image[0] != 0xFF || out->xmp.image[1] != 0xD8)) {
+  LB_RETURN_IF_ERROR(f.Text(kGImageNs, "GImage", "Mime", &out->image_mime));
+  LB_RETURN_IF_ERROR(f.Base64(kGImageNs, "GImage", "Data", memory, RefocusableMemory::Part::kImage,
+                              &out->image, &out->image_size));
+  if (out->image_mime == "image/jpeg" &&
+      (out->image_size < 4 || out->image[0] != 0xFF || out->image[1] != 0xD8)) {
     return Status(Code::kCorruptData, "%s: GImage:Data is not a JPEG", name);
   }
   return Status::Ok();
 }
 
-Status ReadFocus(const Fields& f, RefocusableImage* out) {
+Status ReadFocus(const Fields& f, RefocusableFields* out) {
   const char* names[4] = {"BlurAtInfinity", "FocalDistance", "FocalPointX", "FocalPointY"};
-  double* values[4] = {&out->xmp.focus.blur_at_infinity, &out->xmp.focus.focal_distance,
-                       &out->xmp.focus.focal_point_x, &out->xmp.focus.focal_point_y};
-  out->xmp.has_focus = false;
-  for (const char* n : names) out->xmp.has_focus |= f.Has(kGFocusNs, "GFocus", n);
-  if (!out->xmp.has_focus) return Status::Ok();
+  double* values[4] = {&out->focus.blur_at_infinity, &out->focus.focal_distance,
+                       &out->focus.focal_point_x, &out->focus.focal_point_y};
+  out->has_focus = false;
+  for (const char* n : names) out->has_focus |= f.Has(kGFocusNs, "GFocus", n);
+  if (!out->has_focus) return Status::Ok();
   for (int i = 0; i < 4; ++i)
     LB_RETURN_IF_ERROR(f.Number(kGFocusNs, "GFocus", names[i], values[i]));
   return Status::Ok();
 }
 
-Status Reassemble(const char* name, const std::string& guid, const std::vector<Chunk>& all,
-                  const std::vector<uint32_t>& lengths, std::string* extended) {
-  std::vector<Chunk> chunks;
-  uint32_t full = 0;
-  for (size_t i = 0; i < all.size(); ++i) {
-    if (memcmp(all[i].guid, guid.data(), 32) != 0) continue;  // another packet's chunk
-    if (!chunks.empty() && lengths[i] != full) {
+// The main packet's chunks, in offset order, contiguous, into memory, checked against the MD5.
+Status Reassemble(const char* name, std::string_view guid, ExtendedXmpChunk* all, size_t count,
+                  RefocusableMemory& memory, std::string_view* extended) {
+  ExtendedXmpChunk* mine = std::partition(all, all + count, [&](const ExtendedXmpChunk& c) {
+    return memcmp(c.guid, guid.data(), 32) == 0;  // not another packet's chunk
+  });
+  if (mine == all) {
+    return Status(Code::kCorruptData, "%s: extended XMP %.32s announced but absent", name,
+                  guid.data());
+  }
+  const uint32_t full = all[0].full;
+  for (const ExtendedXmpChunk* c = all; c != mine; ++c) {
+    if (c->full != full) {
       return Status(Code::kCorruptData, "%s: extended XMP chunks disagree on the length", name);
     }
-    full = lengths[i];
-    chunks.push_back(all[i]);
   }
-  if (chunks.empty()) {
-    return Status(Code::kCorruptData, "%s: extended XMP %s announced but absent", name,
-                  guid.c_str());
-  }
-  std::sort(chunks.begin(), chunks.end(),
-            [](const Chunk& a, const Chunk& b) { return a.offset < b.offset; });
+  std::sort(all, mine, [](const ExtendedXmpChunk& a, const ExtendedXmpChunk& b) {
+    return a.offset < b.offset;
+  });
   uint64_t expected = 0;
-  for (const Chunk& c : chunks) {
-    if (c.offset != expected) {
+  for (const ExtendedXmpChunk* c = all; c != mine; ++c) {
+    if (c->offset != expected) {
       return Status(Code::kCorruptData, "%s: extended XMP has a %s at offset %llu", name,
-                    c.offset > expected ? "gap" : "overlap",
+                    c->offset > expected ? "gap" : "overlap",
                     static_cast<unsigned long long>(expected));
     }
-    expected += c.size;
+    expected += c->size;
   }
   if (expected != full) {
     return Status(Code::kCorruptData, "%s: extended XMP truncated: %llu of %u bytes", name,
                   static_cast<unsigned long long>(expected), static_cast<unsigned>(full));
   }
-  extended->reserve(full);
-  for (const Chunk& c : chunks) extended->append(reinterpret_cast<const char*>(c.bytes), c.size);
-  char md5[33];
-  Md5Hex(reinterpret_cast<const uint8_t*>(extended->data()), extended->size(), md5);
-  if (guid != md5) {
-    return Status(Code::kCorruptData, "%s: extended XMP does not match its MD5 %s", name,
-                  guid.c_str());
+  uint8_t* text = memory.Bytes(RefocusableMemory::Part::kExtendedXmp, full);
+  if (text == nullptr) {
+    return Status(Code::kOutOfMemory,
+                  "%s: %u bytes of extended XMP, more than the reader was given", name,
+                  static_cast<unsigned>(full));
   }
+  for (const ExtendedXmpChunk* c = all; c != mine; ++c) memcpy(text + c->offset, c->bytes, c->size);
+  char md5[33];
+  Md5Hex(text, full, md5);
+  if (guid != std::string_view(md5, 32)) {
+    return Status(Code::kCorruptData, "%s: extended XMP does not match its MD5 %.32s", name,
+                  guid.data());
+  }
+  *extended = std::string_view(reinterpret_cast<const char*>(text), full);
   return Status::Ok();
 }
 
-}  // namespace
-
-Status ReadRefocusable(const uint8_t* data, size_t size, const char* name, RefocusableImage* out) {
-  *out = RefocusableImage();
-  if (size < 4 || data[0] != 0xFF || data[1] != 0xD8) {
-    return Status(Code::kCorruptData, "%s: not a JPEG", name);
-  }
-  std::string_view main;
+// The segments before the image data. `chunks` null: counts the extended-XMP chunks; otherwise
+// records them there too.
+Status WalkSegments(const uint8_t* data, size_t size, const char* name, RefocusableFields* out,
+                    std::string_view* main, ExtendedXmpChunk* chunks, size_t* count) {
   bool have_main = false, have_scan = false;
-  std::vector<Chunk> chunks;
-  std::vector<uint32_t> lengths;
+  *count = 0;
   size_t pos = 2;
   while (!have_scan) {
     if (pos >= size || data[pos] != 0xFF) {
@@ -324,8 +323,8 @@ Status ReadRefocusable(const uint8_t* data, size_t size, const char* name, Refoc
     }
     if (marker != 0xE1) continue;
     if (!have_main && StartsWith(p, n, kXmpSignature, sizeof(kXmpSignature))) {
-      main = std::string_view(reinterpret_cast<const char*>(p) + sizeof(kXmpSignature),
-                              n - sizeof(kXmpSignature));
+      *main = std::string_view(reinterpret_cast<const char*>(p) + sizeof(kXmpSignature),
+                               n - sizeof(kXmpSignature));
       have_main = true;
     } else if (StartsWith(p, n, kExtendedXmpSignature, sizeof(kExtendedXmpSignature))) {
       if (n < kExtendedHeader) {
@@ -339,32 +338,124 @@ Status ReadRefocusable(const uint8_t* data, size_t size, const char* name, Refoc
         return Status(Code::kCorruptData, "%s: extended XMP chunk at offset %zu overruns %u bytes",
                       name, pos - length - 2, static_cast<unsigned>(full));
       }
-      chunks.push_back({p + sizeof(kExtendedXmpSignature), offset, p + kExtendedHeader, bytes});
-      lengths.push_back(full);
+      if (chunks != nullptr) {
+        chunks[*count] = {p + sizeof(kExtendedXmpSignature), full, offset, p + kExtendedHeader,
+                          bytes};
+      }
+      ++*count;
     }
   }
   if (!have_main) {
     return Status(Code::kNotFound, "%s: no XMP metadata (not a refocusable JPEG)", name);
   }
-  std::string extended;
+  return Status::Ok();
+}
+
+// Host memory: the parts in vectors, the chunk descriptors in one it owns.
+class VectorMemory final : public RefocusableMemory {
+ public:
+  explicit VectorMemory(RefocusableXmp* xmp) : xmp_(xmp) {}
+  // At least one item each: data() of an empty vector may be null, which means "no room".
+  ExtendedXmpChunk* Chunks(size_t count) override {
+    chunks_.resize(std::max<size_t>(count, 1));
+    return chunks_.data();
+  }
+  uint8_t* Bytes(Part part, size_t count) override {
+    std::vector<uint8_t>& v = part == Part::kDepthPng ? xmp_->depth.data
+                              : part == Part::kImage  ? xmp_->image
+                                                      : extended_;
+    v.resize(std::max<size_t>(count, 1));
+    return v.data();
+  }
+
+ private:
+  RefocusableXmp* xmp_;
+  std::vector<ExtendedXmpChunk> chunks_;
+  std::vector<uint8_t> extended_;
+};
+
+}  // namespace
+
+ExtendedXmpChunk* RefocusableBuffers::Chunks(size_t count) {
+  return count <= chunk_capacity ? chunks : nullptr;
+}
+
+uint8_t* RefocusableBuffers::Bytes(Part part, size_t count) {
+  switch (part) {
+    case Part::kExtendedXmp:
+      return count <= extended_capacity ? extended : nullptr;
+    case Part::kDepthPng:
+      return count <= depth_png_capacity ? depth_png : nullptr;
+    case Part::kImage:
+      return count <= image_capacity ? image : nullptr;
+  }
+  return nullptr;
+}
+
+Status ReadRefocusableFields(const uint8_t* data, size_t size, const char* name,
+                             RefocusableMemory& memory, RefocusableFields* out) {
+  *out = RefocusableFields();
+  if (size < 4 || data[0] != 0xFF || data[1] != 0xD8) {
+    return Status(Code::kCorruptData, "%s: not a JPEG", name);
+  }
+  std::string_view main, extended;
+  size_t count = 0;
+  LB_RETURN_IF_ERROR(WalkSegments(data, size, name, out, &main, nullptr, &count));
   std::string_view guid;
-  const Packet main_packet(main);
-  if (main_packet.Find(main_packet.Prefix(kXmpNoteNs), "HasExtendedXMP", &guid)) {
+  if (FindIn(main, kXmpNoteNs, "HasExtendedXMP", &guid)) {
     if (guid.size() != 32) {
       return Status(Code::kCorruptData, "%s: xmpNote:HasExtendedXMP is not an MD5", name);
     }
-    LB_RETURN_IF_ERROR(Reassemble(name, std::string(guid), chunks, lengths, &extended));
+    ExtendedXmpChunk* chunks = memory.Chunks(count);
+    if (chunks == nullptr) {
+      return Status(Code::kOutOfMemory, "%s: %zu extended XMP chunks, more than the reader takes",
+                    name, count);
+    }
+    LB_RETURN_IF_ERROR(WalkSegments(data, size, name, out, &main, chunks, &count));
+    LB_RETURN_IF_ERROR(Reassemble(name, guid, chunks, count, memory, &extended));
   }
   const Fields fields(name, main, extended);
   if (!fields.Has(kGDepthNs, "GDepth", "Format") && !fields.Has(kGDepthNs, "GDepth", "Data")) {
     return Status(Code::kNotFound, "%s: XMP has no depth map (GDepth)", name);
   }
-  LB_RETURN_IF_ERROR(ReadDepth(name, fields, out));
-  LB_RETURN_IF_ERROR(ReadImage(name, fields, out));
+  LB_RETURN_IF_ERROR(ReadDepth(name, fields, memory, out));
+  LB_RETURN_IF_ERROR(ReadImage(name, fields, memory, out));
   LB_RETURN_IF_ERROR(ReadFocus(fields, out));
   // From the bytes in hand: a re-render must not open the file a second time.
   out->orientation = ExifOrientation(data, size);
   return Status::Ok();
+}
+
+void DepthPngName(const char* name, char* out, size_t out_size) {
+  snprintf(out, out_size, "%s: GDepth:Data", name);
+}
+
+Status ReadRefocusable(const uint8_t* data, size_t size, const char* name, RefocusableImage* out) {
+  *out = RefocusableImage();
+  VectorMemory memory(&out->xmp);
+  RefocusableFields f;
+  Status s = ReadRefocusableFields(data, size, name, memory, &f);
+  // The fields point into the file and `memory`: copied out before it goes.
+  GDepthInfo& d = out->xmp.depth;
+  d.data.resize(f.depth_png_size);
+  out->xmp.image.resize(f.image_size);
+  if (!s.ok()) return s;
+  out->width = f.width;
+  out->height = f.height;
+  out->orientation = f.orientation;
+  d.format = std::string(f.depth_format);
+  d.near_depth = f.near_depth;
+  d.far_depth = f.far_depth;
+  d.mime = std::string(f.depth_mime);
+  d.width = f.depth_width;
+  d.height = f.depth_height;
+  if (f.image != nullptr) out->xmp.image_mime = std::string(f.image_mime);
+  out->xmp.has_focus = f.has_focus;
+  out->xmp.focus = f.focus;
+  char what[300];
+  DepthPngName(name, what, sizeof(what));
+  return DecodeGrayPng(d.data.data(), d.data.size(), what, f.depth_max_side, d.width, d.height,
+                       &out->depth);
 }
 
 Status ReadRefocusableFile(const char* path, RefocusableImage* out) {

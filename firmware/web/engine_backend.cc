@@ -12,6 +12,7 @@
 #include <cstring>
 
 #include "firmware/app/focus.h"
+#include "firmware/codecs/exif.h"
 #include "firmware/codecs/image_file.h"
 #include "firmware/daemon/log.h"
 
@@ -41,66 +42,6 @@ const char* Base(const char* path) {
   return slash ? slash + 1 : path;
 }
 
-bool Turned(int32_t orientation) { return orientation >= 5 && orientation <= 8; }
-
-// Stored fractions (s, t) -> displayed fractions (u, v) for EXIF orientation `o`, and back.
-void StoredToDisplayed(int32_t o, double s, double t, double* u, double* v) {
-  switch (o) {
-    case 2:
-      *u = 1 - s, *v = t;
-      break;
-    case 3:
-      *u = 1 - s, *v = 1 - t;
-      break;
-    case 4:
-      *u = s, *v = 1 - t;
-      break;
-    case 5:
-      *u = t, *v = s;
-      break;
-    case 6:
-      *u = 1 - t, *v = s;
-      break;
-    case 7:
-      *u = 1 - t, *v = 1 - s;
-      break;
-    case 8:
-      *u = t, *v = 1 - s;
-      break;
-    default:
-      *u = s, *v = t;
-      break;
-  }
-}
-void DisplayedToStoredPoint(int32_t o, double u, double v, double* s, double* t) {
-  switch (o) {
-    case 2:
-      *s = 1 - u, *t = v;
-      break;
-    case 3:
-      *s = 1 - u, *t = 1 - v;
-      break;
-    case 4:
-      *s = u, *t = 1 - v;
-      break;
-    case 5:
-      *s = v, *t = u;
-      break;
-    case 6:
-      *s = v, *t = 1 - u;
-      break;
-    case 7:
-      *s = 1 - v, *t = 1 - u;
-      break;
-    case 8:
-      *s = 1 - v, *t = u;
-      break;
-    default:
-      *s = u, *t = v;
-      break;
-  }
-}
-
 double Clamp01(float x) {
   return std::isfinite(x) ? std::clamp(static_cast<double>(x), 0.0, 1.0) : 0.5;
 }
@@ -110,8 +51,8 @@ double Clamp01(float x) {
 FocusRegion DisplayedToStored(const RefocusParams& p, int32_t width, int32_t height,
                               int32_t orientation) {
   double s0, t0, s1, t1;
-  DisplayedToStoredPoint(orientation, Clamp01(p.x0), Clamp01(p.y0), &s0, &t0);
-  DisplayedToStoredPoint(orientation, Clamp01(p.x1), Clamp01(p.y1), &s1, &t1);
+  ExifDisplayedToStored(orientation, Clamp01(p.x0), Clamp01(p.y0), &s0, &t0);
+  ExifDisplayedToStored(orientation, Clamp01(p.x1), Clamp01(p.y1), &s1, &t1);
   const auto px = [](double f, int32_t size) {
     return std::clamp(static_cast<int32_t>(f * size), 0, size - 1);
   };
@@ -287,14 +228,14 @@ Status EngineBackend::Process(Request* r) {
       return Status::Ok();
     }
     const EnginePhoto& p = engine_.photo();
-    const bool turned = Turned(p.orientation);
+    const bool turned = ExifSwapsSides(p.orientation);
     info.width = turned ? p.height : p.width;
     info.height = turned ? p.width : p.height;
     info.refocusable = true;
     const FocusRegion& f = p.current.focus;
     double u = 0.5, v = 0.5;
-    StoredToDisplayed(p.orientation, (f.x + 0.5 * f.width) / p.width,
-                      (f.y + 0.5 * f.height) / p.height, &u, &v);
+    ExifStoredToDisplayed(p.orientation, (f.x + 0.5 * f.width) / p.width,
+                          (f.y + 0.5 * f.height) / p.height, &u, &v);
     info.current.x0 = info.current.x1 = static_cast<float>(u);
     info.current.y0 = info.current.y1 = static_cast<float>(v);
     info.current.f_number = p.current.f_number;

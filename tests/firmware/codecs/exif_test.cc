@@ -64,5 +64,28 @@ TEST(ExifTest, BadTagsAreRefusedByName) {
   EXPECT_FALSE(tags.has_exif() && ExifTags().has_exif());
 }
 
+// Where a viewer shows the stored image's top-left corner and a point near it, per EXIF 2.3's
+// description of each orientation (the 0th row and column), and the way back.
+TEST(ExifTest, OrientationMapsPointsAsAViewerTurnsThem) {
+  struct Case {
+    int32_t o;
+    double u, v;  // where stored (0.25, 0.125) is displayed
+  };
+  const Case cases[] = {{0, 0.25, 0.125}, {1, 0.25, 0.125}, {2, 0.75, 0.125},
+                        {3, 0.75, 0.875}, {4, 0.25, 0.875}, {5, 0.125, 0.25},
+                        {6, 0.875, 0.25}, {7, 0.875, 0.75}, {8, 0.125, 0.75}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.o);
+    double u = -1, v = -1, s = -1, t = -1;
+    ExifStoredToDisplayed(c.o, 0.25, 0.125, &u, &v);
+    EXPECT_DOUBLE_EQ(u, c.u);
+    EXPECT_DOUBLE_EQ(v, c.v);
+    ExifDisplayedToStored(c.o, u, v, &s, &t);
+    EXPECT_DOUBLE_EQ(s, 0.25);
+    EXPECT_DOUBLE_EQ(t, 0.125);
+    EXPECT_EQ(ExifSwapsSides(c.o), c.o >= 5);
+  }
+}
+
 }  // namespace
 }  // namespace lb

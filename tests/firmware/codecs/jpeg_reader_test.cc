@@ -56,6 +56,42 @@ TEST(JpegReader, ReadsRgbInStripsCloseToTheOriginal) {
   EXPECT_LE(MaxDifference(sink.frames[0].pixels, Pattern(24, 40, 3)), 6);
 }
 
+// The caller's strip (the web page's engine): the same pixels as a read that allocates, and an
+// image larger than the caller takes refused before any row reaches the sink.
+TEST(JpegReader, StreamsIntoTheCallersStrip) {
+  const Bytes jpeg = Encode(24, 40, 3);
+  ImageFileInfo info;
+  std::vector<uint8_t> expected;
+  ASSERT_TRUE(Read(jpeg, &info, &expected).ok());
+  std::vector<uint8_t> strip(ImageStripBytes(24, PixelFormat::kRgb8));
+  ImageReadMemory memory;
+  memory.strip = strip.data();
+  memory.strip_bytes = strip.size();
+  memory.max_width = 24;
+  memory.max_height = 40;
+  test::RecordingSink sink;
+  Status s = StreamImageMemory(jpeg.data(), jpeg.size(), "x.jpg", 1, sink, memory);
+  ASSERT_TRUE(s.ok()) << s.message() << sink.error;
+  ASSERT_EQ(sink.frames.size(), 1u);
+  EXPECT_EQ(sink.frames[0].info.index, 1);
+  EXPECT_EQ(sink.frames[0].pixels, expected);
+
+  for (int32_t side : {0, 1}) {
+    ImageReadMemory small = memory;
+    (side == 0 ? small.max_width : small.max_height) -= 1;
+    test::RecordingSink refused;
+    s = StreamImageMemory(jpeg.data(), jpeg.size(), "x.jpg", 0, refused, small);
+    EXPECT_EQ(s.code(), Code::kOutOfMemory) << s.message();
+    EXPECT_TRUE(refused.frames.empty());
+  }
+  ImageReadMemory narrow = memory;
+  narrow.strip_bytes -= 1;
+  test::RecordingSink refused;
+  s = StreamImageMemory(jpeg.data(), jpeg.size(), "x.jpg", 0, refused, narrow);
+  EXPECT_EQ(s.code(), Code::kOutOfMemory) << s.message();
+  EXPECT_TRUE(refused.frames.empty());
+}
+
 TEST(JpegReader, ReadsGrayAndProgressive) {
   ImageFileInfo info;
   std::vector<uint8_t> pixels;

@@ -3,7 +3,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
+#include <vector>
+
+#include "firmware/codecs/image_file.h"
 
 namespace lb {
 namespace {
@@ -51,6 +55,42 @@ TEST(PngMemoryTest, DefectsAreReportedNotCrashed) {
   std::vector<uint8_t> flipped = png;
   flipped[flipped.size() / 2] ^= 0x55;  // inside the image data: CRC or zlib error
   EXPECT_FALSE(DecodeGrayPng(flipped.data(), flipped.size(), "depth", 100, 0, 0, &out).ok());
+}
+
+// Into the caller's memory: the same values as the vector door; an image larger than the
+// memory is kOutOfMemory with nothing written past it.
+TEST(PngMemoryTest, IntoFixedMemoryGivesTheSameValues) {
+  for (int bits : {8, 16}) {
+    const std::vector<uint16_t> v = Ramp(37, 21, bits);
+    std::vector<uint8_t> png;
+    ASSERT_TRUE(EncodeGrayPng(MakeView(v.data(), 37, 21), bits, &png).ok());
+    std::vector<uint16_t> values(37 * 21 + 1, 0xBEEF);
+    std::vector<uint8_t> strip(ImageStripBytes(37, PixelFormat::kGray16));
+    GrayPngBuffer out;
+    out.values = values.data();
+    out.capacity = 37 * 21;
+    out.strip = strip.data();
+    out.strip_bytes = strip.size();
+    Status status = DecodeGrayPngInto(png.data(), png.size(), "t", 100, 37, 21, &out);
+    ASSERT_TRUE(status.ok()) << status.message();
+    EXPECT_EQ(out.width, 37);
+    EXPECT_EQ(out.height, 21);
+    EXPECT_EQ(out.bits, bits);
+    EXPECT_EQ(std::vector<uint16_t>(values.begin(), values.end() - 1), v);
+    EXPECT_EQ(values.back(), 0xBEEF);
+
+    std::fill(values.begin(), values.end(), 0xBEEF);
+    out.capacity = 37 * 21 - 1;
+    status = DecodeGrayPngInto(png.data(), png.size(), "t", 100, 0, 0, &out);
+    EXPECT_EQ(status.code(), Code::kOutOfMemory) << status.message();
+    EXPECT_EQ(out.width, 0);
+    EXPECT_EQ(std::count(values.begin(), values.end(), 0xBEEF), 37 * 21 + 1);
+
+    out.capacity = values.size();
+    out.strip_bytes = strip.size() / 2;  // rows wider than the caller's strip
+    status = DecodeGrayPngInto(png.data(), png.size(), "t", 100, 0, 0, &out);
+    EXPECT_EQ(status.code(), bits == 16 ? Code::kOutOfMemory : Code::kOk) << status.message();
+  }
 }
 
 // The depth image is plain grey: a colour, alpha or interlaced PNG is refused before a pixel

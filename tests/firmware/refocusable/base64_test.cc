@@ -48,6 +48,22 @@ TEST(Base64Test, AllByteValuesRoundTripAndWhitespaceIsSkipped) {
   EXPECT_TRUE(status.ok()) << status.message();
 }
 
+// Into the caller's buffer: exactly the bytes, and a buffer the text might overflow refused
+// before a byte is written.
+TEST(Base64Test, IntoAFixedBufferChecksItsCapacityFirst) {
+  uint8_t out[7] = {0, 0, 0, 0, 0, 0, 0xAA};
+  size_t written = 99;
+  Status status = Base64DecodeInto("Zm9v YmE=", 9, out, 6, &written);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(std::string(reinterpret_cast<const char*>(out), written), "fooba");
+  EXPECT_EQ(out[6], 0xAA);
+  memset(out, 0, sizeof(out));
+  status = Base64DecodeInto("Zm9vYmFy", 8, out, 5, &written);
+  EXPECT_EQ(status.code(), Code::kOutOfMemory) << status.message();
+  EXPECT_EQ(written, 0u);
+  EXPECT_EQ(out[0], 0);
+}
+
 TEST(Base64Test, GarbageIsAnErrorNamingTheProblem) {
   for (const char* bad :
        {"Zm9v!", "Zg=", "Z", "Zg==Zg==", "=Zg=", "Zm9vY", "Zm9=v", "Zg===", "Zm9v\x80"}) {

@@ -84,6 +84,50 @@ TEST(RefocusableTest, LargeFileUsesExtendedXmpAndRoundTrips) {
   ExpectSameAsWritten(s, r);
 }
 
+// Fixed buffers of exactly the size each part needs (the web page's engine sizes them once):
+// the same fields and bytes as the vector door; one byte less in any of them is kOutOfMemory.
+TEST(RefocusableTest, FixedBuffersReadTheSameFieldsAndRefuseWhatDoesNotFit) {
+  const RefocusSample s = test::MakeRefocusSample(true);
+  const std::vector<uint8_t> jpeg = test::WriteRefocusJpeg(s, s.segments);
+  std::vector<ExtendedXmpChunk> chunks(s.segments.size() - 1);
+  // The decoded parts; base64 may need up to a byte or two more than it decodes to.
+  std::vector<uint8_t> extended(1 << 20), png(s.xmp.depth.data.size() + 2),
+      image(s.xmp.image.size() + 2);
+  size_t extended_size = 0;
+  for (size_t i = 1; i < s.segments.size(); ++i) extended_size += s.segments[i].payload.size() - 75;
+  RefocusableBuffers memory;
+  memory.chunks = chunks.data();
+  memory.chunk_capacity = chunks.size();
+  memory.extended = extended.data();
+  memory.extended_capacity = extended_size;
+  memory.depth_png = png.data();
+  memory.depth_png_capacity = png.size();
+  memory.image = image.data();
+  memory.image_capacity = image.size();
+  RefocusableFields f;
+  Status status = ReadRefocusableFields(jpeg.data(), jpeg.size(), "shot.jpg", memory, &f);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(f.width, s.picture.width);
+  EXPECT_EQ(f.depth_format, "RangeInverse");
+  EXPECT_EQ(f.depth_width, s.disp_width);
+  EXPECT_EQ(std::vector<uint8_t>(f.depth_png, f.depth_png + f.depth_png_size), s.xmp.depth.data);
+  EXPECT_EQ(std::vector<uint8_t>(f.image, f.image + f.image_size), s.xmp.image);
+  EXPECT_TRUE(f.has_focus);
+  EXPECT_DOUBLE_EQ(f.focus.focal_point_x, 0.375);
+
+  for (int part = 0; part < 4; ++part) {
+    SCOPED_TRACE(part);
+    RefocusableBuffers small = memory;
+    size_t* capacity[4] = {&small.chunk_capacity, &small.extended_capacity,
+                           &small.depth_png_capacity, &small.image_capacity};
+    // The base64 check is on the text's length: shrink those below the decoded size.
+    *capacity[part] -= part < 2 ? 1 : 3;
+    status = ReadRefocusableFields(jpeg.data(), jpeg.size(), "shot.jpg", small, &f);
+    EXPECT_EQ(status.code(), Code::kOutOfMemory) << status.message();
+    EXPECT_EQ(std::string(status.message()).rfind("shot.jpg: ", 0), 0u) << status.message();
+  }
+}
+
 TEST(RefocusableTest, EightBitDepthReadsBack) {
   const RefocusSample s = test::MakeRefocusSample(false, 8);
   RefocusableImage r;
