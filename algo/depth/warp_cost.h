@@ -91,6 +91,24 @@ struct WarpSpanJob {
   int32_t x0, n, ax, ay, bx, by, lo, hi;
 };
 
+// True when no position of the span samples inside the view, so every column's cost is
+// r.invalid: its positions lie between its anchors (WarpSpan's steps are truncated toward zero),
+// and a position is valid when its Q8 rounding lies in 0 .. (size - 1) * 256 on both axes, a test
+// monotone in each axis. Kernels test it only on spans they cannot take on their fast path (the
+// spans inside the view), so the common span pays nothing for it.
+inline bool SpanOutsideView(const WarpRow& r, const WarpSpanJob& job) {
+  const int32_t xmax = (r.width - 1) * 256, ymax = (r.height - 1) * 256;
+  auto q8 = [](int32_t q16) { return (q16 + 128) >> 8; };
+  return q8(job.ax > job.bx ? job.ax : job.bx) < 0 ||
+         q8(job.ax < job.bx ? job.ax : job.bx) > xmax ||
+         q8(job.ay > job.by ? job.ay : job.by) < 0 || q8(job.ay < job.by ? job.ay : job.by) > ymax;
+}
+
+// Columns lo..hi-1 of a span outside the view.
+inline void FillInvalid(const WarpRow& r, const WarpSpanJob& job, uint8_t* out) {
+  for (int32_t x = job.lo; x < job.hi; ++x) out[x] = r.invalid;
+}
+
 // Spans are handed to a kernel in batches of up to kSpanBatch (its set-up paid once per batch).
 inline constexpr int32_t kSpanBatch = 16;
 
