@@ -122,10 +122,10 @@ void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
   // A span's end anchor is the next one's start: one Map per span.
   // Where a 64-bit division is an instruction (x86-64, aarch64) Map's two are as fast as the
   // row map's estimate and correction; on 32-bit ARM they are library calls.
-  constexpr bool kSlowDivision = sizeof(void*) < 8;
+  constexpr bool kExactDivide = sizeof(void*) >= 8;
   const PlaneRowMap row_map(h, y);
   auto map = [&](int32_t x, int32_t* x_q16, int32_t* y_q16) {
-    return kSlowDivision ? row_map.At(x, x_q16, y_q16) : h.Map(x, y, x_q16, y_q16);
+    return row_map.At<kExactDivide>(x, x_q16, y_q16);
   };
   int32_t ax = 0, ay = 0;
   bool a_ok = map(first, &ax, &ay);

@@ -74,9 +74,13 @@ TEST(WarpCostTest, RowMapEqualsMap) {
     const bool e = h.Map(x, y, &ex, &ey);
     const bool g = PlaneRowMap(h, y).At(x, &gx, &gy);
     ASSERT_EQ(e, g) << x << "," << y;
+    int32_t dx = 0, dy = 0;
+    ASSERT_EQ(PlaneRowMap(h, y).At<true>(x, &dx, &dy), e) << x << "," << y;
     if (e) {
       ASSERT_EQ(ex, gx) << x << "," << y;
       ASSERT_EQ(ey, gy) << x << "," << y;
+      ASSERT_EQ(ex, dx) << x << "," << y;
+      ASSERT_EQ(ey, dy) << x << "," << y;
       ++compared;
     }
   };
