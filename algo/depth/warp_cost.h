@@ -122,8 +122,10 @@ inline void FillInvalid(const WarpRow& r, const WarpSpanJob& job, uint8_t* out) 
   for (int32_t x = job.lo; x < job.hi; ++x) out[x] = r.invalid;
 }
 
-// Spans are handed to a kernel in batches of up to kSpanBatch (its set-up paid once per batch).
-inline constexpr int32_t kSpanBatch = 16;
+// Spans are handed to a kernel in batches of up to kSpanBatch (its set-up paid once per batch):
+// 48 spans hold a 768-pixel row, so a depth row at 640 is one batch (a batch of 16 made the
+// kernel's set-up about 3 % of its instructions on the handheld bench).
+inline constexpr int32_t kSpanBatch = 48;
 
 // A span kernel: the pixel costs of columns lo..hi-1 of each of `count` spans into out (indexed
 // by x). The C reference is dtk::PlaneSpansC (warp_cost.cc); the SIMD twins (warp_cost_avx2.cc,
