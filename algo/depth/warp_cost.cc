@@ -72,22 +72,16 @@ void SpanPositions(int32_t ax, int32_t ay, int32_t bx, int32_t by, int32_t n, in
   y_q16[n] = by;
 }
 
-// True when no position between anchors a and b samples inside the view. WarpSpan's positions
-// lie between its anchors (its steps are truncated toward zero), and a position is valid when
-// its Q8 rounding lies in 0 .. (size - 1) * 256 on both axes, a test monotone in each axis.
-bool SpanOutsideView(const WarpRow& r, int32_t ax, int32_t ay, int32_t bx, int32_t by) {
-  const int32_t xmax = (r.width - 1) * 256, ymax = (r.height - 1) * 256;
-  auto q8 = [](int32_t q16) { return (q16 + 128) >> 8; };
-  return q8(ax > bx ? ax : bx) < 0 || q8(ax < bx ? ax : bx) > xmax || q8(ay > by ? ay : by) < 0 ||
-         q8(ay < by ? ay : by) > ymax;
-}
-
 }  // namespace
 
 namespace dtk {
 
 void PlaneSpansC(const WarpRow& row, const WarpSpanJob* jobs, int32_t count, uint8_t* out) {
   for (const WarpSpanJob* job = jobs; job < jobs + count; ++job) {
+    if (SpanOutsideView(row, *job)) {
+      FillInvalid(row, *job, out);
+      continue;
+    }
     int32_t xq[kAnchorStep + 1], yq[kAnchorStep + 1];
     SpanPositions(job->ax, job->ay, job->bx, job->by, job->n, xq, yq);
     for (int32_t x = job->lo; x < job->hi; ++x) {
@@ -128,10 +122,10 @@ void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
   // A span's end anchor is the next one's start: one Map per span.
   // Where a 64-bit division is an instruction (x86-64, aarch64) Map's two are as fast as the
   // row map's estimate and correction; on 32-bit ARM they are library calls.
-  constexpr bool kSlowDivision = sizeof(void*) < 8;
+  constexpr bool kExactDivide = sizeof(void*) >= 8;
   const PlaneRowMap row_map(h, y);
   auto map = [&](int32_t x, int32_t* x_q16, int32_t* y_q16) {
-    return kSlowDivision ? row_map.At(x, x_q16, y_q16) : h.Map(x, y, x_q16, y_q16);
+    return row_map.At<kExactDivide>(x, x_q16, y_q16);
   };
   int32_t ax = 0, ay = 0;
   bool a_ok = map(first, &ax, &ay);
@@ -143,7 +137,9 @@ void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
     const int32_t lo = x0 > x_begin ? x0 : x_begin, hi = end < x_end ? end : x_end;
     int32_t bx = ax, by = ay;
     const bool b_ok = x1 == x0 ? a_ok : map(x1, &bx, &by);
-    if (a_ok && b_ok && !SpanOutsideView(row, ax, ay, bx, by)) {
+    // A span outside the view is the kernel's to find (SpanOutsideView): not worth a test on
+    // every span here.
+    if (a_ok && b_ok) {
       batch[batched++] = WarpSpanJob{x0, x1 - x0, ax, ay, bx, by, lo, hi};
       if (batched == kSpanBatch) {
         span(row, batch, batched, out);

@@ -41,6 +41,9 @@ class PlaneRowMap {
   PlaneRowMap(const PlaneHomography& h, int32_t y)
       : m_(h.m), den_(h.m[7] * y + h.m[8]), nx_(h.m[1] * y + h.m[2]), ny_(h.m[4] * y + h.m[5]) {}
 
+  // kExactDivide: Map's own 64-bit division (one instruction on x86-64 and aarch64) instead of
+  // the estimate; the row's constant terms are still summed once.
+  template <bool kExactDivide = false>
   bool At(int32_t x, int32_t* x_q16, int32_t* y_q16) const {
     const int64_t den = m_[6] * x + den_;
     const int64_t nx = m_[0] * x + nx_;
@@ -48,6 +51,11 @@ class PlaneRowMap {
     if (den < (int64_t{1} << 20) || den >= (int64_t{1} << 32)) return false;
     const int64_t lim = den << 14;
     if (nx >= lim || -nx >= lim || ny >= lim || -ny >= lim) return false;
+    if (kExactDivide) {
+      *x_q16 = Exact(nx, den);
+      *y_q16 = Exact(ny, den);
+      return true;
+    }
     const double inv = 1.0 / static_cast<double>(den);
     *x_q16 = Div(nx, den, inv);
     *y_q16 = Div(ny, den, inv);
@@ -55,6 +63,11 @@ class PlaneRowMap {
   }
 
  private:
+  static int32_t Exact(int64_t n, int64_t den) {
+    const int64_t a = n < 0 ? -n : n;
+    const int64_t q = ((a << 16) + (den >> 1)) / den;  // as PlaneHomography::Map
+    return static_cast<int32_t>(n < 0 ? -q : q);
+  }
   static int32_t Div(int64_t n, int64_t den, double inv) {
     const int64_t a = n < 0 ? -n : n;
     const int64_t num = (a << 16) + (den >> 1);  // a < den 2^14: below 2^62 + 2^31
@@ -91,8 +104,28 @@ struct WarpSpanJob {
   int32_t x0, n, ax, ay, bx, by, lo, hi;
 };
 
-// Spans are handed to a kernel in batches of up to kSpanBatch (its set-up paid once per batch).
-inline constexpr int32_t kSpanBatch = 16;
+// True when no position of the span samples inside the view, so every column's cost is
+// r.invalid: its positions lie between its anchors (WarpSpan's steps are truncated toward zero),
+// and a position is valid when its Q8 rounding lies in 0 .. (size - 1) * 256 on both axes, a test
+// monotone in each axis. Kernels test it only on spans they cannot take on their fast path (the
+// spans inside the view), so the common span pays nothing for it.
+inline bool SpanOutsideView(const WarpRow& r, const WarpSpanJob& job) {
+  const int32_t xmax = (r.width - 1) * 256, ymax = (r.height - 1) * 256;
+  auto q8 = [](int32_t q16) { return (q16 + 128) >> 8; };
+  return q8(job.ax > job.bx ? job.ax : job.bx) < 0 ||
+         q8(job.ax < job.bx ? job.ax : job.bx) > xmax ||
+         q8(job.ay > job.by ? job.ay : job.by) < 0 || q8(job.ay < job.by ? job.ay : job.by) > ymax;
+}
+
+// Columns lo..hi-1 of a span outside the view.
+inline void FillInvalid(const WarpRow& r, const WarpSpanJob& job, uint8_t* out) {
+  for (int32_t x = job.lo; x < job.hi; ++x) out[x] = r.invalid;
+}
+
+// Spans are handed to a kernel in batches of up to kSpanBatch (its set-up paid once per batch):
+// 48 spans hold a 768-pixel row, so a depth row at 640 is one batch (a batch of 16 made the
+// kernel's set-up about 3 % of its instructions on the handheld bench).
+inline constexpr int32_t kSpanBatch = 48;
 
 // A span kernel: the pixel costs of columns lo..hi-1 of each of `count` spans into out (indexed
 // by x). The C reference is dtk::PlaneSpansC (warp_cost.cc); the SIMD twins (warp_cost_avx2.cc,

@@ -492,6 +492,10 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpSpanJob* jobs, int32_t c
     __m256i xq, yq;
     Band band{};
     const bool in_band = r.width >= 16 && BandOf(r, *job, &band);
+    if (!in_band && SpanOutsideView(r, *job)) {
+      FillInvalid(r, *job, out);
+      continue;
+    }
     if (job->hi - job->lo < kLanes) {
       // A short range: one step over 8 pixels of the row that hold it, into a buffer.
       const int32_t x = Min(job->lo, r.width - kLanes);

@@ -140,6 +140,10 @@ void PlaneSpansNeon(const WarpRow& r, const WarpSpanJob* jobs, int32_t count, ui
   const int32x4_t iota_lo = vld1q_s32(lane_index), iota_hi = vld1q_s32(lane_index + 4);
   const int32x4_t half = vdupq_n_s32(32768);
   for (const WarpSpanJob* job = jobs; job < jobs + count; ++job) {
+    if (SpanOutsideView(r, *job)) {
+      FillInvalid(r, *job, out);
+      continue;
+    }
     // A whole span divides exactly (2^16 / kAnchorStep is whole): no division.
     const int32_t n = job->n;
     const int64_t dx = int64_t{job->bx} - job->ax, dy = int64_t{job->by} - job->ay;

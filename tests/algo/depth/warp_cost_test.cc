@@ -74,9 +74,13 @@ TEST(WarpCostTest, RowMapEqualsMap) {
     const bool e = h.Map(x, y, &ex, &ey);
     const bool g = PlaneRowMap(h, y).At(x, &gx, &gy);
     ASSERT_EQ(e, g) << x << "," << y;
+    int32_t dx = 0, dy = 0;
+    ASSERT_EQ(PlaneRowMap(h, y).At<true>(x, &dx, &dy), e) << x << "," << y;
     if (e) {
       ASSERT_EQ(ex, gx) << x << "," << y;
       ASSERT_EQ(ey, gy) << x << "," << y;
+      ASSERT_EQ(ex, dx) << x << "," << y;
+      ASSERT_EQ(ey, dy) << x << "," << y;
       ++compared;
     }
   };
@@ -145,6 +149,47 @@ TEST(WarpCostTest, AnchorInterpolationIsWithinBoundOfTheExactMap) {
   std::printf("anchor interpolation: worst %.5f px (1/%.0f) over 2 degree, 2 %% motions\n", worst,
               1 / worst);
   EXPECT_LE(worst, 1.0 / 200);
+}
+
+// The kernels fill a span with the invalid cost, without sampling it, when SpanOutsideView says
+// so: that must hold only when every one of its positions (WarpSpan's) rounds to outside the
+// view. Random affine maps (positions moving up to 3 px per pixel either way, in both axes) put
+// spans inside, across every edge and far outside of a 64x48 view.
+TEST(WarpCostTest, SpanOutsideViewOnlyWhenEveryPositionIsOutside) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  WarpRow row;
+  row.width = 64;
+  row.height = 48;
+  int32_t outside = 0, inside = 0;
+  for (int32_t trial = 0; trial < 20000; ++trial) {
+    PlaneHomography h;
+    auto q30 = [](double v) { return static_cast<int64_t>(std::llround(v * (1 << 30))); };
+    h.m[0] = q30(3 * u(rng));
+    h.m[1] = q30(0.2 * u(rng));
+    h.m[2] = q30(100 * u(rng));
+    h.m[3] = q30(trial % 4 == 0 ? 0.0 : 3 * u(rng));
+    h.m[4] = q30(1 + 0.2 * u(rng));
+    h.m[5] = q30(80 * u(rng));
+    h.m[8] = int64_t{1} << 30;
+    const int32_t n = trial % 3 == 0 ? 1 + static_cast<int32_t>(rng() % kAnchorStep) : kAnchorStep;
+    const int32_t x0 = static_cast<int32_t>(rng() % 48), y = static_cast<int32_t>(rng() % 48);
+    int32_t xq[kAnchorStep + 1], yq[kAnchorStep + 1];
+    ASSERT_TRUE(WarpSpan(h, x0, x0 + n, y, xq, yq));
+    const WarpSpanJob job{x0, n, xq[0], yq[0], xq[n], yq[n], x0, x0 + n + 1};
+    if (!SpanOutsideView(row, job)) {
+      ++inside;
+      continue;
+    }
+    ++outside;
+    for (int32_t i = 0; i <= n; ++i) {
+      const int32_t xs = (xq[i] + 128) >> 8, ys = (yq[i] + 128) >> 8;
+      ASSERT_TRUE(xs < 0 || xs > 63 * 256 || ys < 0 || ys > 47 * 256)
+          << "trial " << trial << " pixel " << i << " at " << xs / 256.0 << ", " << ys / 256.0;
+    }
+  }
+  EXPECT_GT(outside, 2000);
+  EXPECT_GT(inside, 2000);
 }
 
 std::vector<uint32_t> Census(const ConstImageU8& img) {
