@@ -150,7 +150,8 @@ Status RefocusEngine::Configure(const RefocusEngineConfig& config) {
 }
 
 Status RefocusEngine::LoadFile(const char* path) {
-  const int fd = open(path, O_RDONLY | O_CLOEXEC);
+  // The web side checked the name without following links; a link swapped in since is refused.
+  const int fd = open(path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
   if (fd < 0) {
     return Status(errno == ENOENT ? Code::kNotFound : Code::kIoError, "%s: %s", path,
                   strerror(errno));

@@ -641,15 +641,19 @@ bool WebServer::ListPhotos(MHD_Connection* c, Request* r) {
   return Reply(c, r, MHD_HTTP_OK, "application/json", json.data(), json.size(), nullptr);
 }
 
-bool WebServer::ServePhoto(MHD_Connection* c, Request* r, const char* name, bool thumbnail) {
+Status WebServer::OpenNamedPhoto(const char* name, int* fd, struct stat* st) const {
   int dir_fd = -1;
   Status s = OpenPhotoFolder(options_.photo_dir.c_str(), &dir_fd);
+  if (!s.ok()) return s;
+  s = OpenPhoto(dir_fd, name, fd, st);
+  close(dir_fd);
+  return s;
+}
+
+bool WebServer::ServePhoto(MHD_Connection* c, Request* r, const char* name, bool thumbnail) {
   int fd = -1;
   struct stat st;
-  if (s.ok()) {
-    s = OpenPhoto(dir_fd, name, &fd, &st);
-    close(dir_fd);
-  }
+  Status s = OpenNamedPhoto(name, &fd, &st);
   if (!s.ok()) return ReplyStatus(c, r, s);
   if (thumbnail) {
     std::vector<uint8_t> jpeg;
@@ -680,14 +684,9 @@ bool WebServer::ServePhoto(MHD_Connection* c, Request* r, const char* name, bool
 }
 
 bool WebServer::Info(MHD_Connection* c, Request* r, const char* name) {
-  int dir_fd = -1;
-  Status s = OpenPhotoFolder(options_.photo_dir.c_str(), &dir_fd);
   int fd = -1;
   struct stat st;
-  if (s.ok()) {
-    s = OpenPhoto(dir_fd, name, &fd, &st);
-    close(dir_fd);
-  }
+  Status s = OpenNamedPhoto(name, &fd, &st);
   if (!s.ok()) return ReplyStatus(c, r, s);
   close(fd);
   const std::string path = options_.photo_dir + "/" + name;

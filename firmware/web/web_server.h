@@ -33,6 +33,8 @@
 // 422 a photo that cannot be refocused, 503 + Retry-After when the renderer is busy.
 #pragma once
 
+#include <sys/stat.h>
+
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
@@ -105,6 +107,8 @@ class WebServer {
   bool ServePage(MHD_Connection* c, Request* r, const char* file, const char* type);
   bool Login(MHD_Connection* c, Request* r);
   bool ListPhotos(MHD_Connection* c, Request* r);
+  // Opens `name` in the photo folder as OpenPhoto does (checked, no link followed).
+  Status OpenNamedPhoto(const char* name, int* fd, struct stat* st) const;
   bool ServePhoto(MHD_Connection* c, Request* r, const char* name, bool thumbnail);
   bool Info(MHD_Connection* c, Request* r, const char* name);
   bool Refocus(MHD_Connection* c, Request* r, const char* action);

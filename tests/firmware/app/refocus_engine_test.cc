@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -309,6 +310,10 @@ TEST_F(RefocusEngineTest, RefusesWhatItCannotTake) {
     EXPECT_FALSE(engine.Load(cut.c_str()).ok()) << keep;
   }
   EXPECT_EQ(engine.Load(dir_->Path("absent.jpg").c_str()).code(), Code::kNotFound);
+  // A link put where a photo was checked is not followed (the page names files, not links).
+  const std::string link = dir_->Path("link.jpg");
+  ASSERT_EQ(symlink(photos_->front().path.c_str(), link.c_str()), 0);
+  EXPECT_FALSE(engine.Load(link.c_str()).ok());
   // After all that, a good photo still loads.
   EXPECT_TRUE(engine.Load(photos_->front().path.c_str()).ok());
 }
