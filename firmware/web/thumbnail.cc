@@ -6,6 +6,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <vector>
+
+#include "firmware/codecs/exif.h"
 
 // After <cstdio>: jpeglib.h uses FILE without declaring it.
 #include <jpeglib.h>
@@ -59,6 +62,26 @@ struct Work {
   }
 };
 
+// The EXIF Orientation in the saved APP1 markers, 0 when none.
+int32_t OrientationOf(jpeg_saved_marker_ptr marker) {
+  for (; marker != nullptr; marker = marker->next) {
+    if (marker->marker != JPEG_APP0 + 1 || marker->data_length < 6 ||
+        memcmp(marker->data, "Exif\0\0", 6) != 0) {
+      continue;
+    }
+    // As a file would hold it: SOI, then the APP1 segment.
+    std::vector<uint8_t> file = {0xff,
+                                 0xd8,
+                                 0xff,
+                                 0xe1,
+                                 static_cast<uint8_t>((marker->data_length + 2) >> 8),
+                                 static_cast<uint8_t>(marker->data_length + 2)};
+    file.insert(file.end(), marker->data, marker->data + marker->data_length);
+    return ExifOrientation(file.data(), file.size());
+  }
+  return 0;
+}
+
 // Returns 0 on success, 1 on a libjpeg error (message in err), 2 on an oversized image, 3 when
 // out of memory.
 int Shrink(Work* w, ErrorManager* err, int32_t width, int quality) {
@@ -69,6 +92,7 @@ int Shrink(Work* w, ErrorManager* err, int32_t width, int quality) {
   jpeg_create_decompress(&w->in);
   w->in_made = true;
   jpeg_stdio_src(&w->in, w->file);
+  jpeg_save_markers(&w->in, JPEG_APP0 + 1, 0xffff);  // EXIF: the orientation to carry over
   jpeg_read_header(&w->in, TRUE);
   if (w->in.image_width > kMaxSide || w->in.image_height > kMaxSide) return 2;
   // Smallest M/8 with image_width * M / 8 >= width.
@@ -108,6 +132,17 @@ int Shrink(Work* w, ErrorManager* err, int32_t width, int quality) {
   jpeg_set_defaults(&w->out);
   jpeg_set_quality(&w->out, quality, TRUE);
   jpeg_start_compress(&w->out, TRUE);
+  // The photo's EXIF Orientation on the thumbnail too, so the gallery turns it as the browser
+  // turns the photo itself.
+  const int32_t orientation = OrientationOf(w->in.marker_list);
+  if (orientation > 1) {
+    ExifTags tags;
+    tags.orientation = orientation;
+    std::vector<uint8_t> exif;
+    if (BuildExif(tags, out_w, out_h, &exif).ok()) {
+      jpeg_write_marker(&w->out, JPEG_APP0 + 1, exif.data(), static_cast<unsigned>(exif.size()));
+    }
+  }
 
   // Input row y belongs to output row y * out_h / in_h; a finished output row is the average of
   // its input rows and columns.

@@ -3,7 +3,8 @@
 // so a 12 MP photo costs a 1/8 decode), an area average takes it the rest of the way, and the
 // result is encoded again. Only a row of each is held, so the memory is a few KiB a column.
 // The embedded depth and all-in-focus images of a refocusable JPEG are APP segments the decoder
-// skips. EXIF orientation is not applied (the camera writes upright photos).
+// skips. The photo's EXIF Orientation is written into the thumbnail (not applied to its
+// pixels), so a browser turns both the same way.
 #pragma once
 
 #include <cstdint>

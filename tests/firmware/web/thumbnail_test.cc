@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "firmware/codecs/exif.h"
 #include "firmware/codecs/jpeg_writer.h"
 #include "tests/firmware/codecs/jpeg_test_util.h"
 
@@ -71,6 +72,27 @@ TEST(ThumbnailTest, OddSizesAndSmallPhotos) {
   const Thumb small = ThumbOf(HalfAndHalf(200, 100), dir);  // narrower: kept
   EXPECT_EQ(small.w, 200);
   EXPECT_EQ(small.h, 100);
+}
+
+TEST(ThumbnailTest, CarriesThePhotosOrientation) {
+  test::ScratchDir dir;
+  std::vector<uint8_t> photo = HalfAndHalf(640, 480);
+  const Thumb plain = ThumbOf(photo, dir);
+  EXPECT_EQ(ExifOrientation(plain.jpeg.data(), plain.jpeg.size()), 0) << "none recorded";
+  // The same photo with EXIF Orientation 6 (turn 90 degrees clockwise) right after SOI.
+  ExifTags tags;
+  tags.orientation = 6;
+  std::vector<uint8_t> exif;
+  ASSERT_TRUE(BuildExif(tags, 640, 480, &exif).ok());
+  const size_t length = exif.size() + 2;
+  std::vector<uint8_t> app1 = {0xff, 0xe1, static_cast<uint8_t>(length >> 8),
+                               static_cast<uint8_t>(length)};
+  app1.insert(app1.end(), exif.begin(), exif.end());
+  photo.insert(photo.begin() + 2, app1.begin(), app1.end());
+  ASSERT_EQ(ExifOrientation(photo.data(), photo.size()), 6);
+  const Thumb t = ThumbOf(photo, dir);
+  EXPECT_EQ(t.w, 320) << "the pixels stay as stored";
+  EXPECT_EQ(ExifOrientation(t.jpeg.data(), t.jpeg.size()), 6);
 }
 
 TEST(ThumbnailTest, CorruptBytesAreAnError) {
