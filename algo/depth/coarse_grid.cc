@@ -83,6 +83,7 @@ void DepthStage::CoarsePass() {
   stats_.initial_energy = energy_;
   for (int32_t y = 0; y < coarse_.height; ++y) {
     RowLabels(coarse_, y);
+    coarse_.row_took[y] = 0;
     coarse_.span[2 * y] = coarse_.span[2 * y + 1] = 0;
   }
   window_ = DepthConfig::kMaxLabels;

@@ -80,6 +80,7 @@ void DepthStage::CarveGrid(Arena& arena, Grid& g, int32_t width, int32_t height,
   g.weight_down = arena.Allocate<uint16_t>(n);
   g.state = arena.Allocate<uint8_t>(n);
   g.row_labels = arena.Allocate<uint64_t>(4 * rows);
+  g.label_count = arena.Allocate<int32_t>(rows * static_cast<size_t>(config_.labels));
   g.span = arena.Allocate<int32_t>(2 * rows);
   g.prev_span = arena.Allocate<int32_t>(2 * rows);
   g.near_span = arena.Allocate<int32_t>(2 * rows);
@@ -169,11 +170,14 @@ void DepthStage::LabelCosts(int32_t label, uint16_t* out) {
 }
 
 void DepthStage::RowLabels(Grid& g, int32_t y) {
-  const int32_t w = g.width;
+  const int32_t w = g.width, labels = config_.labels;
   uint64_t* m = g.row_labels + 4 * y;
-  m[0] = m[1] = m[2] = m[3] = 0;
+  int32_t* count = g.label_count + y * labels;
+  for (int32_t l = 0; l < labels; ++l) count[l] = 0;
   const uint8_t* f = g.labels + y * w;
-  for (int32_t x = 0; x < w; ++x) m[f[x] >> 6] |= uint64_t{1} << (f[x] & 63);
+  for (int32_t x = 0; x < w; ++x) ++count[f[x]];
+  m[0] = m[1] = m[2] = m[3] = 0;
+  for (int32_t l = 0; l < labels; ++l) m[l >> 6] |= uint64_t{count[l] > 0} << (l & 63);
 }
 
 void DepthStage::EdgeWeights(const ConstImageU8& ref) {
@@ -339,7 +343,10 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
     fine_.cost_alpha[p] = fine_.prev_alpha[p] = kNotComputed;  // as MoveRects keeps them
   }
   fine_.written_count = fine_.prev_written_count = 0;
-  for (int32_t y = 0; y < h; ++y) fine_.span[2 * y] = fine_.span[2 * y + 1] = 0;
+  for (int32_t y = 0; y < h; ++y) {
+    fine_.span[2 * y] = fine_.span[2 * y + 1] = 0;
+    fine_.row_took[y] = 0;
+  }
   if (coarse && !c.coarse_blocks) {
     for (int32_t alpha = 0; alpha < c.labels; alpha += c.coarse_step) {
       if (Expand(alpha)) ++stats_.moves;

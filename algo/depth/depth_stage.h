@@ -147,6 +147,7 @@ class DepthStage {
     // Per row, the labels present (bit l of word l / 64), and the columns whose D the move in
     // progress (span) and the one before (prev_span) computed: [x0, x1) as two entries.
     uint64_t* row_labels = nullptr;
+    int32_t* label_count = nullptr;  // per row, how many nodes hold each label (labels per row)
     int32_t* span = nullptr;
     int32_t* prev_span = nullptr;
     // Per row, the columns from the first to the last label within the window of the move in
@@ -161,7 +162,7 @@ class DepthStage {
     Rect* written = nullptr;
     Rect* prev_written = nullptr;
     int32_t written_count = 0, prev_written_count = 0, written_capacity = 0;
-    uint8_t* row_took = nullptr;  // per row, 1 when a pixel of it took alpha (Record)
+    uint8_t* row_took = nullptr;  // per row, 1 when a pixel of it takes alpha (CutRect, Record)
   };
   void CarveGrid(Arena& arena, Grid& g, int32_t width, int32_t height, bool prev_alpha);
   Grid& grid() { return on_coarse_ ? coarse_ : fine_; }
@@ -206,12 +207,21 @@ class DepthStage {
   int32_t ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1);
   void PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1);
   int32_t BuildRow(const Rect& r, int32_t y, int32_t node_row);
-  void RowLabels(Grid& g, int32_t y);
+  void RowLabels(Grid& g, int32_t y);  // counts row y's labels, from scratch
+  // Node (x, y) of g leaves label `from` for `to`: row y's counts and label mask follow.
+  static void MoveLabel(Grid& g, int32_t labels, int32_t y, int32_t from, int32_t to) {
+    int32_t* count = g.label_count + y * labels;
+    uint64_t* m = g.row_labels + 4 * y;
+    if (--count[from] == 0) m[from >> 6] &= ~(uint64_t{1} << (from & 63));
+    if (count[to]++ == 0) m[to >> 6] |= uint64_t{1} << (to & 63);
+  }
   enum : int32_t { kPairRight = 0, kPairDown = 1, kHigh = 2, kRowFree = 1, kRowTake = 2 };
   int32_t* Ring(int32_t y, int32_t kind) {
     return move_rows_ + ((y % 3) * 3 + kind) * config_.width;
   }
   int64_t Record(int32_t alpha);  // returns the energy change
+  void RecordNeighbours(int32_t alpha, const uint8_t* st, const uint8_t* f, const uint16_t* ca,
+                        uint16_t* below, uint16_t* above, int32_t x0, int32_t x1);
   void Refine(ImageU16 disp_q8);
 
   DepthConfig config_;
