@@ -103,7 +103,8 @@ Status DepthStage::Carve(Arena& arena) {
   data_.Carve(arena, w, h, config_.views, config_.workers);
   maxflow_.Carve(arena, w, h);
   CarveGrid(arena, fine_, w, h, true);
-  move_rows_ = arena.Allocate<int32_t>(11 * static_cast<size_t>(w));
+  move_rows_ = arena.Allocate<int32_t>(14 * static_cast<size_t>(w));
+  keep_row_ = arena.Allocate<uint8_t>(static_cast<size_t>(w));
   split_ = arena.Allocate<uint8_t>(static_cast<size_t>(w > h ? w : h) + 2);
   // The coarse grid is done with before the fine moves record anything in below_ and above_,
   // so it lives in their memory (enlarged for the smallest images, where alignment dominates).
@@ -323,6 +324,7 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
   if (progress_ != nullptr) progress_->Report(0, total);
   data_.Prepare(views);
   EdgeWeights(views[c.reference]);
+  for (int32_t x = 0; x < w; ++x) keep_row_[x] = kKeep;
   prev_label_ = -1;
   stats_.cycles = 0;
   stats_.moves = 0;

@@ -240,7 +240,8 @@ class DepthStage {
   // this large (DataTerm::kMaxCost).
   static constexpr uint16_t kNotComputed = 0xffff;
   uint16_t CostAt(int32_t label, int32_t x, int32_t y);
-  int32_t* move_rows_ = nullptr;  // the moves' row ring (expansion_move.cc)
+  int32_t* move_rows_ = nullptr;  // the moves' row ring and rows (expansion_move.cc)
+  uint8_t* keep_row_ = nullptr;   // width x kKeep: the state of the rows around a rectangle
   uint8_t* split_ = nullptr;      // max(width, height) + 2 bytes: SplitRect's column or row marks
   int32_t smooth_[DepthConfig::kMaxLabels] = {};  // min(d, smooth_trunc) for a label distance d
   int32_t prev_label_ = -1;

@@ -128,48 +128,72 @@ void DepthStage::PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1) {
   }
 }
 
+// BuildRow's terms of pixels x0..x1-1 of a row (state st, the rows above and below up and
+// down), 0 for fixed pixels. The left and right neighbours are those within x0..x1-1: the first
+// and last pixel are peeled.
+LB_CLONES_AVX2 static void BuildTerms(const uint8_t* __restrict st, const uint8_t* __restrict up,
+                                      const uint8_t* __restrict down, const int32_t* __restrict er,
+                                      const int32_t* __restrict ed, const int32_t* __restrict eu,
+                                      const int32_t* __restrict hi, int32_t x0, int32_t x1,
+                                      int32_t* __restrict balance, int32_t* __restrict cap_right,
+                                      int32_t* __restrict cap_down) {
+  constexpr uint8_t kFree = 0, kKeep = 1, kTake = 2;  // DepthStage's states
+  auto terms = [&](int32_t x, uint8_t left, uint8_t right, int32_t e_left, int32_t e_right) {
+    const int32_t free = st[x] == kFree ? -1 : 0;
+    const int32_t b = hi[x] - (right == kTake ? e_right : 0) - (left != kKeep ? e_left : 0) -
+                      (down[x] == kTake ? ed[x] : 0) - (up[x] != kKeep ? eu[x] : 0);
+    balance[x] = b & free;
+    cap_right[x] = (right == kFree ? e_right : 0) & free;
+    cap_down[x] = (down[x] == kFree ? ed[x] : 0) & free;
+  };
+  if (x1 - x0 == 1) {
+    terms(x0, kKeep, kKeep, 0, 0);
+    return;
+  }
+  terms(x0, kKeep, st[x0 + 1], 0, er[x0]);
+  for (int32_t x = x0 + 1; x < x1 - 1; ++x) terms(x, st[x - 1], st[x + 1], er[x - 1], er[x]);
+  terms(x1 - 1, st[x1 - 2], kKeep, er[x1 - 2], 0);
+}
+
 // Pass 2, one row behind pass 1: row y's nodes of the 2-label graph over the free pixels (node
 // row `node_row`). A fixed neighbour q turns the pair into a unary term on p: C - A when q keeps
 // its label, -B = C - A - e_pq when it takes alpha. A free right or down neighbour makes the arc
 // p -> q of capacity e_pq (p's balance keeps C - A), and a free left or up neighbour q puts the
 // -C of the pair (q, p), here -B = C - A - e_pq, on p's balance. Neighbours outside the
 // rectangle keep their labels. Returns the free pixels.
+//
+// The terms are computed for every pixel of the row without branches (BuildTerms) and are 0 for
+// fixed pixels, whose nodes are then the solver's idle nodes.
 int32_t DepthStage::BuildRow(const Rect& r, int32_t y, int32_t node_row) {
   const int32_t w = grid().width;
   const uint8_t* st = grid().state + y * w;
-  const uint8_t* up = y > r.y0 ? st - w : nullptr;
-  const uint8_t* down = y + 1 < r.y1 ? st + w : nullptr;
+  // Rows outside the rectangle keep their labels: a row of kKeep stands for them.
+  const uint8_t* up = y > r.y0 ? st - w : keep_row_;
+  const uint8_t* down = y + 1 < r.y1 ? st + w : keep_row_;
   const int32_t* er = Ring(y, kPairRight);
   const int32_t* ed = Ring(y, kPairDown);
-  const int32_t* eu = up != nullptr ? Ring(y - 1, kPairDown) : nullptr;
+  const int32_t* eu = y > r.y0 ? Ring(y - 1, kPairDown) : ed;  // unread when up is keep_row_
   const int32_t* hi = Ring(y, kHigh);
-  const int32_t base = node_row * (r.x1 - r.x0) - r.x0;
-  int32_t free_pixels = 0, first = r.x1, last = r.x0 - 1;
-  for (int32_t x = r.x0; x < r.x1; ++x) {
+  int32_t* balance = move_rows_ + 11 * config_.width;
+  int32_t* cap_right = move_rows_ + 12 * config_.width;
+  int32_t* cap_down = move_rows_ + 13 * config_.width;
+  const int32_t x0 = r.x0, x1 = r.x1;
+  BuildTerms(st, up, down, er, ed, eu, hi, x0, x1, balance, cap_right, cap_down);
+  const int32_t base = node_row * (x1 - x0) - x0;
+  int32_t free_pixels = 0, first = x1, last = x0 - 1;
+  for (int32_t x = x0; x < x1; ++x) {
     if (st[x] != kFree) {
       maxflow_.SetIdle(base + x);
       continue;
     }
+    maxflow_.SetNode(base + x, balance[x], cap_right[x], cap_down[x]);
     ++free_pixels;
     first = x < first ? x : first;
     last = x;
-    int32_t balance = hi[x];
-    int32_t cap_right = 0, cap_down = 0;
-    if (x + 1 < r.x1) {
-      if (st[x + 1] == kFree) cap_right = er[x];
-      if (st[x + 1] == kTake) balance -= er[x];
-    }
-    if (x > r.x0 && st[x - 1] != kKeep) balance -= er[x - 1];
-    if (down) {
-      if (down[x] == kFree) cap_down = ed[x];
-      if (down[x] == kTake) balance -= ed[x];
-    }
-    if (eu && up[x] != kKeep) balance -= eu[x];
-    maxflow_.SetNode(base + x, balance, cap_right, cap_down);
   }
   // The solver's row passes look only from the first free pixel to the last.
   if (free_pixels > 0) {
-    maxflow_.RowDone(node_row, first - r.x0, last + 1 - r.x0);
+    maxflow_.RowDone(node_row, first - x0, last + 1 - x0);
   } else {
     maxflow_.RowDone(node_row, 0, 0);
   }
