@@ -59,9 +59,10 @@ Status RenderStage::Validate(const RenderConfig& c) {
 }
 
 Status RenderStage::ValidateParams(const RenderParams& p) {
-  if (!(p.f_number >= 1.0f && p.f_number <= 32.0f)) {
-    return Status(Code::kInvalidArgument, "render: f-number %.2f outside f/1 .. f/32",
-                  static_cast<double>(p.f_number));
+  if (!(p.f_number >= RenderParams::kMinFNumber && p.f_number <= RenderParams::kMaxFNumber)) {
+    return Status(Code::kInvalidArgument, "render: f-number %.2f outside f/%g .. f/%g",
+                  static_cast<double>(p.f_number), static_cast<double>(RenderParams::kMinFNumber),
+                  static_cast<double>(RenderParams::kMaxFNumber));
   }
   if (p.aperture.blades != 0 && (p.aperture.blades < 3 || p.aperture.blades > 12)) {
     return Status(Code::kInvalidArgument, "render: %d aperture blades (0 for a disc, or 3..12)",

@@ -43,8 +43,11 @@ struct Aperture {
 };
 
 struct RenderParams {
+  // The f-numbers the product accepts anywhere (settings, the command line, the camera's page):
+  // as on a lens, f/1 .. f/22.
+  static constexpr float kMinFNumber = 1.0f, kMaxFNumber = 22.0f;
   FocusRegion focus;
-  float f_number = 2.8f;  // as set on a lens: f/1.4 .. f/16
+  float f_number = 2.8f;  // kMinFNumber .. kMaxFNumber
   Aperture aperture;
   // Highlights: luma at or above the threshold is multiplied by a gain that ramps from 1 at the
   // threshold to highlight_gain at 255 before blurring, so point lights make bright bokeh balls.

@@ -275,7 +275,9 @@ Status RefocusEngine::ParseAndDecode(const char* path, size_t size) {
   cur.f_number = 2.8f;
   if (f.has_focus && focus.blur_at_infinity > 0 && focus.focal_distance > 0) {
     const double fn = 5.6 * scale / (focus.focal_distance * focus.blur_at_infinity * width);
-    if (std::isfinite(fn)) cur.f_number = static_cast<float>(std::clamp(fn, 1.4, 16.0));
+    if (std::isfinite(fn))
+      cur.f_number = static_cast<float>(
+          std::clamp(fn, double{RenderParams::kMinFNumber}, double{RenderParams::kMaxFNumber}));
   }
   return Status::Ok();
 }

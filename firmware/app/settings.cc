@@ -159,7 +159,8 @@ const Setting kSettings[] = {
    "point or rectangle to keep sharp, px of the photo (default: the centre)", Focus},
   {"f-number", nullptr, SettingGroup::kLens, "N", "aperture as on a lens, 1 .. 22 (default 2.8)",
    [](const char* t, JobOptions* j, std::string* w) {
-     return ParseRealNumber(t, 1.0f, 22.0f, &j->render.f_number, w); }},
+     return ParseRealNumber(t, RenderParams::kMinFNumber, RenderParams::kMaxFNumber,
+                            &j->render.f_number, w); }},
   {"aperture", nullptr, SettingGroup::kLens, "SHAPE",
    "disc (default), or N-blade for a polygonal iris (N 3..12)", ApertureShape},
   {"aperture-rotation", "rotation", SettingGroup::kLens, "DEG",

@@ -244,9 +244,10 @@ Status EngineBackend::Process(Request* r) {
   }
   LB_RETURN_IF_ERROR(s);
   const RefocusParams& q = *r->params;
-  if (!(q.f_number >= 1.4f && q.f_number <= 16.0f)) {
-    return Status(Code::kInvalidArgument, "web: f/%.1f outside f/1.4 .. f/16",
-                  static_cast<double>(q.f_number));
+  if (!(q.f_number >= RenderParams::kMinFNumber && q.f_number <= RenderParams::kMaxFNumber)) {
+    return Status(Code::kInvalidArgument, "web: f/%.1f outside f/%g .. f/%g",
+                  static_cast<double>(q.f_number), static_cast<double>(RenderParams::kMinFNumber),
+                  static_cast<double>(RenderParams::kMaxFNumber));
   }
   const EnginePhoto& p = engine_.photo();
   RenderParams params;

@@ -16,7 +16,7 @@ namespace lb {
 // rectangle (x0 == x1, y0 == y1): it means FocusAtPoint at full size.
 struct RefocusParams {
   float x0 = 0.5f, y0 = 0.5f, x1 = 0.5f, y1 = 0.5f;
-  float f_number = 2.8f;  // f/1.4 .. f/16
+  float f_number = 2.8f;  // RenderParams::kMinFNumber .. kMaxFNumber
   Aperture aperture;      // shape: disc or polygon (blades)
 };
 

@@ -221,8 +221,11 @@ Status ParseRefocus(const Fields& f, std::string* name, RefocusParams* p) {
   }
   if (p->x1 < p->x0) std::swap(p->x0, p->x1);
   if (p->y1 < p->y0) std::swap(p->y0, p->y1);
-  if (f.Get("f") != nullptr && !Number(f.Get("f"), 1.0f, 22.0f, &p->f_number)) {
-    return Status(Code::kInvalidArgument, "f must be an f-number from 1 to 22");
+  if (f.Get("f") != nullptr &&
+      !Number(f.Get("f"), RenderParams::kMinFNumber, RenderParams::kMaxFNumber, &p->f_number)) {
+    return Status(Code::kInvalidArgument, "f must be an f-number from %g to %g",
+                  static_cast<double>(RenderParams::kMinFNumber),
+                  static_cast<double>(RenderParams::kMaxFNumber));
   }
   float blades = 0.0f;
   if (f.Get("blades") != nullptr) {

@@ -118,6 +118,14 @@ TEST_F(EngineBackendTest, DescribesRendersAndSaves) {
   wide.f_number = 0.5f;
   VectorSink none;
   EXPECT_EQ(backend.Render(Photo().c_str(), wide, true, &none).code(), Code::kInvalidArgument);
+  wide.f_number = 22.5f;
+  EXPECT_EQ(backend.Render(Photo().c_str(), wide, true, &none).code(), Code::kInvalidArgument);
+  // What a setting accepts, the page renders too.
+  RefocusParams closed = Tap(0.5f, 0.5f);
+  closed.f_number = 22.0f;
+  VectorSink small;
+  EXPECT_TRUE(backend.Render(Photo().c_str(), closed, true, &small).ok());
+  EXPECT_GT(small.bytes.size(), 1000u);
   VectorSink tiny(100);
   EXPECT_EQ(backend.Render(Photo().c_str(), Tap(0.5f, 0.5f), true, &tiny).code(),
             Code::kOutOfMemory);

@@ -300,10 +300,16 @@ TEST_F(WebServerTest, InfoPreviewRenderAndSaveReachTheRenderer) {
   EXPECT_FLOAT_EQ(backend_.last.x1, 0.6f);
   EXPECT_FLOAT_EQ(backend_.last.y1, 0.9f);
   EXPECT_EQ(backend_.last.aperture.blades, 0);
+  // The page takes the f-numbers the settings take, f/1 .. f/22.
+  for (const char* f : {"1", "22"}) {
+    r = Post("/api/preview", std::string("name=") + kPhoto + "&x0=0.5&y0=0.5&f=" + f);
+    EXPECT_EQ(r.status, 200) << f << ": " << r.body;
+    EXPECT_FLOAT_EQ(backend_.last.f_number, std::stof(f));
+  }
 
-  for (const char* body :
-       {"x0=0.5&y0=0.5", "name=a.jpg", "name=a.jpg&x0=2&y0=0.5", "name=a.jpg&x0=0.5&y0=0.5&f=0.5",
-        "name=a.jpg&x0=0.5&y0=0.5&blades=2", "name=a.jpg&x0=nan&y0=0.5"}) {
+  for (const char* body : {"x0=0.5&y0=0.5", "name=a.jpg", "name=a.jpg&x0=2&y0=0.5",
+                           "name=a.jpg&x0=0.5&y0=0.5&f=0.5", "name=a.jpg&x0=0.5&y0=0.5&f=22.5",
+                           "name=a.jpg&x0=0.5&y0=0.5&blades=2", "name=a.jpg&x0=nan&y0=0.5"}) {
     EXPECT_EQ(Post("/api/preview", body).status, 400) << body;
   }
   EXPECT_EQ(Http(port_, "POST", "/api/render", kAuth + "Content-Type: application/json\r\n",
