@@ -270,7 +270,7 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
   r.metadata_s = xmp.build_s();
   r.metadata_wait_s = pending != nullptr ? xmp.wait_s() : 0;
   if (progress_ != nullptr) progress_->Update("write", 100);
-  LB_RETURN_IF_ERROR(file.Commit());
+  LB_RETURN_IF_ERROR(file.Commit(options_.replace));
   r.render_s = Now() - t2;
   if (report) *report = r;
   return Status::Ok();

@@ -12,6 +12,7 @@
 #include "algo/pipeline/pipeline.h"
 #include "firmware/app/progress.h"
 #include "firmware/app/side_task.h"
+#include "firmware/storage/atomic_file.h"
 #include "hal/sensor.h"
 
 namespace lb {
@@ -31,6 +32,9 @@ struct JobOptions {
   // Embed the depth map, the all-in-focus original and the focus (GDepth/GImage/GFocus XMP) so
   // the photo can be refocused later (`refocus rerender`, Google Photos and other viewers).
   bool refocusable = true;
+  // Whether the photo may go over a regular file of its name (`refocus run --out`, a re-run) or
+  // never (the camera's numbered photos: a taken name fails the photo rather than lose another).
+  AtomicFile::Replace replace = AtomicFile::Replace::kRegularFile;
   const char* make = "LensBlur";
   const char* model = "Simulated camera";
   const char* software = "refocus";

@@ -414,8 +414,9 @@ Status RefocusEngine::Save(const RenderParams& params, const char* out_path) {
   source.width = photo_.width;
   source.height = photo_.height;
   CameraYield yield(camera_busy_, &paused_strips_);
+  // A new photo beside the others: never over one, however the name was chosen.
   return WriteRerendered(full_.get(), params, source, config_.quality, "refocusd web", &yield,
-                         nullptr, out_path);
+                         nullptr, out_path, AtomicFile::Replace::kNever);
 }
 
 }  // namespace lb

@@ -82,7 +82,8 @@ class RefocusEngine {
   const uint8_t* output() const { return scratch_.data(); }
   size_t output_size() const { return output_size_; }
 
-  // Renders full size and writes a new refocusable photo at `out_path` (atomic-write rule).
+  // Renders full size and writes a new refocusable photo at `out_path` (atomic-write rule; never
+  // over an existing file).
   Status Save(const RenderParams& params, const char* out_path);
 
   // Bytes reserved by Configure (buffers and arenas).

@@ -141,7 +141,8 @@ Status Rerenderer::Render(const RerenderOptions& options, const char* out_path,
 
 Status WriteRerendered(RenderStage* render, const RenderParams& params,
                        const RerenderSource& source, int quality, const char* software,
-                       StripObserver* observer, Progress* progress, const char* out_path) {
+                       StripObserver* observer, Progress* progress, const char* out_path,
+                       AtomicFile::Replace replace) {
   AtomicFile file;
   LB_RETURN_IF_ERROR(file.Open(out_path));
   JpegMetadata meta;
@@ -156,7 +157,7 @@ Status WriteRerendered(RenderStage* render, const RenderParams& params,
   JpegWriter writer;
   LB_RETURN_IF_ERROR(writer.Begin(&file, source.width, source.height, quality, meta));
   LB_RETURN_IF_ERROR(WriteStrips(render, observer, &writer, progress));
-  return file.Commit();
+  return file.Commit(replace);
 }
 
 }  // namespace lb

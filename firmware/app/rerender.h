@@ -36,9 +36,11 @@ struct RerenderSource {
 // The writing half of every re-render (`refocus rerender` and the web page's engine): `render`
 // has begun with `params`; its strips go through `observer` (may be nullptr) into a refocusable
 // JPEG written atomically at `out_path`. Allocates the metadata (XMP, EXIF) while it writes.
+// `replace`: whether out_path may be a regular file already (AtomicFile::Commit).
 Status WriteRerendered(RenderStage* render, const RenderParams& params,
                        const RerenderSource& source, int quality, const char* software,
-                       StripObserver* observer, Progress* progress, const char* out_path);
+                       StripObserver* observer, Progress* progress, const char* out_path,
+                       AtomicFile::Replace replace = AtomicFile::Replace::kRegularFile);
 
 // The all-in-focus original's rows, as an image reader streams them, into YCbCr 4:2:0 planes
 // (the conversion the pipeline applies to a sensor's reference frame): `y` holds width x height

@@ -298,6 +298,7 @@ JobOptions MakeJobOptions(const DaemonConfig& config) {
   o.make = config.make.c_str();
   o.model = config.model.c_str();
   o.software = "refocusd";
+  o.replace = AtomicFile::Replace::kNever;  // a taken name fails the photo, never loses another
   return o;
 }
 

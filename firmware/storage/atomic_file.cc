@@ -92,7 +92,21 @@ Status AtomicFile::Write(const void* data, size_t size) {
   return Status::Ok();
 }
 
-Status AtomicFile::Commit() {
+int AtomicFile::RenameNoReplace() {
+  if (renameat2(AT_FDCWD, temp_path_, AT_FDCWD, final_path_, RENAME_NOREPLACE) == 0) return 0;
+  if (errno != EINVAL && errno != ENOSYS) return errno;
+  // link() fails on a taken name as well; the temporary then goes as after a rename.
+  if (link(temp_path_, final_path_) == 0) {
+    unlink(temp_path_);
+    return 0;
+  }
+  if (errno != EPERM && errno != EOPNOTSUPP) return errno;
+  struct stat st;
+  if (lstat(final_path_, &st) == 0) return EEXIST;
+  return rename(temp_path_, final_path_) == 0 ? 0 : errno;
+}
+
+Status AtomicFile::Commit(Replace replace) {
   if (fd_ < 0) return Status(Code::kInternal, "%s: commit of a file that is not open", final_path_);
   if (error_ != 0) {
     Status status = Fail(error_, "not committed after a failed write");
@@ -120,9 +134,15 @@ Status AtomicFile::Commit() {
     Forget();
     return kind;
   }
-  if (rename(temp_path_, final_path_) != 0) {
-    const int err = errno;
+  const int err = replace == Replace::kNever             ? RenameNoReplace()
+                  : rename(temp_path_, final_path_) == 0 ? 0
+                                                         : errno;
+  if (err != 0) {
     Forget();
+    if (err == EEXIST) {
+      return Status(Code::kInvalidArgument, "%s exists: a new photo never replaces one",
+                    final_path_);
+    }
     return Fail(err, "rename");
   }
   Unregister();
@@ -130,11 +150,11 @@ Status AtomicFile::Commit() {
   // The rename itself is durable only once the directory is synced.
   const int dir_fd = open(dir_path_, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (dir_fd < 0) return Fail(errno, "sync directory");
-  int err = 0;
+  int sync_err = 0;
   // Some filesystems cannot sync a directory (EINVAL); the file is complete either way.
-  if (fsync(dir_fd) != 0 && errno != EINVAL) err = errno;
+  if (fsync(dir_fd) != 0 && errno != EINVAL) sync_err = errno;
   close(dir_fd);
-  if (err != 0) return Fail(err, "sync directory");
+  if (sync_err != 0) return Fail(sync_err, "sync directory");
   return Status::Ok();
 }
 

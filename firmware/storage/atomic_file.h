@@ -15,6 +15,9 @@ namespace lb {
 class AtomicFile {
  public:
   static constexpr size_t kMaxPath = 1024;
+  // What the commit may put its file over: a regular file of the final name (a re-run's output),
+  // or nothing at all (a new photo beside others: kInvalidArgument when the name is taken).
+  enum class Replace : uint8_t { kRegularFile, kNever };
 
   AtomicFile() = default;
   ~AtomicFile();  // aborts when not committed
@@ -28,8 +31,10 @@ class AtomicFile {
   // Write and Commit fail too, so a caller that missed one error cannot commit a partial file.
   Status Write(const void* data, size_t size);
 
-  // fsync, close, rename over the final name, fsync the directory.
-  Status Commit();
+  // fsync, close, rename to the final name, fsync the directory. With Replace::kNever the rename
+  // itself refuses a taken name (renameat2 RENAME_NOREPLACE; on a filesystem without it, a hard
+  // link; on one without links either, such as FAT, a check just before the rename).
+  Status Commit(Replace replace = Replace::kRegularFile);
 
   // Closes and unlinks the temporary; harmless when nothing is open.
   void Abort();
@@ -40,8 +45,9 @@ class AtomicFile {
 
  private:
   Status Fail(int err, const char* what);
-  void Forget();      // unlinks the temporary and forgets it
-  void Unregister();  // drops it from the signal handler's list (temp_registry.h)
+  int RenameNoReplace();  // 0, or an errno (EEXIST: the name is taken)
+  void Forget();          // unlinks the temporary and forgets it
+  void Unregister();      // drops it from the signal handler's list (temp_registry.h)
 
   int fd_ = -1;
   int error_ = 0;  // errno of the first failed write, sticky until Abort

@@ -197,6 +197,10 @@ TEST_F(RefocusEngineTest, FocusMovesToTheTap) {
     // The saved photo is refocusable again, focused at the tap.
     const std::string out = p.path + ".tap.jpg";
     ASSERT_TRUE(engine.Save(TapAt(p, p.new_x, p.new_y), out.c_str()).ok());
+    // A second save under the same name is refused at the commit: the first stays.
+    const std::vector<uint8_t> first = ReadFile(out);
+    EXPECT_EQ(engine.Save(TapAt(p, p.old_x, p.old_y), out.c_str()).code(), Code::kInvalidArgument);
+    EXPECT_EQ(ReadFile(out), first);
     const Luma saved = Decode(ReadFile(out));
     EXPECT_GT(Sharpness(saved, p.new_x, p.new_y, 6),
               1.5 * Sharpness(original, p.new_x, p.new_y, 6));

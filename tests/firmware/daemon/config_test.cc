@@ -104,6 +104,8 @@ TEST(ConfigTest, ValuesReachTheSettings) {
   EXPECT_EQ(o.sensor.frames, 7);
   EXPECT_EQ(o.sensor.timeout_ms, 500);
   EXPECT_EQ(o.render.aperture.blades, 6);
+  EXPECT_EQ(o.replace, AtomicFile::Replace::kNever) << "a camera's photo never goes over another";
+  EXPECT_EQ(JobOptions{}.replace, AtomicFile::Replace::kRegularFile) << "refocus run --out";
 }
 
 TEST(ConfigTest, GeometryAndLensReachTheJob) {

@@ -90,6 +90,34 @@ TEST_F(AtomicFileTest, ReplacesAnExistingFileOnlyAtCommit) {
   EXPECT_EQ(Entries().size(), 1u);
 }
 
+// A new photo beside others: the commit refuses a taken name, even one taken after Open, and
+// leaves the file that has it and no temporary.
+TEST_F(AtomicFileTest, NeverReplaceRefusesATakenNameAtCommit) {
+  const std::string path = Path("IMG_1.jpg");
+  AtomicFile file;
+  ASSERT_TRUE(file.Open(path.c_str()).ok());
+  ASSERT_TRUE(file.Write("second", 6).ok());
+  {
+    AtomicFile first;
+    ASSERT_TRUE(first.Open(path.c_str()).ok());
+    ASSERT_TRUE(first.Write("first", 5).ok());
+    ASSERT_TRUE(first.Commit(AtomicFile::Replace::kNever).ok());
+  }
+  const Status status = file.Commit(AtomicFile::Replace::kNever);
+  EXPECT_EQ(status.code(), Code::kInvalidArgument) << status.message();
+  EXPECT_NE(std::string(status.message()).find("IMG_1.jpg exists"), std::string::npos)
+      << status.message();
+  EXPECT_EQ(ReadAll(path), "first");
+  EXPECT_EQ(Entries(), std::vector<std::string>{"IMG_1.jpg"});
+  // A free name is written as by the default commit.
+  AtomicFile other;
+  ASSERT_TRUE(other.Open(Path("IMG_2.jpg").c_str()).ok());
+  ASSERT_TRUE(other.Write("2", 1).ok());
+  ASSERT_TRUE(other.Commit(AtomicFile::Replace::kNever).ok());
+  EXPECT_EQ(ReadAll(Path("IMG_2.jpg")), "2");
+  EXPECT_EQ(Entries().size(), 2u);
+}
+
 TEST_F(AtomicFileTest, AbortAndDestructorLeaveNothing) {
   {
     AtomicFile file;
