@@ -207,6 +207,8 @@ class DepthStage {
   int32_t ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1);
   void PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1);
   int32_t BuildRow(const Rect& r, int32_t y, int32_t node_row);
+  void FreeSpan(const Rect& r, int32_t y, bool any);
+  void Reach(const Rect& r, int32_t y, int32_t* x0, int32_t* x1) const;
   void RowLabels(Grid& g, int32_t y);  // counts row y's labels, from scratch
   // Node (x, y) of g leaves label `from` for `to`: row y's counts and label mask follow.
   static void MoveLabel(Grid& g, int32_t labels, int32_t y, int32_t from, int32_t to) {
@@ -242,6 +244,7 @@ class DepthStage {
   uint16_t CostAt(int32_t label, int32_t x, int32_t y);
   int32_t* move_rows_ = nullptr;  // the moves' row ring and rows (expansion_move.cc)
   uint8_t* keep_row_ = nullptr;   // width x kKeep: the state of the rows around a rectangle
+  int32_t* free_span_ = nullptr;  // per row, the free pixels of the rectangle being cut (FreeSpan)
   uint8_t* split_ = nullptr;      // max(width, height) + 2 bytes: SplitRect's column or row marks
   int32_t smooth_[DepthConfig::kMaxLabels] = {};  // min(d, smooth_trunc) for a label distance d
   int32_t prev_label_ = -1;

@@ -177,9 +177,13 @@ int32_t DepthStage::BuildRow(const Rect& r, int32_t y, int32_t node_row) {
   int32_t* balance = move_rows_ + 11 * config_.width;
   int32_t* cap_right = move_rows_ + 12 * config_.width;
   int32_t* cap_down = move_rows_ + 13 * config_.width;
-  const int32_t x0 = r.x0, x1 = r.x1;
+  // Only the nodes a free node can reach are set (Reach); the others are never read.
+  int32_t x0 = r.x0, x1 = r.x1;
+  Reach(r, y, &x0, &x1);
   BuildTerms(st, up, down, er, ed, eu, hi, x0, x1, balance, cap_right, cap_down);
-  const int32_t base = node_row * (x1 - x0) - x0;
+  const int32_t base = node_row * (r.x1 - r.x0) - r.x0;
+  if (x0 > r.x0) maxflow_.SetIdle(base + r.x0);
+  if (x1 < r.x1) maxflow_.SetIdle(base + r.x1 - 1);
   int32_t free_pixels = 0, first = x1, last = x0 - 1;
   for (int32_t x = x0; x < x1; ++x) {
     if (st[x] != kFree) {
@@ -193,11 +197,41 @@ int32_t DepthStage::BuildRow(const Rect& r, int32_t y, int32_t node_row) {
   }
   // The solver's row passes look only from the first free pixel to the last.
   if (free_pixels > 0) {
-    maxflow_.RowDone(node_row, first - x0, last + 1 - x0);
+    maxflow_.RowDone(node_row, first - r.x0, last + 1 - r.x0);
   } else {
     maxflow_.RowDone(node_row, 0, 0);
   }
   return free_pixels;
+}
+
+// Row y's free pixels within r (after ClassifyRow): [first, last + 1) into free_span_, empty
+// at r.x0 when none.
+void DepthStage::FreeSpan(const Rect& r, int32_t y, bool any) {
+  int32_t* span = free_span_ + 2 * y;
+  span[0] = span[1] = r.x0;
+  if (!any) return;
+  const uint8_t* st = grid().state + y * grid().width;
+  int32_t a = r.x0, b = r.x1;
+  while (st[a] != kFree) ++a;  // the row holds one
+  while (st[b - 1] != kFree) --b;
+  span[0] = a;
+  span[1] = b;
+}
+
+// The columns of row y (of rectangle r) whose nodes a free node may look at: its own free
+// pixels and those of the rows above and below, one column either side, as one interval. A row's
+// first and last node also neighbour the rows before and after in node order, so the caller
+// sets them as well.
+void DepthStage::Reach(const Rect& r, int32_t y, int32_t* x0, int32_t* x1) const {
+  int32_t lo = r.x1, hi = r.x0;
+  for (int32_t k = y > r.y0 ? y - 1 : y; k <= y + 1 && k < r.y1; ++k) {
+    const int32_t* span = free_span_ + 2 * k;
+    if (span[0] >= span[1]) continue;
+    lo = span[0] - 1 < lo ? span[0] - 1 : lo;
+    hi = span[1] + 1 > hi ? span[1] + 1 : hi;
+  }
+  *x0 = lo > r.x0 ? lo : r.x0;
+  *x1 = hi < r.x1 ? hi : r.x1;
 }
 
 // Classifies and builds the rectangle's rows, cuts the graph and settles its free pixels.
@@ -214,6 +248,7 @@ void DepthStage::CutRect(int32_t alpha, const Rect& r) {
     if (y < r.y1) {
       present = ClassifyRow(alpha, y, r.x0, r.x1);
       g.row_took[y] |= (present & kRowTake) != 0 ? 1 : 0;
+      FreeSpan(r, y, (present & kRowFree) != 0);
       if (present != 0) {
         y_lo = y < y_lo ? y : y_lo;
         y_hi = y;
@@ -229,7 +264,11 @@ void DepthStage::CutRect(int32_t alpha, const Rect& r) {
       maxflow_.Begin(gw, r.y1 - g_lo);
     }
     for (; pending > 0; --pending, ++rows) {
-      for (int32_t x = 0; x < gw; ++x) maxflow_.SetIdle(rows * gw + x);
+      int32_t u0 = 0, u1 = 0;
+      Reach(r, y - 1 - pending, &u0, &u1);
+      for (int32_t x = u0; x < u1; ++x) maxflow_.SetIdle(rows * gw + x - r.x0);
+      maxflow_.SetIdle(rows * gw);
+      maxflow_.SetIdle(rows * gw + gw - 1);
       maxflow_.RowDone(rows, 0, 0);
     }
     free_pixels += BuildRow(r, y - 1, rows++);
@@ -242,7 +281,8 @@ void DepthStage::CutRect(int32_t alpha, const Rect& r) {
     for (int32_t gy = 0; gy < rows; ++gy) {
       uint8_t* st = g.state + (g_lo + gy) * w;
       uint8_t took = 0;
-      for (int32_t x = r.x0; x < r.x1; ++x) {
+      const int32_t* span = free_span_ + 2 * (g_lo + gy);
+      for (int32_t x = span[0]; x < span[1]; ++x) {
         if (st[x] == kFree) {
           st[x] = maxflow_.InSource(gy * gw + x - r.x0) ? kKeep : kTake;
           took |= static_cast<uint8_t>(st[x] == kTake);
