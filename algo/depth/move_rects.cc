@@ -2,7 +2,37 @@
 // may free, and per row the columns whose D it computes.
 #include "algo/depth/depth_stage.h"
 
+#include <cstring>
+
 namespace lb {
+namespace {
+
+// The first and the last column of a row whose label is in lo..hi, which the row holds: 16
+// labels at a time (one unsigned compare each, in the compiler's generic vectors: SSE2 or NEON),
+// then one by one.
+void LabelsIn(const uint8_t* f, int32_t w, int32_t lo, int32_t hi, int32_t* x0, int32_t* x1) {
+  constexpr int32_t kStep = 16;
+  typedef uint8_t Bytes __attribute__((vector_size(kStep)));
+  typedef uint64_t Words __attribute__((vector_size(kStep)));
+  const uint8_t base = static_cast<uint8_t>(lo), width = static_cast<uint8_t>(hi - lo);
+  auto in = [&](int32_t x) { return static_cast<uint8_t>(f[x] - base) <= width; };
+  auto any = [&](int32_t x) {
+    Bytes v;
+    memcpy(&v, f + x, kStep);
+    const Words m = reinterpret_cast<Words>((v - base) <= width);
+    return (m[0] | m[1]) != 0;
+  };
+  int32_t a = 0;
+  while (a + kStep <= w && !any(a)) a += kStep;
+  while (!in(a)) ++a;
+  int32_t b = w;
+  while (b - kStep >= a && !any(b - kStep)) b -= kStep;
+  while (!in(b - 1)) --b;
+  *x0 = a;
+  *x1 = b;
+}
+
+}  // namespace
 
 // A move looks at rectangles: the whole grid for a full move. A restricted move frees only
 // nodes with a label within window_ of alpha in their 3x3 neighbourhood, so it looks at the runs
@@ -45,17 +75,12 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
   const int32_t hi = alpha + window_ < config_.labels - 1 ? alpha + window_ : config_.labels - 1;
   uint64_t want[4] = {};
   for (int32_t l = lo; l <= hi; ++l) want[l >> 6] |= uint64_t{1} << (l & 63);
-  auto outside = [lo, hi](int32_t f) { return f < lo || f > hi; };
   // Each row's own columns with such a label: [w, 0) when none.
   for (int32_t y = 0; y < h; ++y) {
     const uint64_t* m = g.row_labels + 4 * y;
     int32_t x0 = w, x1 = 0;
     if (((m[0] & want[0]) | (m[1] & want[1]) | (m[2] & want[2]) | (m[3] & want[3])) != 0) {
-      const uint8_t* f = g.labels + y * w;
-      x0 = 0;
-      x1 = w;
-      while (outside(f[x0])) ++x0;  // the row holds one
-      while (outside(f[x1 - 1])) --x1;
+      LabelsIn(g.labels + y * w, w, lo, hi, &x0, &x1);  // the row holds one
     }
     span[2 * y] = x0;
     span[2 * y + 1] = x1;
@@ -72,11 +97,7 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
       const uint64_t* m = g.row_labels + 4 * y;
       int32_t x0 = w, x1 = 0;
       if (((m[0] & more[0]) | (m[1] & more[1]) | (m[2] & more[2]) | (m[3] & more[3])) != 0) {
-        const uint8_t* f = g.labels + y * w;
-        x0 = 0;
-        x1 = w;
-        while (f[x0] < lo || f[x0] > top) ++x0;
-        while (f[x1 - 1] < lo || f[x1 - 1] > top) --x1;
+        LabelsIn(g.labels + y * w, w, lo, top, &x0, &x1);
       }
       g.near_span[2 * y] = x0;
       g.near_span[2 * y + 1] = x1;
