@@ -211,9 +211,10 @@ void DepthStage::FreeSpan(const Rect& r, int32_t y, bool any) {
   span[0] = span[1] = r.x0;
   if (!any) return;
   const uint8_t* st = grid().state + y * grid().width;
-  int32_t a = r.x0, b = r.x1;
-  while (st[a] != kFree) ++a;  // the row holds one
-  while (st[b - 1] != kFree) --b;
+  const void* first = memchr(st + r.x0, kFree, static_cast<size_t>(r.x1 - r.x0));  // one there
+  const int32_t a = static_cast<int32_t>(static_cast<const uint8_t*>(first) - st);
+  const void* last = memrchr(st + a, kFree, static_cast<size_t>(r.x1 - a));
+  const int32_t b = static_cast<int32_t>(static_cast<const uint8_t*>(last) - st) + 1;
   span[0] = a;
   span[1] = b;
 }
