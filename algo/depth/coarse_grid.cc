@@ -5,7 +5,14 @@
 // pass minimises the real energy over block-constant labels, on a quarter of the nodes.
 #include "algo/depth/depth_stage.h"
 
+#include "algo/core/int_math.h"
+
 namespace lb {
+namespace {
+// Pixels per band of the coarse start: the views' rows of a band (9 views of 450 px: 0.6 MB with
+// their census) fit a board's L2 cache.
+constexpr int32_t kBandPixels = 16384;
+}  // namespace
 
 void DepthStage::BlockWeights() {
   const int32_t w = config_.width, h = config_.height, bw = coarse_.width, bh = coarse_.height;
@@ -62,14 +69,20 @@ void DepthStage::CoarseWinnerTakeAll() {
   block_costs_ = spare >= sizeof(uint16_t) * static_cast<size_t>(n) * coarse_labels
                      ? reinterpret_cast<uint16_t*>(room)
                      : nullptr;
-  const Rect all{0, g.width, 0, g.height};
-  for (int32_t label = 0; label < config_.labels; label += config_.coarse_step) {
-    uint16_t* d = block_costs_ != nullptr ? CoarseCosts(label) : g.cost_alpha;
-    BlockCosts(label, all, d);
-    for (int32_t p = 0; p < n; ++p) {
-      if (d[p] < g.cost[p]) {
-        g.cost[p] = d[p];
-        g.labels[p] = static_cast<uint8_t>(label);
+  // Band by band, every label in turn: the views' rows of a band stay in cache from one label
+  // to the next (the data term streams every view once per call). A band costs the data term
+  // two more rows, so bands are not too thin either. The labels still come in order per block.
+  const int32_t band = Max(1, kBandPixels / config_.width / 2);  // block rows
+  for (int32_t by0 = 0; by0 < g.height; by0 += band) {
+    const Rect rows{0, g.width, by0, Min(by0 + band, g.height)};
+    for (int32_t label = 0; label < config_.labels; label += config_.coarse_step) {
+      uint16_t* d = block_costs_ != nullptr ? CoarseCosts(label) : g.cost_alpha;
+      BlockCosts(label, rows, d);
+      for (int32_t p = rows.y0 * g.width; p < rows.y1 * g.width; ++p) {
+        if (d[p] < g.cost[p]) {
+          g.cost[p] = d[p];
+          g.labels[p] = static_cast<uint8_t>(label);
+        }
       }
     }
   }
