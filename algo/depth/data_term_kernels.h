@@ -54,14 +54,14 @@ void CostRowCSsse3(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, 
 void CostRowCAvx2(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, const uint8_t* cimg,
                   ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc, int32_t cw, uint8_t* out);
 #endif
-// The plane sweep's span kernels: the C reference (warp_cost.cc), AVX2 (warp_cost_avx2.cc, the
-// caller checks the CPU) and NEON (warp_cost_neon.cc).
-void PlaneSpansC(const WarpRow& row, const WarpSpanJob* jobs, int32_t count, uint8_t* out);
+// The plane sweep's span kernels, one run of spans a call: the C reference (warp_cost.cc), AVX2
+// (warp_cost_avx2.cc, the caller checks the CPU) and NEON (warp_cost_neon.cc).
+void PlaneSpansC(const WarpRow& row, const WarpRun& run, uint8_t* out);
 #if defined(__x86_64__)
-void PlaneSpansAvx2(const WarpRow& row, const WarpSpanJob* jobs, int32_t count, uint8_t* out);
+void PlaneSpansAvx2(const WarpRow& row, const WarpRun& run, uint8_t* out);
 #endif
 #if defined(__ARM_NEON) || defined(__arm__)
-void PlaneSpansNeon(const WarpRow& row, const WarpSpanJob* jobs, int32_t count, uint8_t* out);
+void PlaneSpansNeon(const WarpRow& row, const WarpRun& run, uint8_t* out);
 #endif
 void HSumRowC(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum);
 void SelectRowC(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1, uint16_t* out);

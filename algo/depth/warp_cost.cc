@@ -76,17 +76,21 @@ void SpanPositions(int32_t ax, int32_t ay, int32_t bx, int32_t by, int32_t n, in
 
 namespace dtk {
 
-void PlaneSpansC(const WarpRow& row, const WarpSpanJob* jobs, int32_t count, uint8_t* out) {
-  for (const WarpSpanJob* job = jobs; job < jobs + count; ++job) {
-    if (SpanOutsideView(row, *job)) {
-      FillInvalid(row, *job, out);
+void PlaneSpansC(const WarpRow& row, const WarpRun& run, uint8_t* out) {
+  int32_t first = 0, end = 0;
+  RunSpans(run, &first, &end);
+  for (int32_t k = first; k < end; ++k) {
+    const WarpSpanJob job = RunSpan(run, k);
+    if (job.lo >= job.hi) continue;
+    if (SpanOutsideView(row, job)) {
+      FillInvalid(row, job, out);
       continue;
     }
     int32_t xq[kAnchorStep + 1], yq[kAnchorStep + 1];
-    SpanPositions(job->ax, job->ay, job->bx, job->by, job->n, xq, yq);
-    for (int32_t x = job->lo; x < job->hi; ++x) {
-      out[x] = SampleCost(row, row.ref + 3 * x, Census(row.cref, row.width, x), xq[x - job->x0],
-                          yq[x - job->x0]);
+    SpanPositions(job.ax, job.ay, job.bx, job.by, job.n, xq, yq);
+    for (int32_t x = job.lo; x < job.hi; ++x) {
+      out[x] = SampleCost(row, row.ref + 3 * x, Census(row.cref, row.width, x), xq[x - job.x0],
+                          yq[x - job.x0]);
     }
   }
 }
@@ -127,32 +131,45 @@ void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
   auto map = [&](int32_t x, int32_t* x_q16, int32_t* y_q16) {
     return row_map.At<kExactDivide>(x, x_q16, y_q16);
   };
-  int32_t ax = 0, ay = 0;
-  bool a_ok = map(first, &ax, &ay);
-  WarpSpanJob batch[kSpanBatch];
-  int32_t batched = 0;
+  // The run being gathered: its anchors so far (the next span's start anchor is the last one),
+  // its first span's start column and first wanted column. A run ends where a plane has no map
+  // (those spans cost `invalid`), when it is full, and at the end of the range.
+  int32_t ax[kRunSpans + 1] = {}, ay[kRunSpans + 1] = {};
+  int32_t count = 0, run_x0 = first, run_lo = x_begin;
+  auto flush = [&](int32_t last, int32_t hi) {
+    if (count > 0) span(row, WarpRun{ax, ay, run_x0, count, last, run_lo, hi}, out);
+    ax[0] = ax[count];
+    ay[0] = ay[count];
+    count = 0;
+  };
+  bool a_ok = map(first, &ax[0], &ay[0]);
+  int32_t last = first, last_hi = first;
   for (int32_t x0 = first, end = 0; x0 < x_end; x0 = end) {
     const int32_t x1 = x0 + kAnchorStep < w - 1 ? x0 + kAnchorStep : w - 1;
     end = x1 == w - 1 ? w : x1;  // the last span keeps its end anchor
     const int32_t lo = x0 > x_begin ? x0 : x_begin, hi = end < x_end ? end : x_end;
-    int32_t bx = ax, by = ay;
+    int32_t bx = ax[count], by = ay[count];
     const bool b_ok = x1 == x0 ? a_ok : map(x1, &bx, &by);
-    // A span outside the view is the kernel's to find (SpanOutsideView): not worth a test on
-    // every span here.
     if (a_ok && b_ok) {
-      batch[batched++] = WarpSpanJob{x0, x1 - x0, ax, ay, bx, by, lo, hi};
-      if (batched == kSpanBatch) {
-        span(row, batch, batched, out);
-        batched = 0;
+      if (count == 0) {
+        run_x0 = x0;
+        run_lo = lo;
       }
+      ++count;
+      ax[count] = bx;
+      ay[count] = by;
+      last = x1;
+      last_hi = hi;
+      if (count == kRunSpans) flush(last, last_hi);
     } else {
+      flush(last, last_hi);
       for (int32_t x = lo; x < hi; ++x) out[x] = row.invalid;
+      ax[0] = bx;
+      ay[0] = by;
     }
-    ax = bx;
-    ay = by;
     a_ok = b_ok;
   }
-  if (batched > 0) span(row, batch, batched, out);
+  flush(last, last_hi);
 }
 
 }  // namespace lb

@@ -122,17 +122,50 @@ inline void FillInvalid(const WarpRow& r, const WarpSpanJob& job, uint8_t* out) 
   for (int32_t x = job.lo; x < job.hi; ++x) out[x] = r.invalid;
 }
 
-// Spans are handed to a kernel in batches of up to kSpanBatch (its set-up paid once per batch):
-// 48 spans hold a 768-pixel row, so a depth row at 640 is one batch (a batch of 16 made the
-// kernel's set-up about 3 % of its instructions on the handheld bench).
-inline constexpr int32_t kSpanBatch = 48;
+// A run of neighbouring spans along one row, each inner anchor shared by the spans either side
+// of it, as PlaneCostRow hands them to a kernel: anchors k = 0..count (x_q16[k], y_q16[k], the
+// exact Map) at reference columns x0 + kAnchorStep k, but the last, at column `last`: x0 +
+// kAnchorStep count, or the row's last column when the run ends the row (a shorter span, whose
+// end column is computed too). Columns lo..hi-1 are computed (x0 <= lo < hi <= last + 1). One
+// call per run, not per span: the kernel sets itself up once and can test many spans at once.
+struct WarpRun {
+  const int32_t* x_q16;
+  const int32_t* y_q16;
+  int32_t x0, count, last, lo, hi;
+};
 
-// A span kernel: the pixel costs of columns lo..hi-1 of each of `count` spans into out (indexed
-// by x). The C reference is dtk::PlaneSpansC (warp_cost.cc); the SIMD twins (warp_cost_avx2.cc,
+// At most this many spans per run (PlaneCostRow's anchors live on its stack): 48 spans hold a
+// 768-pixel row, so a depth row at 640 is one run.
+inline constexpr int32_t kRunSpans = 48;
+
+// Span k of a run as a job, its columns clipped to lo..hi (empty when the span lies outside).
+inline WarpSpanJob RunSpan(const WarpRun& run, int32_t k) {
+  const int32_t x0 = run.x0 + kAnchorStep * k;
+  const bool inner = k + 1 < run.count;
+  const int32_t n = inner ? kAnchorStep : run.last - x0;
+  const int32_t end = inner ? x0 + kAnchorStep : run.last + 1;
+  return WarpSpanJob{x0,
+                     n,
+                     run.x_q16[k],
+                     run.y_q16[k],
+                     run.x_q16[k + 1],
+                     run.y_q16[k + 1],
+                     x0 > run.lo ? x0 : run.lo,
+                     end < run.hi ? end : run.hi};
+}
+
+// The spans of a run that hold columns lo..hi-1 (first, end): the others are not looked at.
+inline void RunSpans(const WarpRun& run, int32_t* first, int32_t* end) {
+  const int32_t a = (run.lo - run.x0) / kAnchorStep, b = (run.hi - 1 - run.x0) / kAnchorStep + 1;
+  *first = a < run.count - 1 ? a : run.count - 1;
+  *end = b < run.count ? b : run.count;
+}
+
+// A span kernel: the pixel costs of columns lo..hi-1 of a run into out (indexed by x). The C
+// reference is dtk::PlaneSpansC (warp_cost.cc); the SIMD twins (warp_cost_avx2.cc,
 // warp_cost_neon.cc) give the same bytes, and the data term picks one through its kernel table
 // (data_term_kernels.h).
-using PlaneSpanFn = void (*)(const WarpRow& row, const WarpSpanJob* jobs, int32_t count,
-                             uint8_t* out);
+using PlaneSpanFn = void (*)(const WarpRow& row, const WarpRun& run, uint8_t* out);
 
 // Pixel costs 0..255 of columns x0..x1-1 of reference row y (out indexed by x) against the view
 // seen through h (invalid_cost where a sample needs a pixel outside the view, or the plane has no

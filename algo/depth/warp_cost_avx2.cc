@@ -424,26 +424,175 @@ LB_AVX2 inline void AnyBandStep(const WarpRow& r, const Consts& k, const Band& b
   BandStep<false, false>(r, k, band, x, xq, yq, dst);
 }
 
-// The two steps of a whole span of the band: pixels x..x+7 at (xq0, yq0), x+8..x+15 at (xq1, yq1).
+// The two steps of a whole span of the band: pixels x..x+7 at (q[0], q[1]), x+8..x+15 at (q[2],
+// q[3]), their costs into dst[0..15].
 template <bool kTwoRows, bool kTwoCensus>
 LB_AVX2 void BandSpan(const WarpRow& r, const Consts& k, const Band& band, int32_t x,
-                      const __m256i* q, uint8_t* out) {
-  BandStep<kTwoRows, kTwoCensus>(r, k, band, x, q[0], q[1], out + x);
-  BandStep<kTwoRows, kTwoCensus>(r, k, band, x + kLanes, q[2], q[3], out + x + kLanes);
+                      const __m256i* q, uint8_t* dst) {
+  BandStep<kTwoRows, kTwoCensus>(r, k, band, x, q[0], q[1], dst);
+  BandStep<kTwoRows, kTwoCensus>(r, k, band, x + kLanes, q[2], q[3], dst + kLanes);
+}
+
+// BandSpan's instance for the span's band.
+LB_AVX2 inline void AnyBandSpan(const WarpRow& r, const Consts& k, const Band& band, int32_t x,
+                                const __m256i* q, uint8_t* dst) {
+  if (band.two_rows) {
+    if (band.two_census) return BandSpan<true, true>(r, k, band, x, q, dst);
+    return BandSpan<true, false>(r, k, band, x, q, dst);
+  }
+  if (band.two_census) return BandSpan<false, true>(r, k, band, x, q, dst);
+  BandSpan<false, false>(r, k, band, x, q, dst);
+}
+
+// One span, any: outside the view, partly outside, beyond the band's reach, short or cut by the
+// wanted columns. Positions as WarpSpan's Q32 accumulators, split so that 32-bit lanes give the
+// same bits: with the step s = q 2^16 + r (0 <= r < 2^16), (a 2^16 + 2^15 + i s) >> 16 = a + i q +
+// ((2^15 + i r) >> 16); i <= 16 keeps 2^15 + i r below 2^21, and a + i q wraps only where the
+// exact result (a Q16 position, |.| < 2^30) does not.
+LB_AVX2 void AnySpan(const WarpRow& r, const Consts& k, const WarpSpanJob* job, uint8_t* out) {
+  const __m256i half = _mm256_set1_epi32(32768);
+  const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  // A whole span divides exactly (2^16 / kAnchorStep is whole): no division.
+  const int32_t n = job->n;
+  const int64_t dx = int64_t{job->bx} - job->ax, dy = int64_t{job->by} - job->ay;
+  const int64_t sx = n == kAnchorStep ? dx * (65536 / kAnchorStep) : n > 0 ? dx * 65536 / n : 0;
+  const int64_t sy = n == kAnchorStep ? dy * (65536 / kAnchorStep) : n > 0 ? dy * 65536 / n : 0;
+  const __m256i qx = _mm256_set1_epi32(static_cast<int32_t>(sx >> 16));
+  const __m256i qy = _mm256_set1_epi32(static_cast<int32_t>(sy >> 16));
+  const __m256i rx = _mm256_set1_epi32(static_cast<int32_t>(sx & 0xffff));
+  const __m256i ry = _mm256_set1_epi32(static_cast<int32_t>(sy & 0xffff));
+  // Lanes off the span (short ranges only) repeat its end pixels, so a step stays monotone;
+  // only a step reaching the span's end needs its end anchor put in.
+  auto positions = [&](int32_t x, __m256i* xq, __m256i* yq) LB_AVX2 {
+    __m256i i = _mm256_add_epi32(_mm256_set1_epi32(x - job->x0), iota);
+    const bool at_ends = x < job->x0 || x + kLanes > job->x0 + n;
+    if (at_ends) {
+      i = _mm256_min_epi32(_mm256_max_epi32(i, _mm256_setzero_si256()), _mm256_set1_epi32(n));
+    }
+    *xq =
+        _mm256_add_epi32(_mm256_add_epi32(_mm256_set1_epi32(job->ax), _mm256_mullo_epi32(i, qx)),
+                         _mm256_srli_epi32(_mm256_add_epi32(half, _mm256_mullo_epi32(i, rx)), 16));
+    *yq =
+        _mm256_add_epi32(_mm256_add_epi32(_mm256_set1_epi32(job->ay), _mm256_mullo_epi32(i, qy)),
+                         _mm256_srli_epi32(_mm256_add_epi32(half, _mm256_mullo_epi32(i, ry)), 16));
+    if (at_ends) {
+      const __m256i at_end = _mm256_cmpeq_epi32(i, _mm256_set1_epi32(n));
+      *xq = _mm256_blendv_epi8(*xq, _mm256_set1_epi32(job->bx), at_end);
+      *yq = _mm256_blendv_epi8(*yq, _mm256_set1_epi32(job->by), at_end);
+    }
+  };
+  __m256i xq, yq;
+  Band band{};
+  const bool in_band = r.width >= 16 && BandOf(r, *job, &band);
+  if (!in_band && SpanOutsideView(r, *job)) {
+    FillInvalid(r, *job, out);
+    return;
+  }
+  if (job->hi - job->lo < kLanes) {
+    // A short range: one step over 8 pixels of the row that hold it, into a buffer.
+    const int32_t x = Min(job->lo, r.width - kLanes);
+    positions(x, &xq, &yq);
+    uint8_t costs[kLanes];
+    if (in_band) {
+      AnyBandStep(r, k, band, x, xq, yq, costs);
+    } else {
+      Step(r, k, x, xq, yq, costs);
+    }
+    std::memcpy(out + job->lo, costs + (job->lo - x), static_cast<size_t>(job->hi - job->lo));
+    return;
+  }
+  for (int32_t step = job->lo; step < job->hi; step += kLanes) {
+    // The last step overlaps the one before: the same bytes again.
+    const int32_t x = step + kLanes <= job->hi ? step : job->hi - kLanes;
+    positions(x, &xq, &yq);
+    if (in_band) {
+      AnyBandStep(r, k, band, x, xq, yq, out + x);
+    } else {
+      Step(r, k, x, xq, yq, out + x);
+    }
+  }
+}
+
+// Unsigned v <= max per lane (AVX2 compares only signed).
+LB_AVX2 inline __m256i AtMost(__m256i v, __m256i max) {
+  return _mm256_cmpeq_epi32(_mm256_min_epu32(v, max), v);
+}
+
+// What the run's band spans need, 8 spans at once (BandOf's tests, lane by lane): a span of
+// kAnchorStep pixels (the row's short last span is not one), both anchors inside the view, its
+// tap rows and census rows each within two neighbouring rows, and the positions advancing at
+// most 9/8 px per pixel. For each: its upper tap row and census row, its x and y change over the
+// span (Q16), and kind bits (kInBand, kTwoRows, kTwoCensus, kRising).
+enum : int32_t { kInBand = 1, kTwoRows = 2, kTwoCensus = 4, kRising = 8 };
+struct RunBands {
+  alignas(32) int32_t y[kRunSpans], cy[kRunSpans], dx[kRunSpans], dy[kRunSpans], kind[kRunSpans];
+};
+
+// Spans first .. end - 1 (end - first <= kRunSpans) into b, indexed from `first`. Lanes past
+// `end` load nothing (masked loads: the anchors may end there).
+LB_AVX2 void BandsOfRun(const WarpRow& r, const WarpRun& run, int32_t first, int32_t end,
+                        RunBands* b) {
+  const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256i xmax = _mm256_set1_epi32((r.width - 1) * 256);
+  const __m256i ymax = _mm256_set1_epi32((r.height - 1) * 256);
+  const __m256i hm2 = _mm256_set1_epi32(r.height - 2);
+  const __m256i q8_half = _mm256_set1_epi32(128), one = _mm256_set1_epi32(1);
+  const __m256i reach = _mm256_set1_epi32(kAnchorStep * 73728);
+  const __m256i last = _mm256_set1_epi32(run.last);
+  for (int32_t g = first; g < end; g += kLanes) {
+    const __m256i lanes = _mm256_cmpgt_epi32(_mm256_set1_epi32(end - g), iota);
+    const __m256i ax = _mm256_maskload_epi32(run.x_q16 + g, lanes);
+    const __m256i bx = _mm256_maskload_epi32(run.x_q16 + g + 1, lanes);
+    const __m256i ay = _mm256_maskload_epi32(run.y_q16 + g, lanes);
+    const __m256i by = _mm256_maskload_epi32(run.y_q16 + g + 1, lanes);
+    // The span's end column x0 + kAnchorStep (k + 1) must be an anchor: not past `last`.
+    const __m256i span_end = _mm256_add_epi32(_mm256_set1_epi32(run.x0 + kAnchorStep * (g + 1)),
+                                              _mm256_slli_epi32(iota, 4));  // kAnchorStep = 16
+    __m256i bad = _mm256_cmpgt_epi32(span_end, last);
+    const __m256i dx = _mm256_sub_epi32(bx, ax), dy = _mm256_sub_epi32(by, ay);
+    bad = _mm256_or_si256(bad, _mm256_cmpgt_epi32(_mm256_abs_epi32(dx), reach));
+    const __m256i xa = _mm256_srai_epi32(_mm256_add_epi32(ax, q8_half), 8);
+    const __m256i xb = _mm256_srai_epi32(_mm256_add_epi32(bx, q8_half), 8);
+    const __m256i ya = _mm256_srai_epi32(_mm256_add_epi32(ay, q8_half), 8);
+    const __m256i yb = _mm256_srai_epi32(_mm256_add_epi32(by, q8_half), 8);
+    const __m256i inside = _mm256_and_si256(_mm256_and_si256(AtMost(xa, xmax), AtMost(xb, xmax)),
+                                            _mm256_and_si256(AtMost(ya, ymax), AtMost(yb, ymax)));
+    const __m256i row_a = _mm256_min_epi32(_mm256_srai_epi32(ya, 8), hm2);
+    const __m256i row_b = _mm256_min_epi32(_mm256_srai_epi32(yb, 8), hm2);
+    const __m256i near_a = _mm256_srai_epi32(_mm256_add_epi32(ya, q8_half), 8);
+    const __m256i near_b = _mm256_srai_epi32(_mm256_add_epi32(yb, q8_half), 8);
+    const __m256i row_d = _mm256_sub_epi32(row_a, row_b), near_d = _mm256_sub_epi32(near_a, near_b);
+    bad = _mm256_or_si256(bad, _mm256_cmpgt_epi32(_mm256_abs_epi32(row_d), one));
+    bad = _mm256_or_si256(bad, _mm256_cmpgt_epi32(_mm256_abs_epi32(near_d), one));
+    const __m256i in_band = _mm256_andnot_si256(bad, _mm256_and_si256(inside, lanes));
+    const __m256i zero = _mm256_setzero_si256();
+    __m256i kind = _mm256_and_si256(in_band, _mm256_set1_epi32(kInBand));
+    kind = _mm256_or_si256(
+        kind, _mm256_andnot_si256(_mm256_cmpeq_epi32(row_d, zero), _mm256_set1_epi32(kTwoRows)));
+    kind = _mm256_or_si256(
+        kind, _mm256_andnot_si256(_mm256_cmpeq_epi32(near_d, zero), _mm256_set1_epi32(kTwoCensus)));
+    kind = _mm256_or_si256(
+        kind, _mm256_andnot_si256(_mm256_cmpgt_epi32(zero, dx), _mm256_set1_epi32(kRising)));
+    const int32_t i = g - first;
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->y + i), _mm256_min_epi32(row_a, row_b));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->cy + i), _mm256_min_epi32(near_a, near_b));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->dx + i), dx);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->dy + i), dy);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->kind + i), kind);
+  }
 }
 
 }  // namespace
 
-// Positions as WarpSpan's Q32 accumulators, split so that 32-bit lanes give the same bits: with
-// the step s = q 2^16 + r (0 <= r < 2^16), (a 2^16 + 2^15 + i s) >> 16 = a + i q +
-// ((2^15 + i r) >> 16); i <= 16 keeps 2^15 + i r below 2^21, and a + i q wraps only where the
-// exact result (a Q16 position, |.| < 2^30) does not.
-LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpSpanJob* jobs, int32_t count,
-                            uint8_t* out) {
+// A run at once: its spans' band tests 8 at a time (BandsOfRun), then each span of the band two
+// steps from its anchors, the rest (outside the view, partly, short, steep) one by one
+// (AnySpan). The positions of a whole span: (a 2^16 + 2^15 + i dx 2^12) >> 16 = a +
+// ((i dx + 8) >> 4), with |i dx| <= 15 * 16 * 73728 < 2^25 in the band.
+LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpRun& run, uint8_t* out) {
   const int64_t bytes = int64_t{r.height} * r.stride;
   if (r.width < kLanes || r.height < 2 || r.stride <= 0 || bytes >= (int64_t{1} << 31) ||
       r.cw < 0 || r.cw > 31) {
-    return PlaneSpansC(r, jobs, count, out);
+    return PlaneSpansC(r, run, out);
   }
   alignas(32) int8_t lut[32];
   for (int32_t i = 0; i < 32; ++i) lut[i] = static_cast<int8_t>(r.cw * kMasks.nibble_bits[i]);
@@ -457,94 +606,51 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpSpanJob* jobs, int32_t c
                  _mm256_set1_epi32(r.invalid),
                  Load(lut),
                  _mm256_set1_epi32(3 * r.width - 18)};
-  const __m256i half = _mm256_set1_epi32(32768);
   const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  for (const WarpSpanJob* job = jobs; job < jobs + count; ++job) {
-    // A whole span divides exactly (2^16 / kAnchorStep is whole): no division.
-    const int32_t n = job->n;
-    const int64_t dx = int64_t{job->bx} - job->ax, dy = int64_t{job->by} - job->ay;
-    const int64_t sx = n == kAnchorStep ? dx * (65536 / kAnchorStep) : n > 0 ? dx * 65536 / n : 0;
-    const int64_t sy = n == kAnchorStep ? dy * (65536 / kAnchorStep) : n > 0 ? dy * 65536 / n : 0;
-    const __m256i qx = _mm256_set1_epi32(static_cast<int32_t>(sx >> 16));
-    const __m256i qy = _mm256_set1_epi32(static_cast<int32_t>(sy >> 16));
-    const __m256i rx = _mm256_set1_epi32(static_cast<int32_t>(sx & 0xffff));
-    const __m256i ry = _mm256_set1_epi32(static_cast<int32_t>(sy & 0xffff));
-    // Lanes off the span (short ranges only) repeat its end pixels, so a step stays monotone;
-    // only a step reaching the span's end needs its end anchor put in.
-    auto positions = [&](int32_t x, __m256i* xq, __m256i* yq) LB_AVX2 {
-      __m256i i = _mm256_add_epi32(_mm256_set1_epi32(x - job->x0), iota);
-      const bool at_ends = x < job->x0 || x + kLanes > job->x0 + n;
-      if (at_ends) {
-        i = _mm256_min_epi32(_mm256_max_epi32(i, _mm256_setzero_si256()), _mm256_set1_epi32(n));
-      }
-      *xq = _mm256_add_epi32(
-          _mm256_add_epi32(_mm256_set1_epi32(job->ax), _mm256_mullo_epi32(i, qx)),
-          _mm256_srli_epi32(_mm256_add_epi32(half, _mm256_mullo_epi32(i, rx)), 16));
-      *yq = _mm256_add_epi32(
-          _mm256_add_epi32(_mm256_set1_epi32(job->ay), _mm256_mullo_epi32(i, qy)),
-          _mm256_srli_epi32(_mm256_add_epi32(half, _mm256_mullo_epi32(i, ry)), 16));
-      if (at_ends) {
-        const __m256i at_end = _mm256_cmpeq_epi32(i, _mm256_set1_epi32(n));
-        *xq = _mm256_blendv_epi8(*xq, _mm256_set1_epi32(job->bx), at_end);
-        *yq = _mm256_blendv_epi8(*yq, _mm256_set1_epi32(job->by), at_end);
-      }
-    };
-    __m256i xq, yq;
-    Band band{};
-    const bool in_band = r.width >= 16 && BandOf(r, *job, &band);
-    if (!in_band && SpanOutsideView(r, *job)) {
-      FillInvalid(r, *job, out);
-      continue;
+  const __m256i eight = _mm256_set1_epi32(8);
+  int32_t first = 0, end = 0;
+  RunSpans(run, &first, &end);
+  RunBands bands;
+  for (int32_t base = first; base < end; base += kRunSpans) {
+    const int32_t stop = Min(end, base + kRunSpans);
+    if (r.width >= 16) {
+      BandsOfRun(r, run, base, stop, &bands);
+    } else {
+      for (int32_t i = 0; i < stop - base; ++i) bands.kind[i] = 0;
     }
-    if (job->hi - job->lo < kLanes) {
-      // A short range: one step over 8 pixels of the row that hold it, into a buffer.
-      const int32_t x = Min(job->lo, r.width - kLanes);
-      positions(x, &xq, &yq);
-      uint8_t costs[kLanes];
-      if (in_band) {
-        AnyBandStep(r, k, band, x, xq, yq, costs);
-      } else {
-        Step(r, k, x, xq, yq, costs);
+    for (int32_t s = base; s < stop; ++s) {
+      const int32_t i = s - base, kind = bands.kind[i];
+      const WarpSpanJob job = RunSpan(run, s);
+      // Not of the band, or the row's last span ending on its end anchor's column (a 17th).
+      if ((kind & kInBand) == 0 || job.hi > job.x0 + kAnchorStep) {
+        if (job.lo < job.hi) AnySpan(r, k, &job, out);
+        continue;
       }
-      std::memcpy(out + job->lo, costs + (job->lo - x), static_cast<size_t>(job->hi - job->lo));
-      continue;
-    }
-    if (in_band && n == kAnchorStep && job->lo == job->x0 && job->hi == job->x0 + n) {
-      // A whole span of the band (most of them): its second step's positions are its first's
-      // moved 8 pixels on, Q16 parts and remainders both.
-      const __m256i ix = _mm256_add_epi32(_mm256_set1_epi32(job->ax), _mm256_mullo_epi32(iota, qx));
-      const __m256i iy = _mm256_add_epi32(_mm256_set1_epi32(job->ay), _mm256_mullo_epi32(iota, qy));
-      const __m256i rem_x = _mm256_add_epi32(half, _mm256_mullo_epi32(iota, rx));
-      const __m256i rem_y = _mm256_add_epi32(half, _mm256_mullo_epi32(iota, ry));
-      const __m256i ix8 = _mm256_add_epi32(ix, _mm256_slli_epi32(qx, 3));
-      const __m256i iy8 = _mm256_add_epi32(iy, _mm256_slli_epi32(qy, 3));
-      const __m256i rem_x8 = _mm256_add_epi32(rem_x, _mm256_slli_epi32(rx, 3));
-      const __m256i rem_y8 = _mm256_add_epi32(rem_y, _mm256_slli_epi32(ry, 3));
-      const __m256i q[4] = {_mm256_add_epi32(ix, _mm256_srli_epi32(rem_x, 16)),
-                            _mm256_add_epi32(iy, _mm256_srli_epi32(rem_y, 16)),
-                            _mm256_add_epi32(ix8, _mm256_srli_epi32(rem_x8, 16)),
-                            _mm256_add_epi32(iy8, _mm256_srli_epi32(rem_y8, 16))};
-      if (band.two_rows) {
-        if (band.two_census) {
-          BandSpan<true, true>(r, k, band, job->x0, q, out);
-        } else {
-          BandSpan<true, false>(r, k, band, job->x0, q, out);
-        }
-      } else if (band.two_census) {
-        BandSpan<false, true>(r, k, band, job->x0, q, out);
-      } else {
-        BandSpan<false, false>(r, k, band, job->x0, q, out);
-      }
-      continue;
-    }
-    for (int32_t step = job->lo; step < job->hi; step += kLanes) {
-      // The last step overlaps the one before: the same bytes again.
-      const int32_t x = step + kLanes <= job->hi ? step : job->hi - kLanes;
-      positions(x, &xq, &yq);
-      if (in_band) {
-        AnyBandStep(r, k, band, x, xq, yq, out + x);
-      } else {
-        Step(r, k, x, xq, yq, out + x);
+      const Band band{r.view + bands.y[i] * r.stride,
+                      r.census_view + static_cast<ptrdiff_t>(bands.cy[i]) * 3 * r.width,
+                      bands.y[i],
+                      bands.cy[i],
+                      (kind & kTwoRows) != 0,
+                      (kind & kTwoCensus) != 0,
+                      (kind & kRising) != 0};
+      const __m256i dx = _mm256_set1_epi32(bands.dx[i]), dy = _mm256_set1_epi32(bands.dy[i]);
+      const __m256i tx = _mm256_add_epi32(_mm256_mullo_epi32(iota, dx), eight);
+      const __m256i ty = _mm256_add_epi32(_mm256_mullo_epi32(iota, dy), eight);
+      const __m256i ax = _mm256_set1_epi32(job.ax), ay = _mm256_set1_epi32(job.ay);
+      const __m256i q[4] = {
+          _mm256_add_epi32(ax, _mm256_srai_epi32(tx, 4)),
+          _mm256_add_epi32(ay, _mm256_srai_epi32(ty, 4)),
+          _mm256_add_epi32(ax,
+                           _mm256_srai_epi32(_mm256_add_epi32(tx, _mm256_slli_epi32(dx, 3)), 4)),
+          _mm256_add_epi32(ay,
+                           _mm256_srai_epi32(_mm256_add_epi32(ty, _mm256_slli_epi32(dy, 3)), 4))};
+      if (job.lo == job.x0 && job.hi == job.x0 + kAnchorStep) {
+        AnyBandSpan(r, k, band, job.x0, q, out + job.x0);
+      } else if (job.lo < job.hi) {
+        // Cut by the wanted columns: the whole span into a buffer, the wanted part copied.
+        uint8_t costs[kAnchorStep];
+        AnyBandSpan(r, k, band, job.x0, q, costs);
+        std::memcpy(out + job.lo, costs + (job.lo - job.x0), static_cast<size_t>(job.hi - job.lo));
       }
     }
   }
