@@ -108,9 +108,20 @@ LB_AVX2 inline void Pairs(__m256i ab0, __m256i ab2, __m256i* pairs) {
 // half up to Q0. Census: the nearest tap's 24 bits against the reference's, counted by nibble
 // lookups of weight * bits (<= 31 * 4 per nibble, <= 248 per byte), summed in 16 then 32 bits.
 // Cost min(min(|dRGB|, trunc) + weighted bits, 255).
+// c and m point at kC and kMasks through an opaque copy (Laundered), so the compiler reads
+// the broadcast constants as memory operands instead of rebuilding each from an immediate in
+// every step (three instructions each).
 struct Consts {
   __m256i xmax, ymax, wm2, hm2, stride, census_row, trunc, invalid, lut, last_window;
+  const Constants* c;
+  const Masks* m;
 };
+
+template <typename T>
+inline const T* Laundered(const T* p) {
+  asm("" : "+r"(p));
+  return p;
+}
 
 // Scalar loads: 8 bytes per tap row, the top one read forward (its 2 extra bytes lie in the row
 // below) and the bottom one from 2 bytes back (in the row above), so every read stays inside the
@@ -193,13 +204,13 @@ LB_AVX2 inline __attribute__((always_inline)) __m256i CostFromTaps(const WarpRow
                                       _mm256_slli_epi32(Widen8(r.cref + r.width + x), 8)),
                       Widen8(r.cref + 2 * r.width + x));
   const __m256i bits = _mm256_xor_si256(census, ref_bits);
-  const __m256i nib = Load(kC.bytes15.v);
+  const __m256i nib = Load(k.c->bytes15.v);
   const __m256i count8 = _mm256_add_epi8(
       _mm256_shuffle_epi8(k.lut, _mm256_and_si256(bits, nib)),
       _mm256_shuffle_epi8(k.lut, _mm256_and_si256(_mm256_srli_epi16(bits, 4), nib)));
   const __m256i ham =
-      _mm256_madd_epi16(_mm256_maddubs_epi16(count8, Load(kC.ones8.v)), Load(kC.ones16.v));
-  return _mm256_min_epi32(_mm256_add_epi32(ad, ham), Load(kC.max_cost.v));
+      _mm256_madd_epi16(_mm256_maddubs_epi16(count8, Load(k.c->ones8.v)), Load(k.c->ones16.v));
+  return _mm256_min_epi32(_mm256_add_epi32(ad, ham), Load(k.c->max_cost.v));
 }
 
 // The costs of pixels x..x+7 from their taps, weights [256 - fx, fx] and row fractions fy.
@@ -215,8 +226,8 @@ LB_AVX2 inline __attribute__((always_inline)) __m256i Cost(const WarpRow& r, con
     const __m256i bottom = _mm256_madd_epi16(t.bottom[c], wx);
     const __m256i s = _mm256_add_epi32(_mm256_slli_epi32(top, 8),
                                        _mm256_mullo_epi32(_mm256_sub_epi32(bottom, top), fy));
-    const __m256i v = _mm256_srai_epi32(_mm256_add_epi32(s, Load(kC.half.v)), 16);
-    const __m256i rc = _mm256_shuffle_epi8(ref, Load(kMasks.ref[c]));
+    const __m256i v = _mm256_srai_epi32(_mm256_add_epi32(s, Load(k.c->half.v)), 16);
+    const __m256i rc = _mm256_shuffle_epi8(ref, Load(k.m->ref[c]));
     ad = _mm256_add_epi32(ad, _mm256_abs_epi32(_mm256_sub_epi32(rc, v)));
   }
   return CostFromTaps(r, k, x, _mm256_min_epi32(ad, k.trunc), t.census);
@@ -236,8 +247,8 @@ LB_AVX2 inline void Store8(uint8_t* out, __m256i cost) {
 LB_AVX2 void Step(const WarpRow& r, const Consts& k, int32_t x, __m256i xq, __m256i yq,
                   uint8_t* dst) {
   const __m256i zero = _mm256_setzero_si256();
-  const __m256i xs = _mm256_srai_epi32(_mm256_add_epi32(xq, Load(kC.q8_half.v)), 8);
-  const __m256i ys = _mm256_srai_epi32(_mm256_add_epi32(yq, Load(kC.q8_half.v)), 8);
+  const __m256i xs = _mm256_srai_epi32(_mm256_add_epi32(xq, Load(k.c->q8_half.v)), 8);
+  const __m256i ys = _mm256_srai_epi32(_mm256_add_epi32(yq, Load(k.c->q8_half.v)), 8);
   const __m256i bad = _mm256_or_si256(
       _mm256_or_si256(_mm256_cmpgt_epi32(zero, xs), _mm256_cmpgt_epi32(xs, k.xmax)),
       _mm256_or_si256(_mm256_cmpgt_epi32(zero, ys), _mm256_cmpgt_epi32(ys, k.ymax)));
@@ -248,7 +259,7 @@ LB_AVX2 void Step(const WarpRow& r, const Consts& k, int32_t x, __m256i xq, __m2
   const __m256i fx = _mm256_sub_epi32(xc, _mm256_slli_epi32(xb, 8));
   const __m256i fy = _mm256_sub_epi32(yc, _mm256_slli_epi32(yb, 8));
   // The nearest tap: the right (lower) one from a fraction of 128 on.
-  const __m256i c127 = Load(kC.near.v);
+  const __m256i c127 = Load(k.c->near.v);
   const __m256i nx = _mm256_sub_epi32(xb, _mm256_cmpgt_epi32(fx, c127));
   const __m256i ny = _mm256_sub_epi32(yb, _mm256_cmpgt_epi32(fy, c127));
   // The positions are monotone along a step (WarpSpan's lie between its anchors), so the first
@@ -278,7 +289,7 @@ LB_AVX2 void Step(const WarpRow& r, const Consts& k, int32_t x, __m256i xq, __m2
     ScalarTaps(r, k, xb, yb, nx, ny, &t);
   }
   const __m256i wx =
-      _mm256_add_epi32(_mm256_sub_epi32(Load(kC.one.v), fx), _mm256_slli_epi32(fx, 16));
+      _mm256_add_epi32(_mm256_sub_epi32(Load(k.c->one.v), fx), _mm256_slli_epi32(fx, 16));
   Store8(dst, _mm256_blendv_epi8(Cost(r, k, x, t, wx, fy), k.invalid, bad));
 }
 
@@ -347,13 +358,13 @@ template <bool kTwoRows, bool kTwoCensus>
 LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, const Consts& k,
                                                             const Band& band, int32_t x, __m256i xq,
                                                             __m256i yq, uint8_t* dst) {
-  const __m256i xs = _mm256_srai_epi32(_mm256_add_epi32(xq, Load(kC.q8_half.v)), 8);
-  const __m256i ys = _mm256_srai_epi32(_mm256_add_epi32(yq, Load(kC.q8_half.v)), 8);
+  const __m256i xs = _mm256_srai_epi32(_mm256_add_epi32(xq, Load(k.c->q8_half.v)), 8);
+  const __m256i ys = _mm256_srai_epi32(_mm256_add_epi32(yq, Load(k.c->q8_half.v)), 8);
   const __m256i xb = _mm256_min_epi32(_mm256_srai_epi32(xs, 8), k.wm2);
   const __m256i yb = _mm256_min_epi32(_mm256_srai_epi32(ys, 8), k.hm2);
   const __m256i fx = _mm256_sub_epi32(xs, _mm256_slli_epi32(xb, 8));
   const __m256i fy = _mm256_sub_epi32(ys, _mm256_slli_epi32(yb, 8));
-  const __m256i nx = _mm256_sub_epi32(xb, _mm256_cmpgt_epi32(fx, Load(kC.near.v)));
+  const __m256i nx = _mm256_sub_epi32(xb, _mm256_cmpgt_epi32(fx, Load(k.c->near.v)));
   // Each half's least pair column: its first lane when the positions rise, else its last.
   const __m256i least =
       band.rising ? _mm256_shuffle_epi32(xb, 0x00) : _mm256_shuffle_epi32(xb, 0xff);
@@ -362,9 +373,9 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
   const int32_t start_lo = _mm256_cvtsi256_si32(start), start_hi = _mm256_extract_epi32(start, 4);
   const __m256i d = _mm256_sub_epi32(_mm256_add_epi32(xb, _mm256_add_epi32(xb, xb)), start);
   const __m256i idx =
-      _mm256_add_epi32(_mm256_add_epi32(d, _mm256_slli_epi32(d, 16)), Load(kC.pair_idx[0].v));
+      _mm256_add_epi32(_mm256_add_epi32(d, _mm256_slli_epi32(d, 16)), Load(k.c->pair_idx[0].v));
   const __m256i wx =
-      _mm256_add_epi32(_mm256_sub_epi32(Load(kC.one.v), fx), _mm256_slli_epi32(fx, 16));
+      _mm256_add_epi32(_mm256_sub_epi32(Load(k.c->one.v), fx), _mm256_slli_epi32(fx, 16));
   const __m128i ref_lo = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r.ref + 3 * x));
   const __m128i ref_hi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r.ref + 3 * x + 8));
   const __m256i ref = _mm256_inserti128_si256(_mm256_castsi128_si256(ref_lo), ref_hi, 1);
@@ -383,8 +394,8 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
     const __m256i t = _mm256_madd_epi16(top, wx), b = _mm256_madd_epi16(bottom, wx);
     const __m256i sum =
         _mm256_add_epi32(_mm256_slli_epi32(t, 8), _mm256_mullo_epi32(_mm256_sub_epi32(b, t), fy));
-    const __m256i v = _mm256_srai_epi32(_mm256_add_epi32(sum, Load(kC.half.v)), 16);
-    const __m256i rc = _mm256_shuffle_epi8(ref, Load(kMasks.ref[c]));
+    const __m256i v = _mm256_srai_epi32(_mm256_add_epi32(sum, Load(k.c->half.v)), 16);
+    const __m256i rc = _mm256_shuffle_epi8(ref, Load(k.m->ref[c]));
     ad = _mm256_add_epi32(ad, _mm256_abs_epi32(_mm256_sub_epi32(rc, v)));
   }
   ad = _mm256_min_epi32(ad, k.trunc);
@@ -397,7 +408,7 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
   const ptrdiff_t census_row = static_cast<ptrdiff_t>(3) * r.width;
   for (int32_t p = 0; p < 3; ++p) {
     const int32_t shift = 8 * (2 - p);  // plane 0 holds the top byte
-    const __m256i pidx = _mm256_or_si256(_mm256_slli_epi32(e, shift), Load(kC.census_idx[p].v));
+    const __m256i pidx = _mm256_or_si256(_mm256_slli_epi32(e, shift), Load(k.c->census_idx[p].v));
     const uint8_t* plane = band.crow + p * r.width + cstart;
     census = _mm256_or_si256(census, _mm256_shuffle_epi8(Broadcast16(plane), pidx));
     if (kTwoCensus) {
@@ -406,7 +417,7 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
     }
   }
   if (kTwoCensus) {
-    const __m256i ny = _mm256_sub_epi32(yb, _mm256_cmpgt_epi32(fy, Load(kC.near.v)));
+    const __m256i ny = _mm256_sub_epi32(yb, _mm256_cmpgt_epi32(fy, Load(k.c->near.v)));
     census =
         _mm256_blendv_epi8(census, census2, _mm256_cmpeq_epi32(ny, _mm256_set1_epi32(band.cy + 1)));
   }
@@ -605,7 +616,9 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpRun& run, uint8_t* out) 
                  _mm256_set1_epi32(r.trunc),
                  _mm256_set1_epi32(r.invalid),
                  Load(lut),
-                 _mm256_set1_epi32(3 * r.width - 18)};
+                 _mm256_set1_epi32(3 * r.width - 18),
+                 Laundered(&kC),
+                 Laundered(&kMasks)};
   const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   const __m256i eight = _mm256_set1_epi32(8);
   int32_t first = 0, end = 0;
