@@ -532,11 +532,13 @@ LB_AVX2 inline __m256i AtMost(__m256i v, __m256i max) {
 // What the run's band spans need, 8 spans at once (BandOf's tests, lane by lane): a span of
 // kAnchorStep pixels (the row's short last span is not one), both anchors inside the view, its
 // tap rows and census rows each within two neighbouring rows, and the positions advancing at
-// most 9/8 px per pixel. For each: its upper tap row and census row, its x and y change over the
-// span (Q16), and kind bits (kInBand, kTwoRows, kTwoCensus, kRising).
+// most 9/8 px per pixel; not the row's last span when its end column is wanted. For each: its
+// upper tap row and census row (and their offsets), its x and y change over the span (Q16), and
+// kind bits (kInBand, kTwoRows, kTwoCensus, kRising).
 enum : int32_t { kInBand = 1, kTwoRows = 2, kTwoCensus = 4, kRising = 8 };
 struct RunBands {
   alignas(32) int32_t y[kRunSpans], cy[kRunSpans], dx[kRunSpans], dy[kRunSpans], kind[kRunSpans];
+  alignas(32) int32_t row[kRunSpans], crow[kRunSpans];  // y * stride, cy * 3 * width
 };
 
 // Spans first .. end - 1 (end - first <= kRunSpans) into b, indexed from `first`. Lanes past
@@ -549,7 +551,11 @@ LB_AVX2 void BandsOfRun(const WarpRow& r, const WarpRun& run, int32_t first, int
   const __m256i hm2 = _mm256_set1_epi32(r.height - 2);
   const __m256i q8_half = _mm256_set1_epi32(128), one = _mm256_set1_epi32(1);
   const __m256i reach = _mm256_set1_epi32(kAnchorStep * 73728);
-  const __m256i last = _mm256_set1_epi32(run.last);
+  // The row's last span, when its end anchor's column is wanted too (a 17th), is not stepped
+  // as one of the band.
+  const __m256i last = _mm256_set1_epi32(run.hi > run.last ? run.last - 1 : run.last);
+  const __m256i stride = _mm256_set1_epi32(static_cast<int32_t>(r.stride));
+  const __m256i census_row = _mm256_set1_epi32(3 * r.width);
   for (int32_t g = first; g < end; g += kLanes) {
     const __m256i lanes = _mm256_cmpgt_epi32(_mm256_set1_epi32(end - g), iota);
     const __m256i ax = _mm256_maskload_epi32(run.x_q16 + g, lanes);
@@ -585,8 +591,14 @@ LB_AVX2 void BandsOfRun(const WarpRow& r, const WarpRun& run, int32_t first, int
     kind = _mm256_or_si256(
         kind, _mm256_andnot_si256(_mm256_cmpgt_epi32(zero, dx), _mm256_set1_epi32(kRising)));
     const int32_t i = g - first;
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->y + i), _mm256_min_epi32(row_a, row_b));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->cy + i), _mm256_min_epi32(near_a, near_b));
+    const __m256i y = _mm256_min_epi32(row_a, row_b), cy = _mm256_min_epi32(near_a, near_b);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->y + i), y);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->cy + i), cy);
+    // Offsets of lanes in the band only (the view's bytes are below 2^31).
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->row + i),
+                        _mm256_and_si256(in_band, _mm256_mullo_epi32(y, stride)));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->crow + i),
+                        _mm256_and_si256(in_band, _mm256_mullo_epi32(cy, census_row)));
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->dx + i), dx);
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->dy + i), dy);
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->kind + i), kind);
@@ -633,23 +645,19 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpRun& run, uint8_t* out) 
     }
     for (int32_t s = base; s < stop; ++s) {
       const int32_t i = s - base, kind = bands.kind[i];
-      const WarpSpanJob job = RunSpan(run, s);
-      // Not of the band, or the row's last span ending on its end anchor's column (a 17th).
-      if ((kind & kInBand) == 0 || job.hi > job.x0 + kAnchorStep) {
+      if ((kind & kInBand) == 0) {
+        const WarpSpanJob job = RunSpan(run, s);
         if (job.lo < job.hi) AnySpan(r, k, &job, out);
         continue;
       }
-      const Band band{r.view + bands.y[i] * r.stride,
-                      r.census_view + static_cast<ptrdiff_t>(bands.cy[i]) * 3 * r.width,
-                      bands.y[i],
-                      bands.cy[i],
-                      (kind & kTwoRows) != 0,
-                      (kind & kTwoCensus) != 0,
-                      (kind & kRising) != 0};
+      const int32_t x = run.x0 + kAnchorStep * s;
+      const Band band{
+          r.view + bands.row[i],  r.census_view + bands.crow[i], bands.y[i],           bands.cy[i],
+          (kind & kTwoRows) != 0, (kind & kTwoCensus) != 0,      (kind & kRising) != 0};
       const __m256i dx = _mm256_set1_epi32(bands.dx[i]), dy = _mm256_set1_epi32(bands.dy[i]);
       const __m256i tx = _mm256_add_epi32(_mm256_mullo_epi32(iota, dx), eight);
       const __m256i ty = _mm256_add_epi32(_mm256_mullo_epi32(iota, dy), eight);
-      const __m256i ax = _mm256_set1_epi32(job.ax), ay = _mm256_set1_epi32(job.ay);
+      const __m256i ax = _mm256_set1_epi32(run.x_q16[s]), ay = _mm256_set1_epi32(run.y_q16[s]);
       const __m256i q[4] = {
           _mm256_add_epi32(ax, _mm256_srai_epi32(tx, 4)),
           _mm256_add_epi32(ay, _mm256_srai_epi32(ty, 4)),
@@ -657,13 +665,14 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpRun& run, uint8_t* out) 
                            _mm256_srai_epi32(_mm256_add_epi32(tx, _mm256_slli_epi32(dx, 3)), 4)),
           _mm256_add_epi32(ay,
                            _mm256_srai_epi32(_mm256_add_epi32(ty, _mm256_slli_epi32(dy, 3)), 4))};
-      if (job.lo == job.x0 && job.hi == job.x0 + kAnchorStep) {
-        AnyBandSpan(r, k, band, job.x0, q, out + job.x0);
-      } else if (job.lo < job.hi) {
+      const int32_t lo = Max(x, run.lo), hi = Min(x + kAnchorStep, run.hi);
+      if (lo == x && hi == x + kAnchorStep) {
+        AnyBandSpan(r, k, band, x, q, out + x);
+      } else if (lo < hi) {
         // Cut by the wanted columns: the whole span into a buffer, the wanted part copied.
         uint8_t costs[kAnchorStep];
-        AnyBandSpan(r, k, band, job.x0, q, costs);
-        std::memcpy(out + job.lo, costs + (job.lo - job.x0), static_cast<size_t>(job.hi - job.lo));
+        AnyBandSpan(r, k, band, x, q, costs);
+        std::memcpy(out + lo, costs + (lo - x), static_cast<size_t>(hi - lo));
       }
     }
   }
