@@ -436,23 +436,14 @@ LB_AVX2 inline void AnyBandStep(const WarpRow& r, const Consts& k, const Band& b
 }
 
 // The two steps of a whole span of the band: pixels x..x+7 at (q[0], q[1]), x+8..x+15 at (q[2],
-// q[3]), their costs into dst[0..15].
+// q[3]), their costs into dst[0..15]. Inlined in the run's loop, one copy per band kind, so a
+// span pays no call and the constants stay put.
 template <bool kTwoRows, bool kTwoCensus>
-LB_AVX2 void BandSpan(const WarpRow& r, const Consts& k, const Band& band, int32_t x,
-                      const __m256i* q, uint8_t* dst) {
+LB_AVX2 inline __attribute__((always_inline)) void BandSpan(const WarpRow& r, const Consts& k,
+                                                            const Band& band, int32_t x,
+                                                            const __m256i* q, uint8_t* dst) {
   BandStep<kTwoRows, kTwoCensus>(r, k, band, x, q[0], q[1], dst);
   BandStep<kTwoRows, kTwoCensus>(r, k, band, x + kLanes, q[2], q[3], dst + kLanes);
-}
-
-// BandSpan's instance for the span's band.
-LB_AVX2 inline void AnyBandSpan(const WarpRow& r, const Consts& k, const Band& band, int32_t x,
-                                const __m256i* q, uint8_t* dst) {
-  if (band.two_rows) {
-    if (band.two_census) return BandSpan<true, true>(r, k, band, x, q, dst);
-    return BandSpan<true, false>(r, k, band, x, q, dst);
-  }
-  if (band.two_census) return BandSpan<false, true>(r, k, band, x, q, dst);
-  BandSpan<false, false>(r, k, band, x, q, dst);
 }
 
 // One span, any: outside the view, partly outside, beyond the band's reach, short or cut by the
@@ -666,12 +657,25 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpRun& run, uint8_t* out) 
           _mm256_add_epi32(ay,
                            _mm256_srai_epi32(_mm256_add_epi32(ty, _mm256_slli_epi32(dy, 3)), 4))};
       const int32_t lo = Max(x, run.lo), hi = Min(x + kAnchorStep, run.hi);
-      if (lo == x && hi == x + kAnchorStep) {
-        AnyBandSpan(r, k, band, x, q, out + x);
-      } else if (lo < hi) {
-        // Cut by the wanted columns: the whole span into a buffer, the wanted part copied.
-        uint8_t costs[kAnchorStep];
-        AnyBandSpan(r, k, band, x, q, costs);
+      // A span cut by the wanted columns goes whole into a buffer, the wanted part copied.
+      const bool whole = lo == x && hi == x + kAnchorStep;
+      uint8_t costs[kAnchorStep];
+      uint8_t* const dst = whole ? out + x : costs;
+      switch (kind & (kTwoRows | kTwoCensus)) {
+        case 0:
+          BandSpan<false, false>(r, k, band, x, q, dst);
+          break;
+        case kTwoRows:
+          BandSpan<true, false>(r, k, band, x, q, dst);
+          break;
+        case kTwoCensus:
+          BandSpan<false, true>(r, k, band, x, q, dst);
+          break;
+        default:
+          BandSpan<true, true>(r, k, band, x, q, dst);
+          break;
+      }
+      if (!whole && lo < hi) {
         std::memcpy(out + lo, costs + (lo - x), static_cast<size_t>(hi - lo));
       }
     }
