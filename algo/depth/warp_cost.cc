@@ -131,45 +131,69 @@ void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
   auto map = [&](int32_t x, int32_t* x_q16, int32_t* y_q16) {
     return row_map.At<kExactDivide>(x, x_q16, y_q16);
   };
-  // The run being gathered: its anchors so far (the next span's start anchor is the last one),
-  // its first span's start column and first wanted column. A run ends where a plane has no map
-  // (those spans cost `invalid`), when it is full, and at the end of the range.
-  int32_t ax[kRunSpans + 1] = {}, ay[kRunSpans + 1] = {};
-  int32_t count = 0, run_x0 = first, run_lo = x_begin;
-  auto flush = [&](int32_t last, int32_t hi) {
-    if (count > 0) span(row, WarpRun{ax, ay, run_x0, count, last, run_lo, hi}, out);
-    ax[0] = ax[count];
-    ay[0] = ay[count];
-    count = 0;
-  };
-  bool a_ok = map(first, &ax[0], &ay[0]);
-  int32_t last = first, last_hi = first;
-  for (int32_t x0 = first, end = 0; x0 < x_end; x0 = end) {
-    const int32_t x1 = x0 + kAnchorStep < w - 1 ? x0 + kAnchorStep : w - 1;
-    end = x1 == w - 1 ? w : x1;  // the last span keeps its end anchor
-    const int32_t lo = x0 > x_begin ? x0 : x_begin, hi = end < x_end ? end : x_end;
-    int32_t bx = ax[count], by = ay[count];
-    const bool b_ok = x1 == x0 ? a_ok : map(x1, &bx, &by);
-    if (a_ok && b_ok) {
-      if (count == 0) {
-        run_x0 = x0;
-        run_lo = lo;
-      }
-      ++count;
-      ax[count] = bx;
-      ay[count] = by;
-      last = x1;
-      last_hi = hi;
-      if (count == kRunSpans) flush(last, last_hi);
-    } else {
-      flush(last, last_hi);
-      for (int32_t x = lo; x < hi; ++x) out[x] = row.invalid;
-      ax[0] = bx;
-      ay[0] = by;
+  // Spans x0 = first + kAnchorStep k up to x_end, the last one ending on column w - 1; each
+  // chunk of up to kRunSpans spans maps its anchors in one tight loop, then goes to the kernel as
+  // one run, or, where a plane has no map at some anchor, as the runs between (the spans
+  // touching that anchor cost `invalid`).
+  int32_t ax[kRunSpans + 1], ay[kRunSpans + 1];
+  bool ok[kRunSpans + 1];
+  ok[0] = map(first, &ax[0], &ay[0]);
+  for (int32_t x0 = first; x0 < x_end;) {
+    // Spans of this chunk: while the span starting at x0 + kAnchorStep k begins before x_end.
+    const int32_t left = (x_end - x0 + kAnchorStep - 1) / kAnchorStep;
+    const int32_t count = left < kRunSpans ? left : kRunSpans;
+    bool all = ok[0];
+    int32_t k = 1;
+    for (; k <= count; ++k) {
+      const int32_t x = x0 + kAnchorStep * k;
+      if (x >= w - 1) break;
+      ok[k] = map(x, &ax[k], &ay[k]);
+      all &= ok[k];
     }
-    a_ok = b_ok;
+    int32_t spans = k - 1, last = x0 + kAnchorStep * spans;
+    if (k <= count) {
+      // The row's last span ends on column w - 1 (w - 1 - x0 <= kAnchorStep k; a row of one
+      // column has a single anchor, start and end).
+      last = w - 1;
+      spans = k;
+      ok[k] = last == x0 + kAnchorStep * (k - 1) ? ok[k - 1] : map(last, &ax[k], &ay[k]);
+      if (last == x0 + kAnchorStep * (k - 1)) {
+        ax[k] = ax[k - 1];
+        ay[k] = ay[k - 1];
+      }
+      all &= ok[k];
+    }
+    const int32_t end = last == w - 1 ? w : last;  // columns x0 .. end - 1 are this chunk's
+    const int32_t lo = x0 > x_begin ? x0 : x_begin, hi = end < x_end ? end : x_end;
+    if (all) {
+      span(row, WarpRun{ax, ay, x0, spans, last, lo, hi}, out);
+    } else {
+      // Runs of spans whose anchors all map; the others invalid.
+      for (int32_t s = 0; s < spans;) {
+        const int32_t sx = x0 + kAnchorStep * s;
+        if (!ok[s] || !ok[s + 1]) {
+          const int32_t se = s + 1 == spans ? end : sx + kAnchorStep;
+          for (int32_t x = sx > lo ? sx : lo; x < se && x < hi; ++x) out[x] = row.invalid;
+          ++s;
+          continue;
+        }
+        int32_t e = s + 1;
+        while (e < spans && ok[e + 1]) ++e;
+        const int32_t run_last = e == spans ? last : x0 + kAnchorStep * e;
+        const int32_t run_end = e == spans ? end : run_last;
+        const int32_t run_lo = sx > lo ? sx : lo, run_hi = run_end < hi ? run_end : hi;
+        if (run_lo < run_hi) {
+          span(row, WarpRun{ax + s, ay + s, sx, e - s, run_last, run_lo, run_hi}, out);
+        }
+        s = e;
+      }
+    }
+    if (end >= x_end) break;
+    x0 = last;
+    ax[0] = ax[spans];
+    ay[0] = ay[spans];
+    ok[0] = ok[spans];
   }
-  flush(last, last_hi);
 }
 
 }  // namespace lb

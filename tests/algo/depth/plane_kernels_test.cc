@@ -259,5 +259,56 @@ TEST(PlaneKernels, RowsThroughRandomHomographiesEqualTheReference) {
   }
 }
 
+// PlaneCostRow's runs against one span at a time: every column's cost is that of its span
+// (anchors at multiples of kAnchorStep, the last span ending on column w - 1) mapped by
+// PlaneHomography::Map and handed to the reference kernel alone, or `invalid` where an anchor of
+// its span has no map. Rows wider than a run (kRunSpans spans), planes without a map left or
+// right of a random column, random column ranges; at least 10 % of the columns asked for are
+// without a map and 10 % with.
+TEST(PlaneKernels, RowsEqualTheirSpansOneByOne) {
+  std::mt19937 rng(23);
+  int64_t with = 0, without = 0;
+  for (const int32_t w : {1, 2, 16, 17, 18, 33, 800, 1000}) {
+    const int32_t h = 24;
+    const Views v(rng, w, h, 3, static_cast<int32_t>(rng() % 3));
+    for (int32_t trial = 0; trial < 30; ++trial) {
+      PlaneHomography hom = RandomPlane(rng, w, h, 2.0, 0.2 + 0.8 * (trial % 5));
+      const int32_t y = static_cast<int32_t>(rng() % h);
+      if (trial % 3 != 0) {
+        // No map left (or right) of a random column of row y: the denominator falls to its
+        // minimum there.
+        const int64_t xc = static_cast<int64_t>(rng() % w);
+        hom.m[6] = (trial % 3 == 1 ? 1 : -1) * ((int64_t{1} << 30) / w);
+        hom.m[8] = (int64_t{1} << 20) - hom.m[6] * xc - hom.m[7] * y;
+      }
+      const DataTermParams params{45, 4};
+      const int32_t invalid = std::min(255, params.color_trunc + 24 * params.census_weight);
+      const int32_t begin = trial % 2 == 0 ? 0 : static_cast<int32_t>(rng() % w);
+      const int32_t end = begin + 1 + static_cast<int32_t>(rng() % (w - begin));
+      std::vector<uint8_t> got(w, 0x5a), want(w, 0x5a);
+      PlaneCostRow(hom, v.Source(), y, params, invalid, begin, end, got.data(),
+                   dtk::kReference.plane);
+      const WarpRow row = v.Row(y, params.color_trunc, params.census_weight, invalid);
+      for (int32_t x = begin; x < end; ++x) {
+        int32_t x0 = x / kAnchorStep * kAnchorStep;
+        if (x0 == w - 1 && x0 > 0) x0 -= kAnchorStep;  // w - 1 ends the span before it
+        const int32_t x1 = std::min(x0 + kAnchorStep, w - 1);
+        int32_t a[2], b[2];
+        if (!hom.Map(x0, y, &a[0], &b[0]) || !hom.Map(x1, y, &a[1], &b[1])) {
+          want[x] = static_cast<uint8_t>(invalid);
+          ++without;
+          continue;
+        }
+        dtk::kReference.plane(row, WarpRun{a, b, x0, 1, x1, x, x + 1}, want.data());
+        ++with;
+      }
+      ASSERT_EQ(got, want) << "w " << w << " y " << y << " [" << begin << ", " << end << ") trial "
+                           << trial;
+    }
+  }
+  EXPECT_GT(without * 10, with + without);
+  EXPECT_GT(with * 10, with + without);
+}
+
 }  // namespace
 }  // namespace lb
