@@ -354,16 +354,22 @@ LB_AVX2 inline __m256i ChannelPairs(const uint8_t* row, int32_t start_lo, int32_
 // by channel, so the taps need no more registers than one channel's.
 // kTwoRows, kTwoCensus: the span's band.two_rows and two_census, fixed per instance so the
 // step has no branch on them.
-template <bool kTwoRows, bool kTwoCensus>
+// kBiased: the positions come with the Q8 rounding's half (128) already added. Without
+// kTwoRows every pixel's upper tap row is the band's (BandOf), so its row fraction is its Q8
+// row less the band's.
+template <bool kTwoRows, bool kTwoCensus, bool kBiased = false>
 LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, const Consts& k,
                                                             const Band& band, int32_t x, __m256i xq,
                                                             __m256i yq, uint8_t* dst) {
-  const __m256i xs = _mm256_srai_epi32(_mm256_add_epi32(xq, Load(k.c->q8_half.v)), 8);
-  const __m256i ys = _mm256_srai_epi32(_mm256_add_epi32(yq, Load(k.c->q8_half.v)), 8);
+  const __m256i half = Load(k.c->q8_half.v);
+  const __m256i xs = _mm256_srai_epi32(kBiased ? xq : _mm256_add_epi32(xq, half), 8);
+  const __m256i ys = _mm256_srai_epi32(kBiased ? yq : _mm256_add_epi32(yq, half), 8);
   const __m256i xb = _mm256_min_epi32(_mm256_srai_epi32(xs, 8), k.wm2);
-  const __m256i yb = _mm256_min_epi32(_mm256_srai_epi32(ys, 8), k.hm2);
+  const __m256i yb =
+      kTwoRows ? _mm256_min_epi32(_mm256_srai_epi32(ys, 8), k.hm2) : _mm256_set1_epi32(band.y);
   const __m256i fx = _mm256_sub_epi32(xs, _mm256_slli_epi32(xb, 8));
-  const __m256i fy = _mm256_sub_epi32(ys, _mm256_slli_epi32(yb, 8));
+  const __m256i fy =
+      _mm256_sub_epi32(ys, kTwoRows ? _mm256_slli_epi32(yb, 8) : _mm256_set1_epi32(band.y * 256));
   const __m256i nx = _mm256_sub_epi32(xb, _mm256_cmpgt_epi32(fx, Load(k.c->near.v)));
   // Each half's least pair column: its first lane when the positions rise, else its last.
   const __m256i least =
@@ -436,14 +442,14 @@ LB_AVX2 inline void AnyBandStep(const WarpRow& r, const Consts& k, const Band& b
 }
 
 // The two steps of a whole span of the band: pixels x..x+7 at (q[0], q[1]), x+8..x+15 at (q[2],
-// q[3]), their costs into dst[0..15]. Inlined in the run's loop, one copy per band kind, so a
-// span pays no call and the constants stay put.
+// q[3]) (Q16 positions plus 128), their costs into dst[0..15]. Inlined in the run's loop, one copy
+// per band kind, so a span pays no call and the constants stay put.
 template <bool kTwoRows, bool kTwoCensus>
 LB_AVX2 inline __attribute__((always_inline)) void BandSpan(const WarpRow& r, const Consts& k,
                                                             const Band& band, int32_t x,
                                                             const __m256i* q, uint8_t* dst) {
-  BandStep<kTwoRows, kTwoCensus>(r, k, band, x, q[0], q[1], dst);
-  BandStep<kTwoRows, kTwoCensus>(r, k, band, x + kLanes, q[2], q[3], dst + kLanes);
+  BandStep<kTwoRows, kTwoCensus, true>(r, k, band, x, q[0], q[1], dst);
+  BandStep<kTwoRows, kTwoCensus, true>(r, k, band, x + kLanes, q[2], q[3], dst + kLanes);
 }
 
 // One span, any: outside the view, partly outside, beyond the band's reach, short or cut by the
@@ -648,7 +654,9 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpRun& run, uint8_t* out) 
       const __m256i dx = _mm256_set1_epi32(bands.dx[i]), dy = _mm256_set1_epi32(bands.dy[i]);
       const __m256i tx = _mm256_add_epi32(_mm256_mullo_epi32(iota, dx), eight);
       const __m256i ty = _mm256_add_epi32(_mm256_mullo_epi32(iota, dy), eight);
-      const __m256i ax = _mm256_set1_epi32(run.x_q16[s]), ay = _mm256_set1_epi32(run.y_q16[s]);
+      // Plus BandStep's rounding half: (a + 128) + t for a + t + 128, exact in int32.
+      const __m256i ax = _mm256_set1_epi32(run.x_q16[s] + 128);
+      const __m256i ay = _mm256_set1_epi32(run.y_q16[s] + 128);
       const __m256i q[4] = {
           _mm256_add_epi32(ax, _mm256_srai_epi32(tx, 4)),
           _mm256_add_epi32(ay, _mm256_srai_epi32(ty, 4)),
