@@ -22,7 +22,12 @@ struct DataTerm::Kernels {
   void (*hsum)(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum);
   void (*select)(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
                  uint16_t* out);
-  PlaneSpanFn plane;  // the plane sweep's pixel costs, a batch of spans (warp_cost.h)
+  PlaneSpanFn plane;  // the plane sweep's pixel costs, a run of spans (warp_cost.h)
+  // The reference row's lanes for `plane` (warp_cost.h: RefLanes) of columns x0..x1-1 of the
+  // row at ref / cref (width columns), column x0 at lanes[0]; nullptr when `plane` does not
+  // read them.
+  void (*plane_lanes)(const uint8_t* ref, const uint8_t* cref, int32_t width, int32_t x0,
+                      int32_t x1, int32_t* lanes, ptrdiff_t stride);
 };
 
 namespace dtk {
@@ -59,6 +64,8 @@ void CostRowCAvx2(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, c
 void PlaneSpansC(const WarpRow& row, const WarpRun& run, uint8_t* out);
 #if defined(__x86_64__)
 void PlaneSpansAvx2(const WarpRow& row, const WarpRun& run, uint8_t* out);
+void PlaneLanesAvx2(const uint8_t* ref, const uint8_t* cref, int32_t width, int32_t x0, int32_t x1,
+                    int32_t* lanes, ptrdiff_t stride);
 #endif
 #if defined(__ARM_NEON) || defined(__arm__)
 void PlaneSpansNeon(const WarpRow& row, const WarpRun& run, uint8_t* out);

@@ -120,7 +120,10 @@ void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
                     src.ref.height,
                     params.color_trunc,
                     params.census_weight,
-                    static_cast<uint8_t>(invalid_cost)};
+                    static_cast<uint8_t>(invalid_cost),
+                    src.ref_lanes,
+                    0,
+                    src.lanes_stride};
   int32_t first = x_begin - x_begin % kAnchorStep;
   if (first == w - 1 && first > 0) first -= kAnchorStep;  // w - 1 ends the span before it
   // A span's end anchor is the next one's start: one Map per span.

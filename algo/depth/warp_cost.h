@@ -29,7 +29,26 @@ struct WarpSource {
   ConstImageU8 ref, view;
   const uint8_t* census_ref = nullptr;
   const uint8_t* census_view = nullptr;
+  // Optional: the row's reference pixels as the kernel's lanes (RefLanes), prepared by the
+  // caller once for the row and reused for every view; nullptr: the kernel reads ref itself.
+  const int32_t* ref_lanes = nullptr;
+  ptrdiff_t lanes_stride = 0;
 };
+
+// The reference row as 32-bit lanes, the form a SIMD kernel subtracts and compares in: four
+// planes `stride` int32 apart, R, G, B and the 24-bit census (as Census() in warp_cost.cc),
+// column x at index x - x0. The data term fills them once per row (a per-worker buffer) instead
+// of every view's kernel unpacking the same bytes again. A kernel reading them for a
+// PlaneCostRow over x_begin..x_end needs columns RefLanesBegin .. RefLanesEnd - 1 (the spans
+// holding that range, and a last step of 8 pixels ending at the row's end).
+inline int32_t RefLanesBegin(int32_t width, int32_t x_begin) {
+  const int32_t first = x_begin - x_begin % 16 - 16, step = width - 8;
+  const int32_t a = first < step ? first : step;
+  return a > 0 ? a : 0;
+}
+inline int32_t RefLanesEnd(int32_t width, int32_t x_end) {
+  return x_end + 17 < width ? x_end + 17 : width;
+}
 
 // PlaneHomography::Map along one row y: the same results bit for bit, with one division instead
 // of two 64-bit ones (a library call each on 32-bit ARM, where PlaneCostRow uses this). The
@@ -95,6 +114,9 @@ struct WarpRow {
   const uint8_t* cref = nullptr;         // its census: three planes of `width` bytes
   int32_t width = 0, height = 0, trunc = 0, cw = 0;
   uint8_t invalid = 255;
+  const int32_t* ref_lanes = nullptr;  // optional (WarpSource), indexed from lanes_x0
+  int32_t lanes_x0 = 0;
+  ptrdiff_t lanes_stride = 0;
 };
 
 // The view positions of one span and the columns wanted from it: pixels x0 .. x0 + n (n <=

@@ -196,13 +196,16 @@ LB_AVX2 inline __attribute__((always_inline)) void WindowTaps(const WarpRow& r, 
 }
 
 // The costs of pixels x..x+7 from their truncated colour differences ad and their census taps.
-LB_AVX2 inline __attribute__((always_inline)) __m256i CostFromTaps(const WarpRow& r,
-                                                                   const Consts& k, int32_t x,
-                                                                   __m256i ad, __m256i census) {
-  const __m256i ref_bits =
-      _mm256_or_si256(_mm256_or_si256(_mm256_slli_epi32(Widen8(r.cref + x), 16),
-                                      _mm256_slli_epi32(Widen8(r.cref + r.width + x), 8)),
-                      Widen8(r.cref + 2 * r.width + x));
+// The reference's census of pixels x..x+7, 24 bits a lane.
+LB_AVX2 inline __m256i RefCensus(const WarpRow& r, int32_t x) {
+  return _mm256_or_si256(_mm256_or_si256(_mm256_slli_epi32(Widen8(r.cref + x), 16),
+                                         _mm256_slli_epi32(Widen8(r.cref + r.width + x), 8)),
+                         Widen8(r.cref + 2 * r.width + x));
+}
+
+LB_AVX2 inline __attribute__((always_inline)) __m256i CostFromTaps(const Consts& k, __m256i ad,
+                                                                   __m256i census,
+                                                                   __m256i ref_bits) {
   const __m256i bits = _mm256_xor_si256(census, ref_bits);
   const __m256i nib = Load(k.c->bytes15.v);
   const __m256i count8 = _mm256_add_epi8(
@@ -230,7 +233,7 @@ LB_AVX2 inline __attribute__((always_inline)) __m256i Cost(const WarpRow& r, con
     const __m256i rc = _mm256_shuffle_epi8(ref, Load(k.m->ref[c]));
     ad = _mm256_add_epi32(ad, _mm256_abs_epi32(_mm256_sub_epi32(rc, v)));
   }
-  return CostFromTaps(r, k, x, _mm256_min_epi32(ad, k.trunc), t.census);
+  return CostFromTaps(k, _mm256_min_epi32(ad, k.trunc), t.census, RefCensus(r, x));
 }
 
 // 8 costs 0..255: two packs leave pixels 0-3 in dword 0 and 4-7 in dword 4, joined for one store.
@@ -382,9 +385,8 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
       _mm256_add_epi32(_mm256_add_epi32(d, _mm256_slli_epi32(d, 16)), Load(k.c->pair_idx[0].v));
   const __m256i wx =
       _mm256_add_epi32(_mm256_sub_epi32(Load(k.c->one.v), fx), _mm256_slli_epi32(fx, 16));
-  const __m128i ref_lo = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r.ref + 3 * x));
-  const __m128i ref_hi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r.ref + 3 * x + 8));
-  const __m256i ref = _mm256_inserti128_si256(_mm256_castsi128_si256(ref_lo), ref_hi, 1);
+  // The reference's R, G, B and census lanes of pixels x..x+7 (r.ref_lanes, RefLanes).
+  const int32_t* lanes = r.ref_lanes + (x - r.lanes_x0);
   const __m256i lower =
       kTwoRows ? _mm256_cmpeq_epi32(yb, _mm256_set1_epi32(band.y + 1)) : _mm256_setzero_si256();
   __m256i ad = _mm256_setzero_si256();
@@ -401,7 +403,8 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
     const __m256i sum =
         _mm256_add_epi32(_mm256_slli_epi32(t, 8), _mm256_mullo_epi32(_mm256_sub_epi32(b, t), fy));
     const __m256i v = _mm256_srai_epi32(_mm256_add_epi32(sum, Load(k.c->half.v)), 16);
-    const __m256i rc = _mm256_shuffle_epi8(ref, Load(k.m->ref[c]));
+    const __m256i rc =
+        _mm256_loadu_si256(reinterpret_cast<const __m256i*>(lanes + c * r.lanes_stride));
     ad = _mm256_add_epi32(ad, _mm256_abs_epi32(_mm256_sub_epi32(rc, v)));
   }
   ad = _mm256_min_epi32(ad, k.trunc);
@@ -427,7 +430,9 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
     census =
         _mm256_blendv_epi8(census, census2, _mm256_cmpeq_epi32(ny, _mm256_set1_epi32(band.cy + 1)));
   }
-  Store8(dst, CostFromTaps(r, k, x, ad, census));
+  const __m256i ref_bits =
+      _mm256_loadu_si256(reinterpret_cast<const __m256i*>(lanes + 3 * r.lanes_stride));
+  Store8(dst, CostFromTaps(k, ad, census, ref_bits));
 }
 
 // A step of a span of the band, its instance chosen at run time (partial and short spans).
@@ -604,6 +609,33 @@ LB_AVX2 void BandsOfRun(const WarpRow& r, const WarpRun& run, int32_t first, int
 
 }  // namespace
 
+// RefLanes (warp_cost.h) of columns x0..x1-1: 8 columns a step from 24 bytes of the row and 8 of
+// each census plane (inside the row while x + 8 <= width), the rest one by one.
+LB_AVX2 void PlaneLanesAvx2(const uint8_t* ref, const uint8_t* cref, int32_t width, int32_t x0,
+                            int32_t x1, int32_t* lanes, ptrdiff_t stride) {
+  int32_t x = x0;
+  WarpRow r;
+  r.cref = cref;
+  r.width = width;
+  for (; x + kLanes <= x1 && x + kLanes <= width; x += kLanes) {
+    const __m128i lo = _mm_loadu_si128(reinterpret_cast<const __m128i*>(ref + 3 * x));
+    const __m128i hi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(ref + 3 * x + 8));
+    const __m256i rgb = _mm256_inserti128_si256(_mm256_castsi128_si256(lo), hi, 1);
+    int32_t* const out = lanes + (x - x0);
+    for (int32_t c = 0; c < 3; ++c) {
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + c * stride),
+                          _mm256_shuffle_epi8(rgb, Load(kMasks.ref[c])));
+    }
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + 3 * stride), RefCensus(r, x));
+  }
+  for (; x < x1; ++x) {
+    int32_t* const out = lanes + (x - x0);
+    for (int32_t c = 0; c < 3; ++c) out[c * stride] = ref[3 * x + c];
+    out[3 * stride] = static_cast<int32_t>((uint32_t{cref[x]} << 16) |
+                                           (uint32_t{cref[width + x]} << 8) | cref[2 * width + x]);
+  }
+}
+
 // A run at once: its spans' band tests 8 at a time (BandsOfRun), then each span of the band two
 // steps from its anchors, the rest (outside the view, partly, short, steep) one by one
 // (AnySpan). The positions of a whole span: (a 2^16 + 2^15 + i dx 2^12) >> 16 = a +
@@ -633,6 +665,11 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpRun& run, uint8_t* out) 
   int32_t first = 0, end = 0;
   RunSpans(run, &first, &end);
   RunBands bands;
+  // Without the caller's reference lanes, this kernel makes its own for each chunk of spans
+  // (RefLanes' columns of at most kRunSpans spans: 16 kRunSpans + 1 + 16 + 39 < kLocalLanes).
+  constexpr int32_t kLocalLanes = 16 * kRunSpans + 64;
+  alignas(32) int32_t local[4 * kLocalLanes];
+  WarpRow rl = r;
   for (int32_t base = first; base < end; base += kRunSpans) {
     const int32_t stop = Min(end, base + kRunSpans);
     if (r.width >= 16) {
@@ -640,11 +677,20 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpRun& run, uint8_t* out) 
     } else {
       for (int32_t i = 0; i < stop - base; ++i) bands.kind[i] = 0;
     }
+    if (r.ref_lanes == nullptr) {
+      const int32_t lo = Max(run.lo, run.x0 + kAnchorStep * base);
+      const int32_t hi = Min(run.hi, run.x0 + kAnchorStep * stop + 1);
+      rl.lanes_x0 = RefLanesBegin(r.width, lo);
+      rl.lanes_stride = kLocalLanes;
+      rl.ref_lanes = local;
+      PlaneLanesAvx2(r.ref, r.cref, r.width, rl.lanes_x0, RefLanesEnd(r.width, hi), local,
+                     kLocalLanes);
+    }
     for (int32_t s = base; s < stop; ++s) {
       const int32_t i = s - base, kind = bands.kind[i];
       if ((kind & kInBand) == 0) {
         const WarpSpanJob job = RunSpan(run, s);
-        if (job.lo < job.hi) AnySpan(r, k, &job, out);
+        if (job.lo < job.hi) AnySpan(rl, k, &job, out);
         continue;
       }
       const int32_t x = run.x0 + kAnchorStep * s;
@@ -671,16 +717,16 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpRun& run, uint8_t* out) 
       uint8_t* const dst = whole ? out + x : costs;
       switch (kind & (kTwoRows | kTwoCensus)) {
         case 0:
-          BandSpan<false, false>(r, k, band, x, q, dst);
+          BandSpan<false, false>(rl, k, band, x, q, dst);
           break;
         case kTwoRows:
-          BandSpan<true, false>(r, k, band, x, q, dst);
+          BandSpan<true, false>(rl, k, band, x, q, dst);
           break;
         case kTwoCensus:
-          BandSpan<false, true>(r, k, band, x, q, dst);
+          BandSpan<false, true>(rl, k, band, x, q, dst);
           break;
         default:
-          BandSpan<true, true>(r, k, band, x, q, dst);
+          BandSpan<true, true>(rl, k, band, x, q, dst);
           break;
       }
       if (!whole && lo < hi) {
