@@ -308,6 +308,7 @@ struct Band {
   bool two_rows;        // some pixels' tap rows are one lower
   bool two_census;      // some pixels' census rows are one lower
   bool rising;          // positions rise along the span: a step's first lane has its least column
+  ptrdiff_t lanes_stride;  // the reference lanes' (WarpRow::ref_lanes)
 };
 
 // The caller checks r.width >= 16 once. Positions |.| < 2^30, so differences fit 32 bits; a
@@ -362,7 +363,8 @@ LB_AVX2 inline __m256i ChannelPairs(const uint8_t* row, int32_t start_lo, int32_
 // row less the band's.
 template <bool kTwoRows, bool kTwoCensus, bool kBiased = false>
 LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, const Consts& k,
-                                                            const Band& band, int32_t x, __m256i xq,
+                                                            const Band& band,
+                                                            const int32_t* lanes, __m256i xq,
                                                             __m256i yq, uint8_t* dst) {
   const __m256i half = Load(k.c->q8_half.v);
   const __m256i xs = _mm256_srai_epi32(kBiased ? xq : _mm256_add_epi32(xq, half), 8);
@@ -385,8 +387,6 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
       _mm256_add_epi32(_mm256_add_epi32(d, _mm256_slli_epi32(d, 16)), Load(k.c->pair_idx[0].v));
   const __m256i wx =
       _mm256_add_epi32(_mm256_sub_epi32(Load(k.c->one.v), fx), _mm256_slli_epi32(fx, 16));
-  // The reference's R, G, B and census lanes of pixels x..x+7 (r.ref_lanes, RefLanes).
-  const int32_t* lanes = r.ref_lanes + (x - r.lanes_x0);
   const __m256i lower =
       kTwoRows ? _mm256_cmpeq_epi32(yb, _mm256_set1_epi32(band.y + 1)) : _mm256_setzero_si256();
   __m256i ad = _mm256_setzero_si256();
@@ -404,7 +404,7 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
         _mm256_add_epi32(_mm256_slli_epi32(t, 8), _mm256_mullo_epi32(_mm256_sub_epi32(b, t), fy));
     const __m256i v = _mm256_srai_epi32(_mm256_add_epi32(sum, Load(k.c->half.v)), 16);
     const __m256i rc =
-        _mm256_loadu_si256(reinterpret_cast<const __m256i*>(lanes + c * r.lanes_stride));
+        _mm256_loadu_si256(reinterpret_cast<const __m256i*>(lanes + c * band.lanes_stride));
     ad = _mm256_add_epi32(ad, _mm256_abs_epi32(_mm256_sub_epi32(rc, v)));
   }
   ad = _mm256_min_epi32(ad, k.trunc);
@@ -431,19 +431,20 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
         _mm256_blendv_epi8(census, census2, _mm256_cmpeq_epi32(ny, _mm256_set1_epi32(band.cy + 1)));
   }
   const __m256i ref_bits =
-      _mm256_loadu_si256(reinterpret_cast<const __m256i*>(lanes + 3 * r.lanes_stride));
+      _mm256_loadu_si256(reinterpret_cast<const __m256i*>(lanes + 3 * band.lanes_stride));
   Store8(dst, CostFromTaps(k, ad, census, ref_bits));
 }
 
 // A step of a span of the band, its instance chosen at run time (partial and short spans).
 LB_AVX2 inline void AnyBandStep(const WarpRow& r, const Consts& k, const Band& band, int32_t x,
                                 __m256i xq, __m256i yq, uint8_t* dst) {
+  const int32_t* lanes = r.ref_lanes + (x - r.lanes_x0);
   if (band.two_rows) {
-    if (band.two_census) return BandStep<true, true>(r, k, band, x, xq, yq, dst);
-    return BandStep<true, false>(r, k, band, x, xq, yq, dst);
+    if (band.two_census) return BandStep<true, true>(r, k, band, lanes, xq, yq, dst);
+    return BandStep<true, false>(r, k, band, lanes, xq, yq, dst);
   }
-  if (band.two_census) return BandStep<false, true>(r, k, band, x, xq, yq, dst);
-  BandStep<false, false>(r, k, band, x, xq, yq, dst);
+  if (band.two_census) return BandStep<false, true>(r, k, band, lanes, xq, yq, dst);
+  BandStep<false, false>(r, k, band, lanes, xq, yq, dst);
 }
 
 // The two steps of a whole span of the band: pixels x..x+7 at (q[0], q[1]), x+8..x+15 at (q[2],
@@ -453,8 +454,9 @@ template <bool kTwoRows, bool kTwoCensus>
 LB_AVX2 inline __attribute__((always_inline)) void BandSpan(const WarpRow& r, const Consts& k,
                                                             const Band& band, int32_t x,
                                                             const __m256i* q, uint8_t* dst) {
-  BandStep<kTwoRows, kTwoCensus, true>(r, k, band, x, q[0], q[1], dst);
-  BandStep<kTwoRows, kTwoCensus, true>(r, k, band, x + kLanes, q[2], q[3], dst + kLanes);
+  const int32_t* lanes = r.ref_lanes + (x - r.lanes_x0);
+  BandStep<kTwoRows, kTwoCensus, true>(r, k, band, lanes, q[0], q[1], dst);
+  BandStep<kTwoRows, kTwoCensus, true>(r, k, band, lanes + kLanes, q[2], q[3], dst + kLanes);
 }
 
 // One span, any: outside the view, partly outside, beyond the band's reach, short or cut by the
@@ -496,6 +498,7 @@ LB_AVX2 void AnySpan(const WarpRow& r, const Consts& k, const WarpSpanJob* job, 
   };
   __m256i xq, yq;
   Band band{};
+  band.lanes_stride = r.lanes_stride;
   const bool in_band = r.width >= 16 && BandOf(r, *job, &band);
   if (!in_band && SpanOutsideView(r, *job)) {
     FillInvalid(r, *job, out);
@@ -696,7 +699,8 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpRun& run, uint8_t* out) 
       const int32_t x = run.x0 + kAnchorStep * s;
       const Band band{
           r.view + bands.row[i],  r.census_view + bands.crow[i], bands.y[i],           bands.cy[i],
-          (kind & kTwoRows) != 0, (kind & kTwoCensus) != 0,      (kind & kRising) != 0};
+          (kind & kTwoRows) != 0, (kind & kTwoCensus) != 0,      (kind & kRising) != 0,
+          rl.lanes_stride};
       const __m256i dx = _mm256_set1_epi32(bands.dx[i]), dy = _mm256_set1_epi32(bands.dy[i]);
       const __m256i tx = _mm256_add_epi32(_mm256_mullo_epi32(iota, dx), eight);
       const __m256i ty = _mm256_add_epi32(_mm256_mullo_epi32(iota, dy), eight);
