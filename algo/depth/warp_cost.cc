@@ -146,13 +146,20 @@ void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
     const int32_t left = (x_end - x0 + kAnchorStep - 1) / kAnchorStep;
     const int32_t count = left < kRunSpans ? left : kRunSpans;
     bool all = ok[0];
-    int32_t k = 1;
-    for (; k <= count; ++k) {
-      const int32_t x = x0 + kAnchorStep * k;
-      if (x >= w - 1) break;
-      ok[k] = map(x, &ax[k], &ay[k]);
+    // The anchors on the grid before w - 1, their sums stepped along the row.
+    const int32_t grid = (w - 2 - x0) / kAnchorStep;  // x0 + kAnchorStep k < w - 1 for k <= grid
+    const int32_t stepped = count < grid ? count : grid;
+    int64_t sums[3], changes[3];
+    row_map.Sums(x0, sums);
+    row_map.Changes(kAnchorStep, changes);
+    for (int32_t k = 1; k <= stepped; ++k) {
+      sums[0] += changes[0];
+      sums[1] += changes[1];
+      sums[2] += changes[2];
+      ok[k] = PlaneRowMap::FromSums<kExactDivide>(sums[0], sums[1], sums[2], &ax[k], &ay[k]);
       all &= ok[k];
     }
+    int32_t k = stepped + 1;
     int32_t spans = k - 1, last = x0 + kAnchorStep * spans;
     if (k <= count) {
       // The row's last span ends on column w - 1 (w - 1 - x0 <= kAnchorStep k; a row of one

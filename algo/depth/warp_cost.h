@@ -64,12 +64,33 @@ class PlaneRowMap {
   // the estimate; the row's constant terms are still summed once.
   template <bool kExactDivide = false>
   bool At(int32_t x, int32_t* x_q16, int32_t* y_q16) const {
-    const int64_t den = m_[6] * x + den_;
-    const int64_t nx = m_[0] * x + nx_;
-    const int64_t ny = m_[3] * x + ny_;
-    if (den < (int64_t{1} << 20) || den >= (int64_t{1} << 32)) return false;
-    const int64_t lim = den << 14;
-    if (nx >= lim || -nx >= lim || ny >= lim || -ny >= lim) return false;
+    return FromSums<kExactDivide>(m_[6] * x + den_, m_[0] * x + nx_, m_[3] * x + ny_, x_q16, y_q16);
+  }
+
+  // The row's denominator and numerators at column x, and their change over dx columns: a
+  // caller stepping along the row adds the changes (the same integers as At's products).
+  void Sums(int32_t x, int64_t* sums) const {
+    sums[0] = m_[6] * x + den_;
+    sums[1] = m_[0] * x + nx_;
+    sums[2] = m_[3] * x + ny_;
+  }
+  void Changes(int32_t dx, int64_t* changes) const {
+    changes[0] = m_[6] * dx;
+    changes[1] = m_[0] * dx;
+    changes[2] = m_[3] * dx;
+  }
+
+  // At from the sums. The range tests in unsigned arithmetic, one compare each: den in
+  // [2^20, 2^32) and |n| < den 2^14 (n + lim - 1 wraps below 2 lim - 1 exactly then).
+  template <bool kExactDivide = false>
+  static bool FromSums(int64_t den, int64_t nx, int64_t ny, int32_t* x_q16, int32_t* y_q16) {
+    constexpr uint64_t kMin = uint64_t{1} << 20, kMax = uint64_t{1} << 32;
+    if (static_cast<uint64_t>(den) - kMin >= kMax - kMin) return false;
+    const uint64_t lim = static_cast<uint64_t>(den) << 14, span = 2 * lim - 1;
+    if (static_cast<uint64_t>(nx) + (lim - 1) >= span ||
+        static_cast<uint64_t>(ny) + (lim - 1) >= span) {
+      return false;
+    }
     if (kExactDivide) {
       *x_q16 = Exact(nx, den);
       *y_q16 = Exact(ny, den);
