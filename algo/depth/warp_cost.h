@@ -42,12 +42,12 @@ struct WarpSource {
 // PlaneCostRow over x_begin..x_end needs columns RefLanesBegin .. RefLanesEnd - 1 (the spans
 // holding that range, and a last step of 8 pixels ending at the row's end).
 inline int32_t RefLanesBegin(int32_t width, int32_t x_begin) {
-  const int32_t first = x_begin - x_begin % 16 - 16, step = width - 8;
+  const int32_t first = x_begin - x_begin % kAnchorStep - kAnchorStep, step = width - 8;
   const int32_t a = first < step ? first : step;
   return a > 0 ? a : 0;
 }
 inline int32_t RefLanesEnd(int32_t width, int32_t x_end) {
-  return x_end + 17 < width ? x_end + 17 : width;
+  return x_end + kAnchorStep + 1 < width ? x_end + kAnchorStep + 1 : width;
 }
 
 // PlaneHomography::Map along one row y: the same results bit for bit, with one division instead

@@ -1,11 +1,15 @@
 // The plane sweep's span kernel for AVX2 (warp_cost.h; the C reference is dtk::PlaneSpansC in
-// warp_cost.cc): 8 pixels a step in 32-bit lanes. Spans inside the view whose taps stay in one
-// band of rows (most: the positions advance about one pixel per pixel) read each colour
-// channel's tap pairs from one 16-byte window per 128-bit half and row, picked by one byte
-// shuffle, and the census taps from 16-byte windows of the census planes; other steps take their
-// taps from byte shuffles of 32-byte windows of the two rows when they share them, else from
-// scalar loads (AVX2 gathers are slower than those on some cores). Views narrower than a step or
-// too large for 32-bit offsets, and census weights over 31, take the reference.
+// warp_cost.cc): a run of spans a call, 8 pixels a step in 32-bit lanes. The run's spans are
+// tested 8 at a time (BandsOfRun): those inside the view whose taps stay in one band of rows
+// (most: the positions advance about one pixel per pixel) are stepped straight from their
+// anchors, two steps each, inlined in the run's loop; each step reads each colour channel's tap
+// pairs from one 16-byte window per 128-bit half and row, picked by one byte shuffle, the census
+// taps from 16-byte windows of the census planes, and the reference pixels from 32-bit lanes
+// prepared once per row (RefLanes: by the data term for every view, else here per run). Other
+// spans go one by one (AnySpan): their steps take their taps from byte shuffles of 32-byte
+// windows of the two rows when they share them, else from scalar loads (AVX2 gathers are slower
+// than those on some cores). Views narrower than a step or too large for 32-bit offsets, and
+// census weights over 31, take the reference.
 #include "algo/depth/data_term_kernels.h"
 
 #if defined(__x86_64__)
@@ -363,9 +367,8 @@ LB_AVX2 inline __m256i ChannelPairs(const uint8_t* row, int32_t start_lo, int32_
 // row less the band's.
 template <bool kTwoRows, bool kTwoCensus, bool kBiased = false>
 LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, const Consts& k,
-                                                            const Band& band,
-                                                            const int32_t* lanes, __m256i xq,
-                                                            __m256i yq, uint8_t* dst) {
+                                                            const Band& band, const int32_t* lanes,
+                                                            __m256i xq, __m256i yq, uint8_t* dst) {
   const __m256i half = Load(k.c->q8_half.v);
   const __m256i xs = _mm256_srai_epi32(kBiased ? xq : _mm256_add_epi32(xq, half), 8);
   const __m256i ys = _mm256_srai_epi32(kBiased ? yq : _mm256_add_epi32(yq, half), 8);
@@ -697,10 +700,14 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpRun& run, uint8_t* out) 
         continue;
       }
       const int32_t x = run.x0 + kAnchorStep * s;
-      const Band band{
-          r.view + bands.row[i],  r.census_view + bands.crow[i], bands.y[i],           bands.cy[i],
-          (kind & kTwoRows) != 0, (kind & kTwoCensus) != 0,      (kind & kRising) != 0,
-          rl.lanes_stride};
+      const Band band{r.view + bands.row[i],
+                      r.census_view + bands.crow[i],
+                      bands.y[i],
+                      bands.cy[i],
+                      (kind & kTwoRows) != 0,
+                      (kind & kTwoCensus) != 0,
+                      (kind & kRising) != 0,
+                      rl.lanes_stride};
       const __m256i dx = _mm256_set1_epi32(bands.dx[i]), dy = _mm256_set1_epi32(bands.dy[i]);
       const __m256i tx = _mm256_add_epi32(_mm256_mullo_epi32(iota, dx), eight);
       const __m256i ty = _mm256_add_epi32(_mm256_mullo_epi32(iota, dy), eight);

@@ -1,5 +1,6 @@
 // The plane sweep's span kernel for NEON (warp_cost.h; the C reference is dtk::PlaneSpansC in
-// warp_cost.cc), aarch64 and armhf built with NEON, ARMv7 intrinsics only: 8 pixels a step. NEON
+// warp_cost.cc), aarch64 and armhf built with NEON, ARMv7 intrinsics only: a run of spans a call,
+// span by span, 8 pixels a step. NEON
 // has no gathers, so positions, weights and offsets are vector arithmetic, each pixel's taps are
 // scalar loads into small buffers, and the interpolation, differences and census counts are
 // vector arithmetic again. Views narrower than a step or too large for 32-bit offsets, and
