@@ -55,6 +55,7 @@ void DataTerm::Carve(Arena& arena, int32_t width, int32_t height, int32_t views,
     s.luma = arena.Allocate<uint8_t>(static_cast<size_t>(width + 2 * kLumaPad) * kLumaRows);
     s.pixel = arena.Allocate<uint8_t>(static_cast<size_t>(width) + 2);
     s.hsum = arena.Allocate<uint16_t>(static_cast<size_t>(width) * 3 * (views - 1));
+    s.ref_lanes = arena.Allocate<int32_t>(static_cast<size_t>(width) * 4);
   }
   runner_ = &inline_;
   UseSimd(true);
@@ -92,10 +93,11 @@ void DataTerm::CensusOfView(const Scratch& s, int32_t v) {
 }
 
 void DataTerm::PixelCostRow(int32_t view, int32_t y, int32_t disp_q8, int32_t x0, int32_t x1,
-                            uint8_t* out) const {
+                            uint8_t* out, const int32_t* ref_lanes) const {
   const int32_t w = width_;
   if (planes_ != nullptr) {
-    const WarpSource src{images_[reference_], images_[view], census_[reference_], census_[view]};
+    const WarpSource src{images_[reference_], images_[view], census_[reference_],
+                         census_[view],       ref_lanes,     w};
     PlaneCostRow(planes_[view], src, y, params_, invalid_cost_, x0, x1, out, kernels_->plane);
     return;
   }
@@ -122,10 +124,22 @@ void DataTerm::WindowRow(const Scratch& s, int32_t view, int32_t y, int32_t disp
   const int32_t w = width_;
   uint8_t* cost = s.pixel + 1;
   const int32_t c0 = x0 > 0 ? x0 - 1 : 0, c1 = x1 < w ? x1 + 1 : w;
-  PixelCostRow(view, Clamp(y, 0, height_ - 1), disp_q8, c0, c1, cost);
+  const bool lanes = planes_ != nullptr && kernels_->plane_lanes != nullptr;
+  PixelCostRow(view, Clamp(y, 0, height_ - 1), disp_q8, c0, c1, cost,
+               lanes ? s.ref_lanes : nullptr);
   if (x0 == 0) cost[-1] = cost[0];
   if (x1 == w) cost[w] = cost[w - 1];
   kernels_->hsum(cost, x0, x1, hsum);
+}
+
+void DataTerm::PrepareRefLanes(const Scratch& s, int32_t y, int32_t x0, int32_t x1) const {
+  if (planes_ == nullptr || kernels_->plane_lanes == nullptr) return;
+  const int32_t w = width_, row = Clamp(y, 0, height_ - 1);
+  const int32_t c0 = x0 > 0 ? x0 - 1 : 0, c1 = x1 < w ? x1 + 1 : w;  // as WindowRow
+  const int32_t a = RefLanesBegin(w, c0);  // s.ref_lanes is indexed by x: column a at + a
+  kernels_->plane_lanes(images_[reference_].Row(row),
+                        census_[reference_] + static_cast<ptrdiff_t>(row) * 3 * w, w, a,
+                        RefLanesEnd(w, c1), s.ref_lanes + a, w);
 }
 
 void DataTerm::ComputeRect(int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0, int32_t y1,
@@ -157,13 +171,15 @@ void DataTerm::ComputeBand(const Scratch& s, int32_t disp_q8, int32_t x0, int32_
     return s.hsum + (static_cast<size_t>(j) * 3 + static_cast<size_t>((row - y0 + 1) % 3)) * w;
   };
   auto view = [&](int32_t j) { return j < reference_ ? j : j + 1; };
-  for (int32_t j = 0; j < others; ++j) {
-    WindowRow(s, view(j), y0 - 1, disp_q8, x0, x1, ring(j, y0 - 1));
-    WindowRow(s, view(j), y0, disp_q8, x0, x1, ring(j, y0));
+  // Row by row, so the plane sweep prepares each reference row once for every view.
+  for (int32_t r = y0 - 1; r <= y0; ++r) {
+    PrepareRefLanes(s, r, x0, x1);
+    for (int32_t j = 0; j < others; ++j) WindowRow(s, view(j), r, disp_q8, x0, x1, ring(j, r));
   }
   const uint16_t* rows[3 * 15];
   const size_t row_bytes = static_cast<size_t>(3) * (x1 - x0);
   for (int32_t y = y0; y < y1; ++y) {
+    PrepareRefLanes(s, y + 1, x0, x1);
     for (int32_t j = 0; j < others; ++j) {
       WindowRow(s, view(j), y + 1, disp_q8, x0, x1, ring(j, y + 1));
       // The views' next rows are far apart (a whole view each), so the hardware prefetcher

@@ -79,13 +79,18 @@ class DataTerm {
  private:
   // One worker's rings.
   struct Scratch {
-    uint8_t* luma = nullptr;   // 5 rows of one view's luma (+/-128), 2 replicated pixels a side
-    uint8_t* pixel = nullptr;  // one row of pixel costs, 1 replicated pixel a side
-    uint16_t* hsum = nullptr;  // per other view, 3 rows of horizontal 3-sums
+    uint8_t* luma = nullptr;       // 5 rows of one view's luma (+/-128), 2 replicated pixels a side
+    uint8_t* pixel = nullptr;      // one row of pixel costs, 1 replicated pixel a side
+    uint16_t* hsum = nullptr;      // per other view, 3 rows of horizontal 3-sums
+    int32_t* ref_lanes = nullptr;  // plane sweep: the reference row as the kernel's lanes
   };
   // Pixel costs of columns x0..x1-1 of row y (out indexed by x).
-  void PixelCostRow(int32_t view, int32_t y, int32_t disp_q8, int32_t x0, int32_t x1,
-                    uint8_t* out) const;
+  // ref_lanes: the plane sweep's prepared reference row (PrepareRefLanes), or nullptr.
+  void PixelCostRow(int32_t view, int32_t y, int32_t disp_q8, int32_t x0, int32_t x1, uint8_t* out,
+                    const int32_t* ref_lanes = nullptr) const;
+  // The plane sweep: reference row y's lanes (warp_cost.h: RefLanes) into s.ref_lanes for the
+  // columns every view's WindowRow(y, x0, x1) reads, when the kernel wants them.
+  void PrepareRefLanes(const Scratch& s, int32_t y, int32_t x0, int32_t x1) const;
   void WindowRow(const Scratch& s, int32_t view, int32_t y, int32_t disp_q8, int32_t x0, int32_t x1,
                  uint16_t* hsum) const;
   void CensusOfView(const Scratch& s, int32_t view);

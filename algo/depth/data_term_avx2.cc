@@ -217,8 +217,9 @@ constexpr SelectRowFn kAvx2ByKeep[kMaxBest] = {
 }  // namespace
 
 const DataTerm::Kernels* Avx2Kernels() {
-  static constexpr DataTerm::Kernels kAvx2 = {CensusRowAvx2, CostRowAvx2, HSumRowAvx2,
-                                              SelectByKeep<kAvx2ByKeep>, PlaneSpansAvx2};
+  static constexpr DataTerm::Kernels kAvx2 = {CensusRowAvx2,  CostRowAvx2,
+                                              HSumRowAvx2,    SelectByKeep<kAvx2ByKeep>,
+                                              PlaneSpansAvx2, PlaneLanesAvx2};
   return __builtin_cpu_supports("avx2") ? &kAvx2 : nullptr;
 }
 

@@ -22,7 +22,12 @@ struct DataTerm::Kernels {
   void (*hsum)(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum);
   void (*select)(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
                  uint16_t* out);
-  PlaneSpanFn plane;  // the plane sweep's pixel costs, a batch of spans (warp_cost.h)
+  PlaneSpanFn plane;  // the plane sweep's pixel costs, a run of spans (warp_cost.h)
+  // The reference row's lanes for `plane` (warp_cost.h: RefLanes) of columns x0..x1-1 of the
+  // row at ref / cref (width columns), column x0 at lanes[0]; nullptr when `plane` does not
+  // read them.
+  void (*plane_lanes)(const uint8_t* ref, const uint8_t* cref, int32_t width, int32_t x0,
+                      int32_t x1, int32_t* lanes, ptrdiff_t stride);
 };
 
 namespace dtk {
@@ -54,14 +59,16 @@ void CostRowCSsse3(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, 
 void CostRowCAvx2(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, const uint8_t* cimg,
                   ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc, int32_t cw, uint8_t* out);
 #endif
-// The plane sweep's span kernels: the C reference (warp_cost.cc), AVX2 (warp_cost_avx2.cc, the
-// caller checks the CPU) and NEON (warp_cost_neon.cc).
-void PlaneSpansC(const WarpRow& row, const WarpSpanJob* jobs, int32_t count, uint8_t* out);
+// The plane sweep's span kernels, one run of spans a call: the C reference (warp_cost.cc), AVX2
+// (warp_cost_avx2.cc, the caller checks the CPU) and NEON (warp_cost_neon.cc).
+void PlaneSpansC(const WarpRow& row, const WarpRun& run, uint8_t* out);
 #if defined(__x86_64__)
-void PlaneSpansAvx2(const WarpRow& row, const WarpSpanJob* jobs, int32_t count, uint8_t* out);
+void PlaneSpansAvx2(const WarpRow& row, const WarpRun& run, uint8_t* out);
+void PlaneLanesAvx2(const uint8_t* ref, const uint8_t* cref, int32_t width, int32_t x0, int32_t x1,
+                    int32_t* lanes, ptrdiff_t stride);
 #endif
 #if defined(__ARM_NEON) || defined(__arm__)
-void PlaneSpansNeon(const WarpRow& row, const WarpSpanJob* jobs, int32_t count, uint8_t* out);
+void PlaneSpansNeon(const WarpRow& row, const WarpRun& run, uint8_t* out);
 #endif
 void HSumRowC(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum);
 void SelectRowC(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1, uint16_t* out);

@@ -156,8 +156,8 @@ constexpr SelectRowFn kNeonByKeep[kMaxBest] = {
 }  // namespace
 
 const DataTerm::Kernels* NeonKernels() {
-  static constexpr DataTerm::Kernels kNeon = {CensusRowNeon, CostRowNeon, HSumRowNeon,
-                                              SelectByKeep<kNeonByKeep>, PlaneSpansNeon};
+  static constexpr DataTerm::Kernels kNeon = {
+      CensusRowNeon, CostRowNeon, HSumRowNeon, SelectByKeep<kNeonByKeep>, PlaneSpansNeon, nullptr};
   return &kNeon;
 }
 

@@ -76,17 +76,21 @@ void SpanPositions(int32_t ax, int32_t ay, int32_t bx, int32_t by, int32_t n, in
 
 namespace dtk {
 
-void PlaneSpansC(const WarpRow& row, const WarpSpanJob* jobs, int32_t count, uint8_t* out) {
-  for (const WarpSpanJob* job = jobs; job < jobs + count; ++job) {
-    if (SpanOutsideView(row, *job)) {
-      FillInvalid(row, *job, out);
+void PlaneSpansC(const WarpRow& row, const WarpRun& run, uint8_t* out) {
+  int32_t first = 0, end = 0;
+  RunSpans(run, &first, &end);
+  for (int32_t k = first; k < end; ++k) {
+    const WarpSpanJob job = RunSpan(run, k);
+    if (job.lo >= job.hi) continue;
+    if (SpanOutsideView(row, job)) {
+      FillInvalid(row, job, out);
       continue;
     }
     int32_t xq[kAnchorStep + 1], yq[kAnchorStep + 1];
-    SpanPositions(job->ax, job->ay, job->bx, job->by, job->n, xq, yq);
-    for (int32_t x = job->lo; x < job->hi; ++x) {
-      out[x] = SampleCost(row, row.ref + 3 * x, Census(row.cref, row.width, x), xq[x - job->x0],
-                          yq[x - job->x0]);
+    SpanPositions(job.ax, job.ay, job.bx, job.by, job.n, xq, yq);
+    for (int32_t x = job.lo; x < job.hi; ++x) {
+      out[x] = SampleCost(row, row.ref + 3 * x, Census(row.cref, row.width, x), xq[x - job.x0],
+                          yq[x - job.x0]);
     }
   }
 }
@@ -116,7 +120,10 @@ void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
                     src.ref.height,
                     params.color_trunc,
                     params.census_weight,
-                    static_cast<uint8_t>(invalid_cost)};
+                    static_cast<uint8_t>(invalid_cost),
+                    src.ref_lanes,
+                    0,
+                    src.lanes_stride};
   int32_t first = x_begin - x_begin % kAnchorStep;
   if (first == w - 1 && first > 0) first -= kAnchorStep;  // w - 1 ends the span before it
   // A span's end anchor is the next one's start: one Map per span.
@@ -127,32 +134,76 @@ void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
   auto map = [&](int32_t x, int32_t* x_q16, int32_t* y_q16) {
     return row_map.At<kExactDivide>(x, x_q16, y_q16);
   };
-  int32_t ax = 0, ay = 0;
-  bool a_ok = map(first, &ax, &ay);
-  WarpSpanJob batch[kSpanBatch];
-  int32_t batched = 0;
-  for (int32_t x0 = first, end = 0; x0 < x_end; x0 = end) {
-    const int32_t x1 = x0 + kAnchorStep < w - 1 ? x0 + kAnchorStep : w - 1;
-    end = x1 == w - 1 ? w : x1;  // the last span keeps its end anchor
-    const int32_t lo = x0 > x_begin ? x0 : x_begin, hi = end < x_end ? end : x_end;
-    int32_t bx = ax, by = ay;
-    const bool b_ok = x1 == x0 ? a_ok : map(x1, &bx, &by);
-    // A span outside the view is the kernel's to find (SpanOutsideView): not worth a test on
-    // every span here.
-    if (a_ok && b_ok) {
-      batch[batched++] = WarpSpanJob{x0, x1 - x0, ax, ay, bx, by, lo, hi};
-      if (batched == kSpanBatch) {
-        span(row, batch, batched, out);
-        batched = 0;
-      }
-    } else {
-      for (int32_t x = lo; x < hi; ++x) out[x] = row.invalid;
+  // Spans x0 = first + kAnchorStep k up to x_end, the last one ending on column w - 1; each
+  // chunk of up to kRunSpans spans maps its anchors in one tight loop, then goes to the kernel as
+  // one run, or, where a plane has no map at some anchor, as the runs between (the spans
+  // touching that anchor cost `invalid`).
+  int32_t ax[kRunSpans + 1], ay[kRunSpans + 1];
+  bool ok[kRunSpans + 1];
+  ok[0] = map(first, &ax[0], &ay[0]);
+  for (int32_t x0 = first; x0 < x_end;) {
+    // Spans of this chunk: while the span starting at x0 + kAnchorStep k begins before x_end.
+    const int32_t left = (x_end - x0 + kAnchorStep - 1) / kAnchorStep;
+    const int32_t count = left < kRunSpans ? left : kRunSpans;
+    bool all = ok[0];
+    // The anchors on the grid before w - 1, their sums stepped along the row.
+    const int32_t grid = (w - 2 - x0) / kAnchorStep;  // x0 + kAnchorStep k < w - 1 for k <= grid
+    const int32_t stepped = count < grid ? count : grid;
+    int64_t sums[3], changes[3];
+    row_map.Sums(x0, sums);
+    row_map.Changes(kAnchorStep, changes);
+    for (int32_t k = 1; k <= stepped; ++k) {
+      sums[0] += changes[0];
+      sums[1] += changes[1];
+      sums[2] += changes[2];
+      ok[k] = PlaneRowMap::FromSums<kExactDivide>(sums[0], sums[1], sums[2], &ax[k], &ay[k]);
+      all &= ok[k];
     }
-    ax = bx;
-    ay = by;
-    a_ok = b_ok;
+    int32_t k = stepped + 1;
+    int32_t spans = k - 1, last = x0 + kAnchorStep * spans;
+    if (k <= count) {
+      // The row's last span ends on column w - 1 (w - 1 - x0 <= kAnchorStep k; a row of one
+      // column has a single anchor, start and end).
+      last = w - 1;
+      spans = k;
+      ok[k] = last == x0 + kAnchorStep * (k - 1) ? ok[k - 1] : map(last, &ax[k], &ay[k]);
+      if (last == x0 + kAnchorStep * (k - 1)) {
+        ax[k] = ax[k - 1];
+        ay[k] = ay[k - 1];
+      }
+      all &= ok[k];
+    }
+    const int32_t end = last == w - 1 ? w : last;  // columns x0 .. end - 1 are this chunk's
+    const int32_t lo = x0 > x_begin ? x0 : x_begin, hi = end < x_end ? end : x_end;
+    if (all) {
+      span(row, WarpRun{ax, ay, x0, spans, last, lo, hi}, out);
+    } else {
+      // Runs of spans whose anchors all map; the others invalid.
+      for (int32_t s = 0; s < spans;) {
+        const int32_t sx = x0 + kAnchorStep * s;
+        if (!ok[s] || !ok[s + 1]) {
+          const int32_t se = s + 1 == spans ? end : sx + kAnchorStep;
+          for (int32_t x = sx > lo ? sx : lo; x < se && x < hi; ++x) out[x] = row.invalid;
+          ++s;
+          continue;
+        }
+        int32_t e = s + 1;
+        while (e < spans && ok[e + 1]) ++e;
+        const int32_t run_last = e == spans ? last : x0 + kAnchorStep * e;
+        const int32_t run_end = e == spans ? end : run_last;
+        const int32_t run_lo = sx > lo ? sx : lo, run_hi = run_end < hi ? run_end : hi;
+        if (run_lo < run_hi) {
+          span(row, WarpRun{ax + s, ay + s, sx, e - s, run_last, run_lo, run_hi}, out);
+        }
+        s = e;
+      }
+    }
+    if (end >= x_end) break;
+    x0 = last;
+    ax[0] = ax[spans];
+    ay[0] = ay[spans];
+    ok[0] = ok[spans];
   }
-  if (batched > 0) span(row, batch, batched, out);
 }
 
 }  // namespace lb

@@ -29,7 +29,26 @@ struct WarpSource {
   ConstImageU8 ref, view;
   const uint8_t* census_ref = nullptr;
   const uint8_t* census_view = nullptr;
+  // Optional: the row's reference pixels as the kernel's lanes (RefLanes), prepared by the
+  // caller once for the row and reused for every view; nullptr: the kernel reads ref itself.
+  const int32_t* ref_lanes = nullptr;
+  ptrdiff_t lanes_stride = 0;
 };
+
+// The reference row as 32-bit lanes, the form a SIMD kernel subtracts and compares in: four
+// planes `stride` int32 apart, R, G, B and the 24-bit census (as Census() in warp_cost.cc),
+// column x at index x - x0. The data term fills them once per row (a per-worker buffer) instead
+// of every view's kernel unpacking the same bytes again. A kernel reading them for a
+// PlaneCostRow over x_begin..x_end needs columns RefLanesBegin .. RefLanesEnd - 1 (the spans
+// holding that range, and a last step of 8 pixels ending at the row's end).
+inline int32_t RefLanesBegin(int32_t width, int32_t x_begin) {
+  const int32_t first = x_begin - x_begin % kAnchorStep - kAnchorStep, step = width - 8;
+  const int32_t a = first < step ? first : step;
+  return a > 0 ? a : 0;
+}
+inline int32_t RefLanesEnd(int32_t width, int32_t x_end) {
+  return x_end + kAnchorStep + 1 < width ? x_end + kAnchorStep + 1 : width;
+}
 
 // PlaneHomography::Map along one row y: the same results bit for bit, with one division instead
 // of two 64-bit ones (a library call each on 32-bit ARM, where PlaneCostRow uses this). The
@@ -45,12 +64,33 @@ class PlaneRowMap {
   // the estimate; the row's constant terms are still summed once.
   template <bool kExactDivide = false>
   bool At(int32_t x, int32_t* x_q16, int32_t* y_q16) const {
-    const int64_t den = m_[6] * x + den_;
-    const int64_t nx = m_[0] * x + nx_;
-    const int64_t ny = m_[3] * x + ny_;
-    if (den < (int64_t{1} << 20) || den >= (int64_t{1} << 32)) return false;
-    const int64_t lim = den << 14;
-    if (nx >= lim || -nx >= lim || ny >= lim || -ny >= lim) return false;
+    return FromSums<kExactDivide>(m_[6] * x + den_, m_[0] * x + nx_, m_[3] * x + ny_, x_q16, y_q16);
+  }
+
+  // The row's denominator and numerators at column x, and their change over dx columns: a
+  // caller stepping along the row adds the changes (the same integers as At's products).
+  void Sums(int32_t x, int64_t* sums) const {
+    sums[0] = m_[6] * x + den_;
+    sums[1] = m_[0] * x + nx_;
+    sums[2] = m_[3] * x + ny_;
+  }
+  void Changes(int32_t dx, int64_t* changes) const {
+    changes[0] = m_[6] * dx;
+    changes[1] = m_[0] * dx;
+    changes[2] = m_[3] * dx;
+  }
+
+  // At from the sums. The range tests in unsigned arithmetic, one compare each: den in
+  // [2^20, 2^32) and |n| < den 2^14 (n + lim - 1 wraps below 2 lim - 1 exactly then).
+  template <bool kExactDivide = false>
+  static bool FromSums(int64_t den, int64_t nx, int64_t ny, int32_t* x_q16, int32_t* y_q16) {
+    constexpr uint64_t kMin = uint64_t{1} << 20, kMax = uint64_t{1} << 32;
+    if (static_cast<uint64_t>(den) - kMin >= kMax - kMin) return false;
+    const uint64_t lim = static_cast<uint64_t>(den) << 14, span = 2 * lim - 1;
+    if (static_cast<uint64_t>(nx) + (lim - 1) >= span ||
+        static_cast<uint64_t>(ny) + (lim - 1) >= span) {
+      return false;
+    }
     if (kExactDivide) {
       *x_q16 = Exact(nx, den);
       *y_q16 = Exact(ny, den);
@@ -95,6 +135,9 @@ struct WarpRow {
   const uint8_t* cref = nullptr;         // its census: three planes of `width` bytes
   int32_t width = 0, height = 0, trunc = 0, cw = 0;
   uint8_t invalid = 255;
+  const int32_t* ref_lanes = nullptr;  // optional (WarpSource), indexed from lanes_x0
+  int32_t lanes_x0 = 0;
+  ptrdiff_t lanes_stride = 0;
 };
 
 // The view positions of one span and the columns wanted from it: pixels x0 .. x0 + n (n <=
@@ -122,17 +165,50 @@ inline void FillInvalid(const WarpRow& r, const WarpSpanJob& job, uint8_t* out) 
   for (int32_t x = job.lo; x < job.hi; ++x) out[x] = r.invalid;
 }
 
-// Spans are handed to a kernel in batches of up to kSpanBatch (its set-up paid once per batch):
-// 48 spans hold a 768-pixel row, so a depth row at 640 is one batch (a batch of 16 made the
-// kernel's set-up about 3 % of its instructions on the handheld bench).
-inline constexpr int32_t kSpanBatch = 48;
+// A run of neighbouring spans along one row, each inner anchor shared by the spans either side
+// of it, as PlaneCostRow hands them to a kernel: anchors k = 0..count (x_q16[k], y_q16[k], the
+// exact Map) at reference columns x0 + kAnchorStep k, but the last, at column `last`: x0 +
+// kAnchorStep count, or the row's last column when the run ends the row (a shorter span, whose
+// end column is computed too). Columns lo..hi-1 are computed (x0 <= lo < hi <= last + 1). One
+// call per run, not per span: the kernel sets itself up once and can test many spans at once.
+struct WarpRun {
+  const int32_t* x_q16;
+  const int32_t* y_q16;
+  int32_t x0, count, last, lo, hi;
+};
 
-// A span kernel: the pixel costs of columns lo..hi-1 of each of `count` spans into out (indexed
-// by x). The C reference is dtk::PlaneSpansC (warp_cost.cc); the SIMD twins (warp_cost_avx2.cc,
+// At most this many spans per run (PlaneCostRow's anchors live on its stack): 48 spans hold a
+// 768-pixel row, so a depth row at 640 is one run.
+inline constexpr int32_t kRunSpans = 48;
+
+// Span k of a run as a job, its columns clipped to lo..hi (empty when the span lies outside).
+inline WarpSpanJob RunSpan(const WarpRun& run, int32_t k) {
+  const int32_t x0 = run.x0 + kAnchorStep * k;
+  const bool inner = k + 1 < run.count;
+  const int32_t n = inner ? kAnchorStep : run.last - x0;
+  const int32_t end = inner ? x0 + kAnchorStep : run.last + 1;
+  return WarpSpanJob{x0,
+                     n,
+                     run.x_q16[k],
+                     run.y_q16[k],
+                     run.x_q16[k + 1],
+                     run.y_q16[k + 1],
+                     x0 > run.lo ? x0 : run.lo,
+                     end < run.hi ? end : run.hi};
+}
+
+// The spans of a run that hold columns lo..hi-1 (first, end): the others are not looked at.
+inline void RunSpans(const WarpRun& run, int32_t* first, int32_t* end) {
+  const int32_t a = (run.lo - run.x0) / kAnchorStep, b = (run.hi - 1 - run.x0) / kAnchorStep + 1;
+  *first = a < run.count - 1 ? a : run.count - 1;
+  *end = b < run.count ? b : run.count;
+}
+
+// A span kernel: the pixel costs of columns lo..hi-1 of a run into out (indexed by x). The C
+// reference is dtk::PlaneSpansC (warp_cost.cc); the SIMD twins (warp_cost_avx2.cc,
 // warp_cost_neon.cc) give the same bytes, and the data term picks one through its kernel table
 // (data_term_kernels.h).
-using PlaneSpanFn = void (*)(const WarpRow& row, const WarpSpanJob* jobs, int32_t count,
-                             uint8_t* out);
+using PlaneSpanFn = void (*)(const WarpRow& row, const WarpRun& run, uint8_t* out);
 
 // Pixel costs 0..255 of columns x0..x1-1 of reference row y (out indexed by x) against the view
 // seen through h (invalid_cost where a sample needs a pixel outside the view, or the plane has no

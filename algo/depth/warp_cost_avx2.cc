@@ -1,11 +1,15 @@
 // The plane sweep's span kernel for AVX2 (warp_cost.h; the C reference is dtk::PlaneSpansC in
-// warp_cost.cc): 8 pixels a step in 32-bit lanes. Spans inside the view whose taps stay in one
-// band of rows (most: the positions advance about one pixel per pixel) read each colour
-// channel's tap pairs from one 16-byte window per 128-bit half and row, picked by one byte
-// shuffle, and the census taps from 16-byte windows of the census planes; other steps take their
-// taps from byte shuffles of 32-byte windows of the two rows when they share them, else from
-// scalar loads (AVX2 gathers are slower than those on some cores). Views narrower than a step or
-// too large for 32-bit offsets, and census weights over 31, take the reference.
+// warp_cost.cc): a run of spans a call, 8 pixels a step in 32-bit lanes. The run's spans are
+// tested 8 at a time (BandsOfRun): those inside the view whose taps stay in one band of rows
+// (most: the positions advance about one pixel per pixel) are stepped straight from their
+// anchors, two steps each, inlined in the run's loop; each step reads each colour channel's tap
+// pairs from one 16-byte window per 128-bit half and row, picked by one byte shuffle, the census
+// taps from 16-byte windows of the census planes, and the reference pixels from 32-bit lanes
+// prepared once per row (RefLanes: by the data term for every view, else here per run). Other
+// spans go one by one (AnySpan): their steps take their taps from byte shuffles of 32-byte
+// windows of the two rows when they share them, else from scalar loads (AVX2 gathers are slower
+// than those on some cores). Views narrower than a step or too large for 32-bit offsets, and
+// census weights over 31, take the reference.
 #include "algo/depth/data_term_kernels.h"
 
 #if defined(__x86_64__)
@@ -108,9 +112,20 @@ LB_AVX2 inline void Pairs(__m256i ab0, __m256i ab2, __m256i* pairs) {
 // half up to Q0. Census: the nearest tap's 24 bits against the reference's, counted by nibble
 // lookups of weight * bits (<= 31 * 4 per nibble, <= 248 per byte), summed in 16 then 32 bits.
 // Cost min(min(|dRGB|, trunc) + weighted bits, 255).
+// c and m point at kC and kMasks through an opaque copy (Laundered), so the compiler reads
+// the broadcast constants as memory operands instead of rebuilding each from an immediate in
+// every step (three instructions each).
 struct Consts {
   __m256i xmax, ymax, wm2, hm2, stride, census_row, trunc, invalid, lut, last_window;
+  const Constants* c;
+  const Masks* m;
 };
+
+template <typename T>
+inline const T* Laundered(const T* p) {
+  asm("" : "+r"(p));
+  return p;
+}
 
 // Scalar loads: 8 bytes per tap row, the top one read forward (its 2 extra bytes lie in the row
 // below) and the bottom one from 2 bytes back (in the row above), so every read stays inside the
@@ -185,21 +200,24 @@ LB_AVX2 inline __attribute__((always_inline)) void WindowTaps(const WarpRow& r, 
 }
 
 // The costs of pixels x..x+7 from their truncated colour differences ad and their census taps.
-LB_AVX2 inline __attribute__((always_inline)) __m256i CostFromTaps(const WarpRow& r,
-                                                                   const Consts& k, int32_t x,
-                                                                   __m256i ad, __m256i census) {
-  const __m256i ref_bits =
-      _mm256_or_si256(_mm256_or_si256(_mm256_slli_epi32(Widen8(r.cref + x), 16),
-                                      _mm256_slli_epi32(Widen8(r.cref + r.width + x), 8)),
-                      Widen8(r.cref + 2 * r.width + x));
+// The reference's census of pixels x..x+7, 24 bits a lane.
+LB_AVX2 inline __m256i RefCensus(const WarpRow& r, int32_t x) {
+  return _mm256_or_si256(_mm256_or_si256(_mm256_slli_epi32(Widen8(r.cref + x), 16),
+                                         _mm256_slli_epi32(Widen8(r.cref + r.width + x), 8)),
+                         Widen8(r.cref + 2 * r.width + x));
+}
+
+LB_AVX2 inline __attribute__((always_inline)) __m256i CostFromTaps(const Consts& k, __m256i ad,
+                                                                   __m256i census,
+                                                                   __m256i ref_bits) {
   const __m256i bits = _mm256_xor_si256(census, ref_bits);
-  const __m256i nib = Load(kC.bytes15.v);
+  const __m256i nib = Load(k.c->bytes15.v);
   const __m256i count8 = _mm256_add_epi8(
       _mm256_shuffle_epi8(k.lut, _mm256_and_si256(bits, nib)),
       _mm256_shuffle_epi8(k.lut, _mm256_and_si256(_mm256_srli_epi16(bits, 4), nib)));
   const __m256i ham =
-      _mm256_madd_epi16(_mm256_maddubs_epi16(count8, Load(kC.ones8.v)), Load(kC.ones16.v));
-  return _mm256_min_epi32(_mm256_add_epi32(ad, ham), Load(kC.max_cost.v));
+      _mm256_madd_epi16(_mm256_maddubs_epi16(count8, Load(k.c->ones8.v)), Load(k.c->ones16.v));
+  return _mm256_min_epi32(_mm256_add_epi32(ad, ham), Load(k.c->max_cost.v));
 }
 
 // The costs of pixels x..x+7 from their taps, weights [256 - fx, fx] and row fractions fy.
@@ -215,11 +233,11 @@ LB_AVX2 inline __attribute__((always_inline)) __m256i Cost(const WarpRow& r, con
     const __m256i bottom = _mm256_madd_epi16(t.bottom[c], wx);
     const __m256i s = _mm256_add_epi32(_mm256_slli_epi32(top, 8),
                                        _mm256_mullo_epi32(_mm256_sub_epi32(bottom, top), fy));
-    const __m256i v = _mm256_srai_epi32(_mm256_add_epi32(s, Load(kC.half.v)), 16);
-    const __m256i rc = _mm256_shuffle_epi8(ref, Load(kMasks.ref[c]));
+    const __m256i v = _mm256_srai_epi32(_mm256_add_epi32(s, Load(k.c->half.v)), 16);
+    const __m256i rc = _mm256_shuffle_epi8(ref, Load(k.m->ref[c]));
     ad = _mm256_add_epi32(ad, _mm256_abs_epi32(_mm256_sub_epi32(rc, v)));
   }
-  return CostFromTaps(r, k, x, _mm256_min_epi32(ad, k.trunc), t.census);
+  return CostFromTaps(k, _mm256_min_epi32(ad, k.trunc), t.census, RefCensus(r, x));
 }
 
 // 8 costs 0..255: two packs leave pixels 0-3 in dword 0 and 4-7 in dword 4, joined for one store.
@@ -236,8 +254,8 @@ LB_AVX2 inline void Store8(uint8_t* out, __m256i cost) {
 LB_AVX2 void Step(const WarpRow& r, const Consts& k, int32_t x, __m256i xq, __m256i yq,
                   uint8_t* dst) {
   const __m256i zero = _mm256_setzero_si256();
-  const __m256i xs = _mm256_srai_epi32(_mm256_add_epi32(xq, Load(kC.q8_half.v)), 8);
-  const __m256i ys = _mm256_srai_epi32(_mm256_add_epi32(yq, Load(kC.q8_half.v)), 8);
+  const __m256i xs = _mm256_srai_epi32(_mm256_add_epi32(xq, Load(k.c->q8_half.v)), 8);
+  const __m256i ys = _mm256_srai_epi32(_mm256_add_epi32(yq, Load(k.c->q8_half.v)), 8);
   const __m256i bad = _mm256_or_si256(
       _mm256_or_si256(_mm256_cmpgt_epi32(zero, xs), _mm256_cmpgt_epi32(xs, k.xmax)),
       _mm256_or_si256(_mm256_cmpgt_epi32(zero, ys), _mm256_cmpgt_epi32(ys, k.ymax)));
@@ -248,7 +266,7 @@ LB_AVX2 void Step(const WarpRow& r, const Consts& k, int32_t x, __m256i xq, __m2
   const __m256i fx = _mm256_sub_epi32(xc, _mm256_slli_epi32(xb, 8));
   const __m256i fy = _mm256_sub_epi32(yc, _mm256_slli_epi32(yb, 8));
   // The nearest tap: the right (lower) one from a fraction of 128 on.
-  const __m256i c127 = Load(kC.near.v);
+  const __m256i c127 = Load(k.c->near.v);
   const __m256i nx = _mm256_sub_epi32(xb, _mm256_cmpgt_epi32(fx, c127));
   const __m256i ny = _mm256_sub_epi32(yb, _mm256_cmpgt_epi32(fy, c127));
   // The positions are monotone along a step (WarpSpan's lie between its anchors), so the first
@@ -278,7 +296,7 @@ LB_AVX2 void Step(const WarpRow& r, const Consts& k, int32_t x, __m256i xq, __m2
     ScalarTaps(r, k, xb, yb, nx, ny, &t);
   }
   const __m256i wx =
-      _mm256_add_epi32(_mm256_sub_epi32(Load(kC.one.v), fx), _mm256_slli_epi32(fx, 16));
+      _mm256_add_epi32(_mm256_sub_epi32(Load(k.c->one.v), fx), _mm256_slli_epi32(fx, 16));
   Store8(dst, _mm256_blendv_epi8(Cost(r, k, x, t, wx, fy), k.invalid, bad));
 }
 
@@ -294,6 +312,7 @@ struct Band {
   bool two_rows;        // some pixels' tap rows are one lower
   bool two_census;      // some pixels' census rows are one lower
   bool rising;          // positions rise along the span: a step's first lane has its least column
+  ptrdiff_t lanes_stride;  // the reference lanes' (WarpRow::ref_lanes)
 };
 
 // The caller checks r.width >= 16 once. Positions |.| < 2^30, so differences fit 32 bits; a
@@ -343,17 +362,23 @@ LB_AVX2 inline __m256i ChannelPairs(const uint8_t* row, int32_t start_lo, int32_
 // by channel, so the taps need no more registers than one channel's.
 // kTwoRows, kTwoCensus: the span's band.two_rows and two_census, fixed per instance so the
 // step has no branch on them.
-template <bool kTwoRows, bool kTwoCensus>
+// kBiased: the positions come with the Q8 rounding's half (128) already added. Without
+// kTwoRows every pixel's upper tap row is the band's (BandOf), so its row fraction is its Q8
+// row less the band's.
+template <bool kTwoRows, bool kTwoCensus, bool kBiased = false>
 LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, const Consts& k,
-                                                            const Band& band, int32_t x, __m256i xq,
-                                                            __m256i yq, uint8_t* dst) {
-  const __m256i xs = _mm256_srai_epi32(_mm256_add_epi32(xq, Load(kC.q8_half.v)), 8);
-  const __m256i ys = _mm256_srai_epi32(_mm256_add_epi32(yq, Load(kC.q8_half.v)), 8);
+                                                            const Band& band, const int32_t* lanes,
+                                                            __m256i xq, __m256i yq, uint8_t* dst) {
+  const __m256i half = Load(k.c->q8_half.v);
+  const __m256i xs = _mm256_srai_epi32(kBiased ? xq : _mm256_add_epi32(xq, half), 8);
+  const __m256i ys = _mm256_srai_epi32(kBiased ? yq : _mm256_add_epi32(yq, half), 8);
   const __m256i xb = _mm256_min_epi32(_mm256_srai_epi32(xs, 8), k.wm2);
-  const __m256i yb = _mm256_min_epi32(_mm256_srai_epi32(ys, 8), k.hm2);
+  const __m256i yb =
+      kTwoRows ? _mm256_min_epi32(_mm256_srai_epi32(ys, 8), k.hm2) : _mm256_set1_epi32(band.y);
   const __m256i fx = _mm256_sub_epi32(xs, _mm256_slli_epi32(xb, 8));
-  const __m256i fy = _mm256_sub_epi32(ys, _mm256_slli_epi32(yb, 8));
-  const __m256i nx = _mm256_sub_epi32(xb, _mm256_cmpgt_epi32(fx, Load(kC.near.v)));
+  const __m256i fy =
+      _mm256_sub_epi32(ys, kTwoRows ? _mm256_slli_epi32(yb, 8) : _mm256_set1_epi32(band.y * 256));
+  const __m256i nx = _mm256_sub_epi32(xb, _mm256_cmpgt_epi32(fx, Load(k.c->near.v)));
   // Each half's least pair column: its first lane when the positions rise, else its last.
   const __m256i least =
       band.rising ? _mm256_shuffle_epi32(xb, 0x00) : _mm256_shuffle_epi32(xb, 0xff);
@@ -362,12 +387,9 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
   const int32_t start_lo = _mm256_cvtsi256_si32(start), start_hi = _mm256_extract_epi32(start, 4);
   const __m256i d = _mm256_sub_epi32(_mm256_add_epi32(xb, _mm256_add_epi32(xb, xb)), start);
   const __m256i idx =
-      _mm256_add_epi32(_mm256_add_epi32(d, _mm256_slli_epi32(d, 16)), Load(kC.pair_idx[0].v));
+      _mm256_add_epi32(_mm256_add_epi32(d, _mm256_slli_epi32(d, 16)), Load(k.c->pair_idx[0].v));
   const __m256i wx =
-      _mm256_add_epi32(_mm256_sub_epi32(Load(kC.one.v), fx), _mm256_slli_epi32(fx, 16));
-  const __m128i ref_lo = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r.ref + 3 * x));
-  const __m128i ref_hi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(r.ref + 3 * x + 8));
-  const __m256i ref = _mm256_inserti128_si256(_mm256_castsi128_si256(ref_lo), ref_hi, 1);
+      _mm256_add_epi32(_mm256_sub_epi32(Load(k.c->one.v), fx), _mm256_slli_epi32(fx, 16));
   const __m256i lower =
       kTwoRows ? _mm256_cmpeq_epi32(yb, _mm256_set1_epi32(band.y + 1)) : _mm256_setzero_si256();
   __m256i ad = _mm256_setzero_si256();
@@ -383,8 +405,9 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
     const __m256i t = _mm256_madd_epi16(top, wx), b = _mm256_madd_epi16(bottom, wx);
     const __m256i sum =
         _mm256_add_epi32(_mm256_slli_epi32(t, 8), _mm256_mullo_epi32(_mm256_sub_epi32(b, t), fy));
-    const __m256i v = _mm256_srai_epi32(_mm256_add_epi32(sum, Load(kC.half.v)), 16);
-    const __m256i rc = _mm256_shuffle_epi8(ref, Load(kMasks.ref[c]));
+    const __m256i v = _mm256_srai_epi32(_mm256_add_epi32(sum, Load(k.c->half.v)), 16);
+    const __m256i rc =
+        _mm256_loadu_si256(reinterpret_cast<const __m256i*>(lanes + c * band.lanes_stride));
     ad = _mm256_add_epi32(ad, _mm256_abs_epi32(_mm256_sub_epi32(rc, v)));
   }
   ad = _mm256_min_epi32(ad, k.trunc);
@@ -397,7 +420,7 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
   const ptrdiff_t census_row = static_cast<ptrdiff_t>(3) * r.width;
   for (int32_t p = 0; p < 3; ++p) {
     const int32_t shift = 8 * (2 - p);  // plane 0 holds the top byte
-    const __m256i pidx = _mm256_or_si256(_mm256_slli_epi32(e, shift), Load(kC.census_idx[p].v));
+    const __m256i pidx = _mm256_or_si256(_mm256_slli_epi32(e, shift), Load(k.c->census_idx[p].v));
     const uint8_t* plane = band.crow + p * r.width + cstart;
     census = _mm256_or_si256(census, _mm256_shuffle_epi8(Broadcast16(plane), pidx));
     if (kTwoCensus) {
@@ -406,44 +429,228 @@ LB_AVX2 inline __attribute__((always_inline)) void BandStep(const WarpRow& r, co
     }
   }
   if (kTwoCensus) {
-    const __m256i ny = _mm256_sub_epi32(yb, _mm256_cmpgt_epi32(fy, Load(kC.near.v)));
+    const __m256i ny = _mm256_sub_epi32(yb, _mm256_cmpgt_epi32(fy, Load(k.c->near.v)));
     census =
         _mm256_blendv_epi8(census, census2, _mm256_cmpeq_epi32(ny, _mm256_set1_epi32(band.cy + 1)));
   }
-  Store8(dst, CostFromTaps(r, k, x, ad, census));
+  const __m256i ref_bits =
+      _mm256_loadu_si256(reinterpret_cast<const __m256i*>(lanes + 3 * band.lanes_stride));
+  Store8(dst, CostFromTaps(k, ad, census, ref_bits));
 }
 
 // A step of a span of the band, its instance chosen at run time (partial and short spans).
 LB_AVX2 inline void AnyBandStep(const WarpRow& r, const Consts& k, const Band& band, int32_t x,
                                 __m256i xq, __m256i yq, uint8_t* dst) {
+  const int32_t* lanes = r.ref_lanes + (x - r.lanes_x0);
   if (band.two_rows) {
-    if (band.two_census) return BandStep<true, true>(r, k, band, x, xq, yq, dst);
-    return BandStep<true, false>(r, k, band, x, xq, yq, dst);
+    if (band.two_census) return BandStep<true, true>(r, k, band, lanes, xq, yq, dst);
+    return BandStep<true, false>(r, k, band, lanes, xq, yq, dst);
   }
-  if (band.two_census) return BandStep<false, true>(r, k, band, x, xq, yq, dst);
-  BandStep<false, false>(r, k, band, x, xq, yq, dst);
+  if (band.two_census) return BandStep<false, true>(r, k, band, lanes, xq, yq, dst);
+  BandStep<false, false>(r, k, band, lanes, xq, yq, dst);
 }
 
-// The two steps of a whole span of the band: pixels x..x+7 at (xq0, yq0), x+8..x+15 at (xq1, yq1).
+// The two steps of a whole span of the band: pixels x..x+7 at (q[0], q[1]), x+8..x+15 at (q[2],
+// q[3]) (Q16 positions plus 128), their costs into dst[0..15]. Inlined in the run's loop, one copy
+// per band kind, so a span pays no call and the constants stay put.
 template <bool kTwoRows, bool kTwoCensus>
-LB_AVX2 void BandSpan(const WarpRow& r, const Consts& k, const Band& band, int32_t x,
-                      const __m256i* q, uint8_t* out) {
-  BandStep<kTwoRows, kTwoCensus>(r, k, band, x, q[0], q[1], out + x);
-  BandStep<kTwoRows, kTwoCensus>(r, k, band, x + kLanes, q[2], q[3], out + x + kLanes);
+LB_AVX2 inline __attribute__((always_inline)) void BandSpan(const WarpRow& r, const Consts& k,
+                                                            const Band& band, int32_t x,
+                                                            const __m256i* q, uint8_t* dst) {
+  const int32_t* lanes = r.ref_lanes + (x - r.lanes_x0);
+  BandStep<kTwoRows, kTwoCensus, true>(r, k, band, lanes, q[0], q[1], dst);
+  BandStep<kTwoRows, kTwoCensus, true>(r, k, band, lanes + kLanes, q[2], q[3], dst + kLanes);
+}
+
+// One span, any: outside the view, partly outside, beyond the band's reach, short or cut by the
+// wanted columns. Positions as WarpSpan's Q32 accumulators, split so that 32-bit lanes give the
+// same bits: with the step s = q 2^16 + r (0 <= r < 2^16), (a 2^16 + 2^15 + i s) >> 16 = a + i q +
+// ((2^15 + i r) >> 16); i <= 16 keeps 2^15 + i r below 2^21, and a + i q wraps only where the
+// exact result (a Q16 position, |.| < 2^30) does not.
+LB_AVX2 void AnySpan(const WarpRow& r, const Consts& k, const WarpSpanJob* job, uint8_t* out) {
+  const __m256i half = _mm256_set1_epi32(32768);
+  const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  // A whole span divides exactly (2^16 / kAnchorStep is whole): no division.
+  const int32_t n = job->n;
+  const int64_t dx = int64_t{job->bx} - job->ax, dy = int64_t{job->by} - job->ay;
+  const int64_t sx = n == kAnchorStep ? dx * (65536 / kAnchorStep) : n > 0 ? dx * 65536 / n : 0;
+  const int64_t sy = n == kAnchorStep ? dy * (65536 / kAnchorStep) : n > 0 ? dy * 65536 / n : 0;
+  const __m256i qx = _mm256_set1_epi32(static_cast<int32_t>(sx >> 16));
+  const __m256i qy = _mm256_set1_epi32(static_cast<int32_t>(sy >> 16));
+  const __m256i rx = _mm256_set1_epi32(static_cast<int32_t>(sx & 0xffff));
+  const __m256i ry = _mm256_set1_epi32(static_cast<int32_t>(sy & 0xffff));
+  // Lanes off the span (short ranges only) repeat its end pixels, so a step stays monotone;
+  // only a step reaching the span's end needs its end anchor put in.
+  auto positions = [&](int32_t x, __m256i* xq, __m256i* yq) LB_AVX2 {
+    __m256i i = _mm256_add_epi32(_mm256_set1_epi32(x - job->x0), iota);
+    const bool at_ends = x < job->x0 || x + kLanes > job->x0 + n;
+    if (at_ends) {
+      i = _mm256_min_epi32(_mm256_max_epi32(i, _mm256_setzero_si256()), _mm256_set1_epi32(n));
+    }
+    *xq =
+        _mm256_add_epi32(_mm256_add_epi32(_mm256_set1_epi32(job->ax), _mm256_mullo_epi32(i, qx)),
+                         _mm256_srli_epi32(_mm256_add_epi32(half, _mm256_mullo_epi32(i, rx)), 16));
+    *yq =
+        _mm256_add_epi32(_mm256_add_epi32(_mm256_set1_epi32(job->ay), _mm256_mullo_epi32(i, qy)),
+                         _mm256_srli_epi32(_mm256_add_epi32(half, _mm256_mullo_epi32(i, ry)), 16));
+    if (at_ends) {
+      const __m256i at_end = _mm256_cmpeq_epi32(i, _mm256_set1_epi32(n));
+      *xq = _mm256_blendv_epi8(*xq, _mm256_set1_epi32(job->bx), at_end);
+      *yq = _mm256_blendv_epi8(*yq, _mm256_set1_epi32(job->by), at_end);
+    }
+  };
+  __m256i xq, yq;
+  Band band{};
+  band.lanes_stride = r.lanes_stride;
+  const bool in_band = r.width >= 16 && BandOf(r, *job, &band);
+  if (!in_band && SpanOutsideView(r, *job)) {
+    FillInvalid(r, *job, out);
+    return;
+  }
+  if (job->hi - job->lo < kLanes) {
+    // A short range: one step over 8 pixels of the row that hold it, into a buffer.
+    const int32_t x = Min(job->lo, r.width - kLanes);
+    positions(x, &xq, &yq);
+    uint8_t costs[kLanes];
+    if (in_band) {
+      AnyBandStep(r, k, band, x, xq, yq, costs);
+    } else {
+      Step(r, k, x, xq, yq, costs);
+    }
+    std::memcpy(out + job->lo, costs + (job->lo - x), static_cast<size_t>(job->hi - job->lo));
+    return;
+  }
+  for (int32_t step = job->lo; step < job->hi; step += kLanes) {
+    // The last step overlaps the one before: the same bytes again.
+    const int32_t x = step + kLanes <= job->hi ? step : job->hi - kLanes;
+    positions(x, &xq, &yq);
+    if (in_band) {
+      AnyBandStep(r, k, band, x, xq, yq, out + x);
+    } else {
+      Step(r, k, x, xq, yq, out + x);
+    }
+  }
+}
+
+// Unsigned v <= max per lane (AVX2 compares only signed).
+LB_AVX2 inline __m256i AtMost(__m256i v, __m256i max) {
+  return _mm256_cmpeq_epi32(_mm256_min_epu32(v, max), v);
+}
+
+// What the run's band spans need, 8 spans at once (BandOf's tests, lane by lane): a span of
+// kAnchorStep pixels (the row's short last span is not one), both anchors inside the view, its
+// tap rows and census rows each within two neighbouring rows, and the positions advancing at
+// most 9/8 px per pixel; not the row's last span when its end column is wanted. For each: its
+// upper tap row and census row (and their offsets), its x and y change over the span (Q16), and
+// kind bits (kInBand, kTwoRows, kTwoCensus, kRising).
+enum : int32_t { kInBand = 1, kTwoRows = 2, kTwoCensus = 4, kRising = 8 };
+struct RunBands {
+  alignas(32) int32_t y[kRunSpans], cy[kRunSpans], dx[kRunSpans], dy[kRunSpans], kind[kRunSpans];
+  alignas(32) int32_t row[kRunSpans], crow[kRunSpans];  // y * stride, cy * 3 * width
+};
+
+// Spans first .. end - 1 (end - first <= kRunSpans) into b, indexed from `first`. Lanes past
+// `end` load nothing (masked loads: the anchors may end there).
+LB_AVX2 void BandsOfRun(const WarpRow& r, const WarpRun& run, int32_t first, int32_t end,
+                        RunBands* b) {
+  const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256i xmax = _mm256_set1_epi32((r.width - 1) * 256);
+  const __m256i ymax = _mm256_set1_epi32((r.height - 1) * 256);
+  const __m256i hm2 = _mm256_set1_epi32(r.height - 2);
+  const __m256i q8_half = _mm256_set1_epi32(128), one = _mm256_set1_epi32(1);
+  const __m256i reach = _mm256_set1_epi32(kAnchorStep * 73728);
+  // The row's last span, when its end anchor's column is wanted too (a 17th), is not stepped
+  // as one of the band.
+  const __m256i last = _mm256_set1_epi32(run.hi > run.last ? run.last - 1 : run.last);
+  const __m256i stride = _mm256_set1_epi32(static_cast<int32_t>(r.stride));
+  const __m256i census_row = _mm256_set1_epi32(3 * r.width);
+  for (int32_t g = first; g < end; g += kLanes) {
+    const __m256i lanes = _mm256_cmpgt_epi32(_mm256_set1_epi32(end - g), iota);
+    const __m256i ax = _mm256_maskload_epi32(run.x_q16 + g, lanes);
+    const __m256i bx = _mm256_maskload_epi32(run.x_q16 + g + 1, lanes);
+    const __m256i ay = _mm256_maskload_epi32(run.y_q16 + g, lanes);
+    const __m256i by = _mm256_maskload_epi32(run.y_q16 + g + 1, lanes);
+    // The span's end column x0 + kAnchorStep (k + 1) must be an anchor: not past `last`.
+    const __m256i span_end = _mm256_add_epi32(_mm256_set1_epi32(run.x0 + kAnchorStep * (g + 1)),
+                                              _mm256_slli_epi32(iota, 4));  // kAnchorStep = 16
+    __m256i bad = _mm256_cmpgt_epi32(span_end, last);
+    const __m256i dx = _mm256_sub_epi32(bx, ax), dy = _mm256_sub_epi32(by, ay);
+    bad = _mm256_or_si256(bad, _mm256_cmpgt_epi32(_mm256_abs_epi32(dx), reach));
+    const __m256i xa = _mm256_srai_epi32(_mm256_add_epi32(ax, q8_half), 8);
+    const __m256i xb = _mm256_srai_epi32(_mm256_add_epi32(bx, q8_half), 8);
+    const __m256i ya = _mm256_srai_epi32(_mm256_add_epi32(ay, q8_half), 8);
+    const __m256i yb = _mm256_srai_epi32(_mm256_add_epi32(by, q8_half), 8);
+    const __m256i inside = _mm256_and_si256(_mm256_and_si256(AtMost(xa, xmax), AtMost(xb, xmax)),
+                                            _mm256_and_si256(AtMost(ya, ymax), AtMost(yb, ymax)));
+    const __m256i row_a = _mm256_min_epi32(_mm256_srai_epi32(ya, 8), hm2);
+    const __m256i row_b = _mm256_min_epi32(_mm256_srai_epi32(yb, 8), hm2);
+    const __m256i near_a = _mm256_srai_epi32(_mm256_add_epi32(ya, q8_half), 8);
+    const __m256i near_b = _mm256_srai_epi32(_mm256_add_epi32(yb, q8_half), 8);
+    const __m256i row_d = _mm256_sub_epi32(row_a, row_b), near_d = _mm256_sub_epi32(near_a, near_b);
+    bad = _mm256_or_si256(bad, _mm256_cmpgt_epi32(_mm256_abs_epi32(row_d), one));
+    bad = _mm256_or_si256(bad, _mm256_cmpgt_epi32(_mm256_abs_epi32(near_d), one));
+    const __m256i in_band = _mm256_andnot_si256(bad, _mm256_and_si256(inside, lanes));
+    const __m256i zero = _mm256_setzero_si256();
+    __m256i kind = _mm256_and_si256(in_band, _mm256_set1_epi32(kInBand));
+    kind = _mm256_or_si256(
+        kind, _mm256_andnot_si256(_mm256_cmpeq_epi32(row_d, zero), _mm256_set1_epi32(kTwoRows)));
+    kind = _mm256_or_si256(
+        kind, _mm256_andnot_si256(_mm256_cmpeq_epi32(near_d, zero), _mm256_set1_epi32(kTwoCensus)));
+    kind = _mm256_or_si256(
+        kind, _mm256_andnot_si256(_mm256_cmpgt_epi32(zero, dx), _mm256_set1_epi32(kRising)));
+    const int32_t i = g - first;
+    const __m256i y = _mm256_min_epi32(row_a, row_b), cy = _mm256_min_epi32(near_a, near_b);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->y + i), y);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->cy + i), cy);
+    // Offsets of lanes in the band only (the view's bytes are below 2^31).
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->row + i),
+                        _mm256_and_si256(in_band, _mm256_mullo_epi32(y, stride)));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->crow + i),
+                        _mm256_and_si256(in_band, _mm256_mullo_epi32(cy, census_row)));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->dx + i), dx);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->dy + i), dy);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->kind + i), kind);
+  }
 }
 
 }  // namespace
 
-// Positions as WarpSpan's Q32 accumulators, split so that 32-bit lanes give the same bits: with
-// the step s = q 2^16 + r (0 <= r < 2^16), (a 2^16 + 2^15 + i s) >> 16 = a + i q +
-// ((2^15 + i r) >> 16); i <= 16 keeps 2^15 + i r below 2^21, and a + i q wraps only where the
-// exact result (a Q16 position, |.| < 2^30) does not.
-LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpSpanJob* jobs, int32_t count,
-                            uint8_t* out) {
+// RefLanes (warp_cost.h) of columns x0..x1-1: 8 columns a step from 24 bytes of the row and 8 of
+// each census plane (inside the row while x + 8 <= width), the rest one by one.
+LB_AVX2 void PlaneLanesAvx2(const uint8_t* ref, const uint8_t* cref, int32_t width, int32_t x0,
+                            int32_t x1, int32_t* lanes, ptrdiff_t stride) {
+  int32_t x = x0;
+  WarpRow r;
+  r.cref = cref;
+  r.width = width;
+  for (; x + kLanes <= x1 && x + kLanes <= width; x += kLanes) {
+    const __m128i lo = _mm_loadu_si128(reinterpret_cast<const __m128i*>(ref + 3 * x));
+    const __m128i hi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(ref + 3 * x + 8));
+    const __m256i rgb = _mm256_inserti128_si256(_mm256_castsi128_si256(lo), hi, 1);
+    int32_t* const out = lanes + (x - x0);
+    for (int32_t c = 0; c < 3; ++c) {
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + c * stride),
+                          _mm256_shuffle_epi8(rgb, Load(kMasks.ref[c])));
+    }
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + 3 * stride), RefCensus(r, x));
+  }
+  for (; x < x1; ++x) {
+    int32_t* const out = lanes + (x - x0);
+    for (int32_t c = 0; c < 3; ++c) out[c * stride] = ref[3 * x + c];
+    out[3 * stride] = static_cast<int32_t>((uint32_t{cref[x]} << 16) |
+                                           (uint32_t{cref[width + x]} << 8) | cref[2 * width + x]);
+  }
+}
+
+// A run at once: its spans' band tests 8 at a time (BandsOfRun), then each span of the band two
+// steps from its anchors, the rest (outside the view, partly, short, steep) one by one
+// (AnySpan). The positions of a whole span: (a 2^16 + 2^15 + i dx 2^12) >> 16 = a +
+// ((i dx + 8) >> 4), with |i dx| <= 15 * 16 * 73728 < 2^25 in the band.
+LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpRun& run, uint8_t* out) {
   const int64_t bytes = int64_t{r.height} * r.stride;
   if (r.width < kLanes || r.height < 2 || r.stride <= 0 || bytes >= (int64_t{1} << 31) ||
       r.cw < 0 || r.cw > 31) {
-    return PlaneSpansC(r, jobs, count, out);
+    return PlaneSpansC(r, run, out);
   }
   alignas(32) int8_t lut[32];
   for (int32_t i = 0; i < 32; ++i) lut[i] = static_cast<int8_t>(r.cw * kMasks.nibble_bits[i]);
@@ -456,95 +663,85 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpSpanJob* jobs, int32_t c
                  _mm256_set1_epi32(r.trunc),
                  _mm256_set1_epi32(r.invalid),
                  Load(lut),
-                 _mm256_set1_epi32(3 * r.width - 18)};
-  const __m256i half = _mm256_set1_epi32(32768);
+                 _mm256_set1_epi32(3 * r.width - 18),
+                 Laundered(&kC),
+                 Laundered(&kMasks)};
   const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  for (const WarpSpanJob* job = jobs; job < jobs + count; ++job) {
-    // A whole span divides exactly (2^16 / kAnchorStep is whole): no division.
-    const int32_t n = job->n;
-    const int64_t dx = int64_t{job->bx} - job->ax, dy = int64_t{job->by} - job->ay;
-    const int64_t sx = n == kAnchorStep ? dx * (65536 / kAnchorStep) : n > 0 ? dx * 65536 / n : 0;
-    const int64_t sy = n == kAnchorStep ? dy * (65536 / kAnchorStep) : n > 0 ? dy * 65536 / n : 0;
-    const __m256i qx = _mm256_set1_epi32(static_cast<int32_t>(sx >> 16));
-    const __m256i qy = _mm256_set1_epi32(static_cast<int32_t>(sy >> 16));
-    const __m256i rx = _mm256_set1_epi32(static_cast<int32_t>(sx & 0xffff));
-    const __m256i ry = _mm256_set1_epi32(static_cast<int32_t>(sy & 0xffff));
-    // Lanes off the span (short ranges only) repeat its end pixels, so a step stays monotone;
-    // only a step reaching the span's end needs its end anchor put in.
-    auto positions = [&](int32_t x, __m256i* xq, __m256i* yq) LB_AVX2 {
-      __m256i i = _mm256_add_epi32(_mm256_set1_epi32(x - job->x0), iota);
-      const bool at_ends = x < job->x0 || x + kLanes > job->x0 + n;
-      if (at_ends) {
-        i = _mm256_min_epi32(_mm256_max_epi32(i, _mm256_setzero_si256()), _mm256_set1_epi32(n));
-      }
-      *xq = _mm256_add_epi32(
-          _mm256_add_epi32(_mm256_set1_epi32(job->ax), _mm256_mullo_epi32(i, qx)),
-          _mm256_srli_epi32(_mm256_add_epi32(half, _mm256_mullo_epi32(i, rx)), 16));
-      *yq = _mm256_add_epi32(
-          _mm256_add_epi32(_mm256_set1_epi32(job->ay), _mm256_mullo_epi32(i, qy)),
-          _mm256_srli_epi32(_mm256_add_epi32(half, _mm256_mullo_epi32(i, ry)), 16));
-      if (at_ends) {
-        const __m256i at_end = _mm256_cmpeq_epi32(i, _mm256_set1_epi32(n));
-        *xq = _mm256_blendv_epi8(*xq, _mm256_set1_epi32(job->bx), at_end);
-        *yq = _mm256_blendv_epi8(*yq, _mm256_set1_epi32(job->by), at_end);
-      }
-    };
-    __m256i xq, yq;
-    Band band{};
-    const bool in_band = r.width >= 16 && BandOf(r, *job, &band);
-    if (!in_band && SpanOutsideView(r, *job)) {
-      FillInvalid(r, *job, out);
-      continue;
+  const __m256i eight = _mm256_set1_epi32(8);
+  int32_t first = 0, end = 0;
+  RunSpans(run, &first, &end);
+  RunBands bands;
+  // Without the caller's reference lanes, this kernel makes its own for each chunk of spans
+  // (RefLanes' columns of at most kRunSpans spans: 16 kRunSpans + 1 + 16 + 39 < kLocalLanes).
+  constexpr int32_t kLocalLanes = 16 * kRunSpans + 64;
+  alignas(32) int32_t local[4 * kLocalLanes];
+  WarpRow rl = r;
+  for (int32_t base = first; base < end; base += kRunSpans) {
+    const int32_t stop = Min(end, base + kRunSpans);
+    if (r.width >= 16) {
+      BandsOfRun(r, run, base, stop, &bands);
+    } else {
+      for (int32_t i = 0; i < stop - base; ++i) bands.kind[i] = 0;
     }
-    if (job->hi - job->lo < kLanes) {
-      // A short range: one step over 8 pixels of the row that hold it, into a buffer.
-      const int32_t x = Min(job->lo, r.width - kLanes);
-      positions(x, &xq, &yq);
-      uint8_t costs[kLanes];
-      if (in_band) {
-        AnyBandStep(r, k, band, x, xq, yq, costs);
-      } else {
-        Step(r, k, x, xq, yq, costs);
-      }
-      std::memcpy(out + job->lo, costs + (job->lo - x), static_cast<size_t>(job->hi - job->lo));
-      continue;
+    if (r.ref_lanes == nullptr) {
+      const int32_t lo = Max(run.lo, run.x0 + kAnchorStep * base);
+      const int32_t hi = Min(run.hi, run.x0 + kAnchorStep * stop + 1);
+      rl.lanes_x0 = RefLanesBegin(r.width, lo);
+      rl.lanes_stride = kLocalLanes;
+      rl.ref_lanes = local;
+      PlaneLanesAvx2(r.ref, r.cref, r.width, rl.lanes_x0, RefLanesEnd(r.width, hi), local,
+                     kLocalLanes);
     }
-    if (in_band && n == kAnchorStep && job->lo == job->x0 && job->hi == job->x0 + n) {
-      // A whole span of the band (most of them): its second step's positions are its first's
-      // moved 8 pixels on, Q16 parts and remainders both.
-      const __m256i ix = _mm256_add_epi32(_mm256_set1_epi32(job->ax), _mm256_mullo_epi32(iota, qx));
-      const __m256i iy = _mm256_add_epi32(_mm256_set1_epi32(job->ay), _mm256_mullo_epi32(iota, qy));
-      const __m256i rem_x = _mm256_add_epi32(half, _mm256_mullo_epi32(iota, rx));
-      const __m256i rem_y = _mm256_add_epi32(half, _mm256_mullo_epi32(iota, ry));
-      const __m256i ix8 = _mm256_add_epi32(ix, _mm256_slli_epi32(qx, 3));
-      const __m256i iy8 = _mm256_add_epi32(iy, _mm256_slli_epi32(qy, 3));
-      const __m256i rem_x8 = _mm256_add_epi32(rem_x, _mm256_slli_epi32(rx, 3));
-      const __m256i rem_y8 = _mm256_add_epi32(rem_y, _mm256_slli_epi32(ry, 3));
-      const __m256i q[4] = {_mm256_add_epi32(ix, _mm256_srli_epi32(rem_x, 16)),
-                            _mm256_add_epi32(iy, _mm256_srli_epi32(rem_y, 16)),
-                            _mm256_add_epi32(ix8, _mm256_srli_epi32(rem_x8, 16)),
-                            _mm256_add_epi32(iy8, _mm256_srli_epi32(rem_y8, 16))};
-      if (band.two_rows) {
-        if (band.two_census) {
-          BandSpan<true, true>(r, k, band, job->x0, q, out);
-        } else {
-          BandSpan<true, false>(r, k, band, job->x0, q, out);
-        }
-      } else if (band.two_census) {
-        BandSpan<false, true>(r, k, band, job->x0, q, out);
-      } else {
-        BandSpan<false, false>(r, k, band, job->x0, q, out);
+    for (int32_t s = base; s < stop; ++s) {
+      const int32_t i = s - base, kind = bands.kind[i];
+      if ((kind & kInBand) == 0) {
+        const WarpSpanJob job = RunSpan(run, s);
+        if (job.lo < job.hi) AnySpan(rl, k, &job, out);
+        continue;
       }
-      continue;
-    }
-    for (int32_t step = job->lo; step < job->hi; step += kLanes) {
-      // The last step overlaps the one before: the same bytes again.
-      const int32_t x = step + kLanes <= job->hi ? step : job->hi - kLanes;
-      positions(x, &xq, &yq);
-      if (in_band) {
-        AnyBandStep(r, k, band, x, xq, yq, out + x);
-      } else {
-        Step(r, k, x, xq, yq, out + x);
+      const int32_t x = run.x0 + kAnchorStep * s;
+      const Band band{r.view + bands.row[i],
+                      r.census_view + bands.crow[i],
+                      bands.y[i],
+                      bands.cy[i],
+                      (kind & kTwoRows) != 0,
+                      (kind & kTwoCensus) != 0,
+                      (kind & kRising) != 0,
+                      rl.lanes_stride};
+      const __m256i dx = _mm256_set1_epi32(bands.dx[i]), dy = _mm256_set1_epi32(bands.dy[i]);
+      const __m256i tx = _mm256_add_epi32(_mm256_mullo_epi32(iota, dx), eight);
+      const __m256i ty = _mm256_add_epi32(_mm256_mullo_epi32(iota, dy), eight);
+      // Plus BandStep's rounding half: (a + 128) + t for a + t + 128, exact in int32.
+      const __m256i ax = _mm256_set1_epi32(run.x_q16[s] + 128);
+      const __m256i ay = _mm256_set1_epi32(run.y_q16[s] + 128);
+      const __m256i q[4] = {
+          _mm256_add_epi32(ax, _mm256_srai_epi32(tx, 4)),
+          _mm256_add_epi32(ay, _mm256_srai_epi32(ty, 4)),
+          _mm256_add_epi32(ax,
+                           _mm256_srai_epi32(_mm256_add_epi32(tx, _mm256_slli_epi32(dx, 3)), 4)),
+          _mm256_add_epi32(ay,
+                           _mm256_srai_epi32(_mm256_add_epi32(ty, _mm256_slli_epi32(dy, 3)), 4))};
+      const int32_t lo = Max(x, run.lo), hi = Min(x + kAnchorStep, run.hi);
+      // A span cut by the wanted columns goes whole into a buffer, the wanted part copied.
+      const bool whole = lo == x && hi == x + kAnchorStep;
+      uint8_t costs[kAnchorStep];
+      uint8_t* const dst = whole ? out + x : costs;
+      switch (kind & (kTwoRows | kTwoCensus)) {
+        case 0:
+          BandSpan<false, false>(rl, k, band, x, q, dst);
+          break;
+        case kTwoRows:
+          BandSpan<true, false>(rl, k, band, x, q, dst);
+          break;
+        case kTwoCensus:
+          BandSpan<false, true>(rl, k, band, x, q, dst);
+          break;
+        default:
+          BandSpan<true, true>(rl, k, band, x, q, dst);
+          break;
+      }
+      if (!whole && lo < hi) {
+        std::memcpy(out + lo, costs + (lo - x), static_cast<size_t>(hi - lo));
       }
     }
   }

@@ -1,5 +1,6 @@
 // The plane sweep's span kernel for NEON (warp_cost.h; the C reference is dtk::PlaneSpansC in
-// warp_cost.cc), aarch64 and armhf built with NEON, ARMv7 intrinsics only: 8 pixels a step. NEON
+// warp_cost.cc), aarch64 and armhf built with NEON, ARMv7 intrinsics only: a run of spans a call,
+// span by span, 8 pixels a step. NEON
 // has no gathers, so positions, weights and offsets are vector arithmetic, each pixel's taps are
 // scalar loads into small buffers, and the interpolation, differences and census counts are
 // vector arithmetic again. Views narrower than a step or too large for 32-bit offsets, and
@@ -121,11 +122,11 @@ void Step(const WarpRow& r, const Consts& k, int32_t x, const Lanes& xq, const L
 // the step s = q 2^16 + r (0 <= r < 2^16), (a 2^16 + 2^15 + i s) >> 16 = a + i q +
 // ((2^15 + i r) >> 16); i <= 16 keeps 2^15 + i r below 2^21, and a + i q wraps only where the
 // exact result (a Q16 position, |.| < 2^30) does not.
-void PlaneSpansNeon(const WarpRow& r, const WarpSpanJob* jobs, int32_t count, uint8_t* out) {
+void PlaneSpansNeon(const WarpRow& r, const WarpRun& run, uint8_t* out) {
   const int64_t bytes = int64_t{r.height} * r.stride;
   if (r.width < kLanes || r.height < 2 || r.stride <= 0 || bytes >= (int64_t{1} << 31) ||
       r.trunc < 0 || r.trunc > 765 || r.cw < 0 || r.cw > 255) {
-    return PlaneSpansC(r, jobs, count, out);
+    return PlaneSpansC(r, run, out);
   }
   const Consts k{vdupq_n_s32((r.width - 1) * 256),
                  vdupq_n_s32((r.height - 1) * 256),
@@ -139,7 +140,12 @@ void PlaneSpansNeon(const WarpRow& r, const WarpSpanJob* jobs, int32_t count, ui
   const int32_t lane_index[kLanes] = {0, 1, 2, 3, 4, 5, 6, 7};
   const int32x4_t iota_lo = vld1q_s32(lane_index), iota_hi = vld1q_s32(lane_index + 4);
   const int32x4_t half = vdupq_n_s32(32768);
-  for (const WarpSpanJob* job = jobs; job < jobs + count; ++job) {
+  int32_t first = 0, end = 0;
+  RunSpans(run, &first, &end);
+  for (int32_t span = first; span < end; ++span) {
+    const WarpSpanJob spanjob = RunSpan(run, span);
+    const WarpSpanJob* const job = &spanjob;
+    if (job->lo >= job->hi) continue;
     if (SpanOutsideView(r, *job)) {
       FillInvalid(r, *job, out);
       continue;

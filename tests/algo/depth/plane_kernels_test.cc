@@ -1,8 +1,9 @@
 // The plane sweep's span kernels (warp_cost.h, in the data term's tables): every table this
 // processor runs (AVX2, NEON), forced rather than chosen, against the C reference, bit for bit:
-// single spans with random anchors (inside the view, leaving it on any side, crossing rows, on
-// whole pixels and half pixels, at the last column and row, steep and reversed), short column
-// ranges, the extremes of the parameters; and whole rows through PlaneCostRow with random
+// runs of spans with random anchors (inside the view, leaving it on any side, crossing rows, on
+// whole pixels and half pixels, at the last column and row, steep and reversed, mixed in one
+// run), ending at the row's end or at an inner anchor, random column ranges, the extremes of
+// the parameters; and whole rows through PlaneCostRow with random
 // homographies, random column ranges (the w - 1 anchor) and planes without a map over part of
 // the row.
 #include <gtest/gtest.h>
@@ -10,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -120,11 +122,53 @@ WarpSpanJob RandomSpan(std::mt19937& rng, int32_t w, int32_t h, int32_t x0, int3
   return WarpSpanJob{x0, n, q16(ax), q16(ay), q16(bx), q16(by), lo, std::max(hi, lo + 1)};
 }
 
+// A run of spans along row y as PlaneCostRow hands one over (warp_cost.h: WarpRun): from a
+// random anchor column to the row's end (its short last span included) or to an inner anchor,
+// each span's end anchor from RandomSpan's kinds (mixed within the run, so spans of the band
+// sit beside steep, outside and crossing ones), the end anchor kept relative to the start one
+// (the span's slope) or, for kinds 1 and 2, where RandomSpan put it; wanted columns random, or
+// the whole run.
+struct RandomRun {
+  std::vector<int32_t> x_q16, y_q16;
+  WarpRun run{};
+
+  RandomRun(std::mt19937& rng, int32_t w, int32_t h) {
+    const int32_t spans_to_end = (w - 1 + kAnchorStep - 1) / kAnchorStep;
+    const int32_t x0 = kAnchorStep * static_cast<int32_t>(rng() % spans_to_end);
+    const int32_t whole = (w - 1 - x0) / kAnchorStep;  // whole spans before the row's end
+    const bool to_end = whole == 0 || rng() % 2 == 0;
+    const int32_t count = to_end ? (w - 1 - x0 + kAnchorStep - 1) / kAnchorStep
+                                 : 1 + static_cast<int32_t>(rng() % whole);
+    const int32_t last = to_end ? w - 1 : x0 + kAnchorStep * count;
+    for (int32_t k = 0; k < count; ++k) {
+      const int32_t start = x0 + kAnchorStep * k;
+      const int32_t n = std::min(kAnchorStep, last - start);
+      const int32_t kind = static_cast<int32_t>(rng() % 5);
+      const WarpSpanJob j = RandomSpan(rng, w, h, start, n, kind);
+      if (k == 0) {
+        x_q16.push_back(j.ax);
+        y_q16.push_back(j.ay);
+      }
+      const bool absolute = (kind == 1 || kind == 2) && rng() % 2 == 0;
+      x_q16.push_back(absolute ? j.bx : x_q16.back() + (j.bx - j.ax));
+      y_q16.push_back(absolute ? j.by : y_q16.back() + (j.by - j.ay));
+    }
+    const int32_t end = to_end ? w : last;
+    int32_t lo = x0, hi = end;
+    if (rng() % 3 != 0) {
+      lo = x0 + static_cast<int32_t>(rng() % (end - x0));
+      hi = lo + 1 + static_cast<int32_t>(rng() % (end - lo));
+    }
+    run = WarpRun{x_q16.data(), y_q16.data(), x0, count, last, lo, hi};
+  }
+};
+
 TEST(PlaneKernels, SpanVariantsEqualTheReference) {
   LB_SKIP_WITHOUT_VARIANTS();
   std::mt19937 rng(21);
   const int32_t truncs[] = {0, 1, 45, 254, 255, 256, 765};
-  for (const int32_t w : {8, 9, 15, 16, 17, 24, 31, 33, 40, 64, 97}) {
+  int64_t runs = 0, spans = 0;
+  for (const int32_t w : {8, 9, 15, 16, 17, 24, 31, 33, 40, 64, 97, 161, 800}) {
     for (int32_t kind = 0; kind < 3; ++kind) {
       const int32_t h = 2 + static_cast<int32_t>(rng() % 20);
       const Views v(rng, w, h, kind == 1 ? 5 : 0, kind);
@@ -134,27 +178,31 @@ TEST(PlaneKernels, SpanVariantsEqualTheReference) {
         const int32_t cw = kind == 2 ? 10 : static_cast<int32_t>(rng() % 11);
         const int32_t invalid = std::min(255, trunc + 24 * cw);
         const WarpRow row = v.Row(y, trunc, cw, invalid);
-        // A batch of spans along the row, as PlaneCostRow hands them over.
-        WarpSpanJob jobs[kSpanBatch];
-        int32_t count = 0;
-        for (int32_t x0 = 0; x0 < w - 1 && count < kSpanBatch; x0 += kAnchorStep) {
-          const int32_t n = std::min(kAnchorStep, w - 1 - x0);
-          const WarpSpanJob job = RandomSpan(rng, w, h, x0, n, static_cast<int32_t>(rng() % 5));
-          if (job.lo < w) jobs[count++] = job;
-        }
+        const RandomRun r(rng, w, h);
+        ++runs;
+        spans += r.run.count;
         std::vector<uint8_t> want(w, 0xa5);
-        dtk::kReference.plane(row, jobs, count, want.data());
+        dtk::kReference.plane(row, r.run, want.data());
+        for (int32_t x = 0; x < w; ++x) {
+          if (x < r.run.lo || x >= r.run.hi) {
+            ASSERT_EQ(want[x], 0xa5) << "unwanted column " << x;
+          }
+        }
         for (const dtk::Variant& var : Others()) {
           std::vector<uint8_t> got(w, 0xa5);
-          var.kernels->plane(row, jobs, count, got.data());
+          var.kernels->plane(row, r.run, got.data());
           ASSERT_EQ(got, want) << var.name << " w " << w << " h " << h << " y " << y << " kind "
-                               << kind << " trunc " << trunc << " cw " << cw << " first span "
-                               << jobs[0].ax << "," << jobs[0].ay << " -> " << jobs[0].bx << ","
-                               << jobs[0].by << " [" << jobs[0].lo << "," << jobs[0].hi << ")";
+                               << kind << " trunc " << trunc << " cw " << cw << " run from "
+                               << r.run.x0 << ", " << r.run.count << " spans to " << r.run.last
+                               << " [" << r.run.lo << "," << r.run.hi << ") first anchors "
+                               << r.run.x_q16[0] << "," << r.run.y_q16[0] << " -> "
+                               << r.run.x_q16[1] << "," << r.run.y_q16[1];
         }
       }
     }
   }
+  std::printf("%lld runs, %lld spans\n", static_cast<long long>(runs),
+              static_cast<long long>(spans));
 }
 
 // A homography from a random small rotation (up to `deg`) and translation, at inverse depth rho.
@@ -209,6 +257,57 @@ TEST(PlaneKernels, RowsThroughRandomHomographiesEqualTheReference) {
       }
     }
   }
+}
+
+// PlaneCostRow's runs against one span at a time: every column's cost is that of its span
+// (anchors at multiples of kAnchorStep, the last span ending on column w - 1) mapped by
+// PlaneHomography::Map and handed to the reference kernel alone, or `invalid` where an anchor of
+// its span has no map. Rows wider than a run (kRunSpans spans), planes without a map left or
+// right of a random column, random column ranges; at least 10 % of the columns asked for are
+// without a map and 10 % with.
+TEST(PlaneKernels, RowsEqualTheirSpansOneByOne) {
+  std::mt19937 rng(23);
+  int64_t with = 0, without = 0;
+  for (const int32_t w : {1, 2, 16, 17, 18, 33, 800, 1000}) {
+    const int32_t h = 24;
+    const Views v(rng, w, h, 3, static_cast<int32_t>(rng() % 3));
+    for (int32_t trial = 0; trial < 30; ++trial) {
+      PlaneHomography hom = RandomPlane(rng, w, h, 2.0, 0.2 + 0.8 * (trial % 5));
+      const int32_t y = static_cast<int32_t>(rng() % h);
+      if (trial % 3 != 0) {
+        // No map left (or right) of a random column of row y: the denominator falls to its
+        // minimum there.
+        const int64_t xc = static_cast<int64_t>(rng() % w);
+        hom.m[6] = (trial % 3 == 1 ? 1 : -1) * ((int64_t{1} << 30) / w);
+        hom.m[8] = (int64_t{1} << 20) - hom.m[6] * xc - hom.m[7] * y;
+      }
+      const DataTermParams params{45, 4};
+      const int32_t invalid = std::min(255, params.color_trunc + 24 * params.census_weight);
+      const int32_t begin = trial % 2 == 0 ? 0 : static_cast<int32_t>(rng() % w);
+      const int32_t end = begin + 1 + static_cast<int32_t>(rng() % (w - begin));
+      std::vector<uint8_t> got(w, 0x5a), want(w, 0x5a);
+      PlaneCostRow(hom, v.Source(), y, params, invalid, begin, end, got.data(),
+                   dtk::kReference.plane);
+      const WarpRow row = v.Row(y, params.color_trunc, params.census_weight, invalid);
+      for (int32_t x = begin; x < end; ++x) {
+        int32_t x0 = x / kAnchorStep * kAnchorStep;
+        if (x0 == w - 1 && x0 > 0) x0 -= kAnchorStep;  // w - 1 ends the span before it
+        const int32_t x1 = std::min(x0 + kAnchorStep, w - 1);
+        int32_t a[2], b[2];
+        if (!hom.Map(x0, y, &a[0], &b[0]) || !hom.Map(x1, y, &a[1], &b[1])) {
+          want[x] = static_cast<uint8_t>(invalid);
+          ++without;
+          continue;
+        }
+        dtk::kReference.plane(row, WarpRun{a, b, x0, 1, x1, x, x + 1}, want.data());
+        ++with;
+      }
+      ASSERT_EQ(got, want) << "w " << w << " y " << y << " [" << begin << ", " << end << ") trial "
+                           << trial;
+    }
+  }
+  EXPECT_GT(without * 10, with + without);
+  EXPECT_GT(with * 10, with + without);
 }
 
 }  // namespace
