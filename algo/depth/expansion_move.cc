@@ -388,7 +388,7 @@ int64_t DepthStage::Record(int32_t alpha) {
   Grid& g = grid();
   const int32_t w = g.width, h = g.height;
   int64_t delta = 0;
-  const bool refine = !on_coarse_;
+  const bool refine = !on_coarse_ && config_.subpixel;  // the labels alone need none of it
   const bool have_prev = refine && prev_label_ == alpha - 1;
   for (int32_t i = 0; i < g.rect_count; ++i) {
     const Rect& r = g.rects[i];

@@ -49,7 +49,8 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
   // The pixels' D of this move goes where the move before last left its own (Record swaps the
   // two buffers): back to "not computed" there, so that Record can tell which D the move before
   // this one computed (fine grid only; the coarse grid keeps no D for the refinement).
-  if (!on_coarse_) {
+  if (!on_coarse_ && !config_.subpixel) g.written_count = 0;  // no sub-label fit to feed
+  if (!on_coarse_ && config_.subpixel) {
     if (g.written_count < 0) {
       for (int32_t p = 0; p < w * h; ++p) g.cost_alpha[p] = kNotComputed;
     }
@@ -85,12 +86,13 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
     span[2 * y] = x0;
     span[2 * y + 1] = x1;
   }
-  // Where the move computes D (ComputeNear): next to a label within the window or one above it.
+  // Where the move computes D (ComputeNear): next to a label within the window or, for the
+  // sub-label fit (config_.subpixel), one above it.
   // A pixel that takes alpha + 1 in the next move is next to a label within the window of
   // alpha + 1 after this move, so next to one in lo..hi + 1 now or to a pixel that takes alpha
   // now; either way its D(alpha) for the sub-label fit is then mostly at hand (Record).
   {
-    const int32_t top = hi + 1 < config_.labels ? hi + 1 : hi;
+    const int32_t top = config_.subpixel && hi + 1 < config_.labels ? hi + 1 : hi;
     uint64_t more[4] = {want[0], want[1], want[2], want[3]};
     more[top >> 6] |= uint64_t{1} << (top & 63);
     for (int32_t y = 0; y < h; ++y) {

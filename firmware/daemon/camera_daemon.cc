@@ -104,6 +104,11 @@ void CameraDaemon::Problems(char* out, size_t size) const {
            camera_problem_.text[0] && folder_problem_.text[0] ? "; " : "", folder_problem_.text);
 }
 
+bool CameraDaemon::Idle() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return !busy_;
+}
+
 bool CameraDaemon::CheckReady(bool scheduled) {
   // A missing camera or a read-only card must show before the first press, not as its photo
   // failing. The folder is never created here: on a camera it is usually a card's mount point,
@@ -156,6 +161,14 @@ void CameraDaemon::BecomeReady() {
 Status CameraDaemon::Run() {
   Status result;
   while (!stop_.load()) {
+    // A capture failed: the camera may be gone. Checked from here, with the worker idle, as at
+    // the start (the sensor is not probed while a photo may use it).
+    if (recheck_.load() && Idle()) {
+      recheck_.store(false);
+      ready_.store(false);
+      retry_ms_ = kFirstRetryMs;
+      next_check_ns_ = clock_->MonotonicNs();
+    }
     int32_t wait_ms = kPollMs;
     if (!ready_.load()) {
       const int64_t left_ns = next_check_ns_ - clock_->MonotonicNs();
@@ -293,7 +306,10 @@ Status CameraDaemon::ConfigureSensor() {
 
 void CameraDaemon::TakePhoto(int32_t number) {
   Status s;
-  if (!configured_) s = ConfigureSensor();
+  if (!configured_) {
+    s = ConfigureSensor();
+    if (!s.ok()) recheck_.store(true);
+  }
   char path[PhotoNamer::kMaxDir + 64];
   if (s.ok()) {
     tm now;
@@ -322,6 +338,7 @@ void CameraDaemon::TakePhoto(int32_t number) {
       // way back.
       sensor_->Stop();
       configured_ = false;
+      recheck_.store(true);
     }
     log_->Printf(LogLevel::kError, "photo %d: not saved: %s%s", number, s.message(),
                  capture_failed_ ? " (the sensor is reopened at the next press)" : "");

@@ -13,8 +13,11 @@
 // checks run again after 1 s, doubling to every 30 s (a camera plugged in or a card mounted later
 // is found without polling the device all the time); a line is logged only when a problem
 // appears, changes or goes away. A press while not ready checks at once: it takes its photo if
-// everything holds now, else it is refused with the reason. Once ready the daemon stays ready;
-// a camera or card that goes away later fails the photos, each with its log line.
+// everything holds now, else it is refused with the reason. A photo whose capture fails sends
+// the daemon back to these checks once the worker is idle (at once, then on the same schedule):
+// a camera unplugged since makes it not ready, so presses are refused with the reason until the
+// camera is back; one still there makes it ready again at once. A card that goes away fails the
+// photos, each with its log line.
 //
 // One Job is configured once (on the first half press or press) and reused for every photo, so
 // nothing grows from press to press. Sensor, button, clock and log are borrowed; tests inject a
@@ -114,6 +117,7 @@ class CameraDaemon {
   // logs "ready". `scheduled`: the run the schedule asked for (else a press's), which sets the
   // next. Run thread only (Start before Run starts).
   bool CheckReady(bool scheduled);
+  bool Idle();  // no photo accepted and unfinished
   // Logs a new or changed problem (error), or `fixed` (info) when a problem went away; true when
   // anything changed.
   bool Note(const Status& status, Problem* problem, const char* fixed);
@@ -136,6 +140,7 @@ class CameraDaemon {
   std::atomic<bool> stop_{false};
   std::atomic<bool> ready_{false};
   std::atomic<bool> camera_busy_{false};  // mirrors busy_ for readers that take no lock
+  std::atomic<bool> recheck_{false};      // set by the worker: a capture failed
 
   // Run thread only, until ready: the checks' last findings and schedule.
   Problem camera_problem_, folder_problem_;

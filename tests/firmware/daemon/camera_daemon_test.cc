@@ -204,9 +204,9 @@ class RecordingSink : public LogSink {
       return l.find(part) != std::string::npos;
     }));
   }
-  bool WaitFor(const std::string& part) {
+  bool WaitFor(const std::string& part, int times = 1) {
     for (int i = 0; i < 1000; ++i) {
-      if (Count(part) > 0) return true;
+      if (Count(part) >= times) return true;
       std::this_thread::sleep_for(milliseconds(10));
     }
     return false;
@@ -479,6 +479,46 @@ TEST_F(CameraDaemonTest, CameraPluggedInLaterIsFoundAndThenPressesWork) {
   const int probes = sensor_.probes.load();
   PressAndWait();
   EXPECT_EQ(sensor_.probes.load(), probes);
+}
+
+// Unplugged after the start: the failed photo sends the daemon back to its checks, so the next
+// presses are refused with the reason (not each failed as a capture), until the camera is back.
+TEST_F(CameraDaemonTest, CameraUnpluggedAfterReadyIsNotReadyUntilItIsBack) {
+  StartDaemon();
+  ASSERT_TRUE(daemon_->ready());
+  sensor_.present = false;
+  sensor_.AddFault(Fault::kTimeout);  // what a vanished device gives a burst in progress
+  PressAndWait();
+  EXPECT_EQ(Files(), std::vector<std::string>{});
+  ASSERT_TRUE(sink_.WaitFor("warning: not ready: will check again in 1 s")) << sink_.All();
+  EXPECT_FALSE(daemon_->ready());
+  EXPECT_EQ(sink_.Count("error: camera test0: no such device"), 1) << sink_.All();
+  const int configures = sensor_.configures.load();
+  PressAndWait();
+  EXPECT_EQ(sink_.Count("warning: press: refused, not ready: camera test0: no such device"), 1)
+      << sink_.All();
+  EXPECT_EQ(sensor_.configures.load(), configures) << "a refused press leaves the sensor alone";
+  // Plugged in again: found by the next scheduled check, and the next press takes its photo.
+  sensor_.present = true;
+  ASSERT_TRUE(sink_.WaitFor("info: sensor test: the camera is there now")) << sink_.All();
+  ASSERT_TRUE(sink_.WaitFor("ready: sensor test", 2)) << sink_.All();
+  EXPECT_TRUE(daemon_->ready());
+  PressAndWait();
+  EXPECT_EQ(Files(), std::vector<std::string>{kFirst}) << sink_.All();
+  ExpectWholeJpeg(kFirst);
+}
+
+// A capture that fails with the camera still there: checked at once and ready again, and the
+// next press works (as before the checks came back).
+TEST_F(CameraDaemonTest, FailedCaptureWithTheCameraThereIsReadyAgainAtOnce) {
+  StartDaemon();
+  sensor_.AddFault(Fault::kTimeout);
+  PressAndWait();
+  ASSERT_TRUE(sink_.WaitFor("ready: sensor test", 2)) << sink_.All();
+  EXPECT_TRUE(daemon_->ready());
+  EXPECT_EQ(sink_.Count("not ready"), 0) << sink_.All();
+  PressAndWait();
+  EXPECT_EQ(Files(), std::vector<std::string>{kFirst}) << sink_.All();
 }
 
 TEST_F(CameraDaemonTest, PressChecksAtOnceAndTakesThePhotoWhenTheCameraIsBack) {
