@@ -68,8 +68,8 @@ void GridMaxflowProbe::Reset(GridMaxflow& mf, int32_t width, int32_t height) {
 
 void GridMaxflow::Activate(int32_t p) {
   Node& n = nodes_[p];
-  if (n.link & kQueued) return;
-  n.link |= kQueued;
+  if (n.queued) return;
+  n.queued = 1;
   int32_t slot = queue_head_ + queue_count_;
   if (slot >= max_nodes_) slot -= max_nodes_;
   queue_[slot] = p;
@@ -92,15 +92,14 @@ int32_t GridMaxflow::NextActive() {
     queue_head_ = queue_head_ + 1 == max_nodes_ ? 0 : queue_head_ + 1;
     --queue_count_;
     Node& n = nodes_[p];
-    n.link &= static_cast<uint8_t>(~kQueued);
-    if (Tree(n) != kFree) return p;
+    n.queued = 0;
+    if (n.tree != kFree) return p;
   }
   return kNotActive;
 }
 
 void GridMaxflow::PushOrphan(int32_t p) {
-  Node& n = nodes_[p];
-  n.link = static_cast<uint8_t>((n.link & ~kParentMask) | kOrphan);
+  nodes_[p].parent = kOrphan;
   int32_t slot = orphan_head_ + orphan_count_;
   if (slot >= max_nodes_) slot -= max_nodes_;
   orphans_[slot] = p;
@@ -114,38 +113,36 @@ void GridMaxflow::Augment(int32_t s_node, int dir) {
   // Source side: arcs parent -> child, up to the root's source capacity.
   for (int32_t p = s_node;;) {
     const Node& n = nodes_[p];
-    const int d = Parent(n);
-    if (d == kTerminal) {
+    if (n.parent == kTerminal) {
       if (n.tcap < bottleneck) bottleneck = n.tcap;
       break;
     }
-    const int32_t parent = p + offset_[d];
-    const int32_t c = nodes_[parent].cap[d ^ 1];
+    const int32_t parent = p + offset_[n.parent];
+    const int32_t c = nodes_[parent].cap[n.parent ^ 1];
     if (c < bottleneck) bottleneck = c;
     p = parent;
   }
   // Sink side: arcs child -> parent, down to the root's sink capacity.
   for (int32_t p = t_node;;) {
     const Node& n = nodes_[p];
-    const int d = Parent(n);
-    if (d == kTerminal) {
+    if (n.parent == kTerminal) {
       if (-n.tcap < bottleneck) bottleneck = -n.tcap;
       break;
     }
-    if (n.cap[d] < bottleneck) bottleneck = n.cap[d];
-    p += offset_[d];
+    if (n.cap[n.parent] < bottleneck) bottleneck = n.cap[n.parent];
+    p += offset_[n.parent];
   }
 
   nodes_[s_node].cap[dir] -= bottleneck;
   nodes_[t_node].cap[dir ^ 1] += bottleneck;
   for (int32_t p = s_node;;) {
     Node& n = nodes_[p];
-    const int d = Parent(n);
-    if (d == kTerminal) {
+    if (n.parent == kTerminal) {
       n.tcap -= bottleneck;
       if (n.tcap == 0) PushOrphan(p);
       break;
     }
+    const int d = n.parent;
     const int32_t parent = p + offset_[d];
     n.cap[d] += bottleneck;
     if ((nodes_[parent].cap[d ^ 1] -= bottleneck) == 0) PushOrphan(p);
@@ -153,12 +150,12 @@ void GridMaxflow::Augment(int32_t s_node, int dir) {
   }
   for (int32_t p = t_node;;) {
     Node& n = nodes_[p];
-    const int d = Parent(n);
-    if (d == kTerminal) {
+    if (n.parent == kTerminal) {
       n.tcap += bottleneck;
       if (n.tcap == 0) PushOrphan(p);
       break;
     }
+    const int d = n.parent;
     const int32_t parent = p + offset_[d];
     nodes_[parent].cap[d ^ 1] += bottleneck;
     if ((n.cap[d] -= bottleneck) == 0) PushOrphan(p);
@@ -177,7 +174,7 @@ void GridMaxflow::Adopt(int32_t p) {
   for (int dir = 0; dir < 4; ++dir) {
     const int32_t q = p + offset_[dir];
     Node& first = nodes_[q];
-    if (Tree(first) != tree) continue;
+    if (first.tree != tree) continue;
     // The arc that would carry flow from the new parent: q->p in the source tree, p->q in the sink.
     const int32_t c = kSource ? first.cap[dir ^ 1] : n.cap[dir];
     if (c <= 0) continue;
@@ -192,15 +189,14 @@ void GridMaxflow::Adopt(int32_t p) {
         break;
       }
       ++d;
-      const uint8_t parent = Parent(m);
-      if (parent == kTerminal) {
-        m.ts = static_cast<uint16_t>(time_);
+      if (m.parent == kTerminal) {
+        m.ts = time_;
         m.dist = 1;
         valid = true;
         break;
       }
-      if (parent == kOrphan) break;
-      j += offset_[parent];
+      if (m.parent == kOrphan) break;
+      j += offset_[m.parent];
     }
     if (!valid) continue;
     if (d < best_dist) {
@@ -210,16 +206,16 @@ void GridMaxflow::Adopt(int32_t p) {
     // Record the verified distances along the path so later walks stop early.
     for (int32_t j = q; nodes_[j].ts != time_;) {
       Node& m = nodes_[j];
-      m.ts = static_cast<uint16_t>(time_);
-      m.dist = static_cast<uint8_t>(d > kFarthest ? kFarthest : d);
+      m.ts = time_;
+      m.dist = static_cast<uint16_t>(d > 0xffff ? 0xffff : d);
       --d;
-      j += offset_[Parent(m)];
+      j += offset_[m.parent];
     }
   }
   if (best_dir >= 0) {
-    n.link = static_cast<uint8_t>((n.link & ~kParentMask) | best_dir);
-    n.ts = static_cast<uint16_t>(time_);
-    n.dist = static_cast<uint8_t>(best_dist + 1 > kFarthest ? kFarthest : best_dist + 1);
+    n.parent = static_cast<uint8_t>(best_dir);
+    n.ts = time_;
+    n.dist = static_cast<uint16_t>(best_dist + 1 > 0xffff ? 0xffff : best_dist + 1);
     return;
   }
   // No parent: p leaves its tree. Neighbours that could feed it become active again, and its
@@ -227,12 +223,12 @@ void GridMaxflow::Adopt(int32_t p) {
   for (int dir = 0; dir < 4; ++dir) {
     const int32_t q = p + offset_[dir];
     Node& m = nodes_[q];
-    if (Tree(m) != tree) continue;
+    if (m.tree != tree) continue;
     const int32_t c = kSource ? m.cap[dir ^ 1] : n.cap[dir];
     if (c > 0) Activate(q);
-    if (Parent(m) == (dir ^ 1)) PushOrphan(q);
+    if (m.parent == (dir ^ 1)) PushOrphan(q);
   }
-  n.link = static_cast<uint8_t>((n.link & kQueued) | kFree | kOrphan);
+  n.tree = kFree;
 }
 
 // Before any tree search: moves row y's excess rightward to deficits (ChainRow), then
@@ -304,22 +300,25 @@ void GridMaxflow::InitRow(int32_t y) {
   Node* row = nodes_ + y * w;
   for (int32_t x = live_[2 * y]; x < live_[2 * y + 1]; ++x) {
     Node& n = row[x];
+    n.queued = 0;
     n.ts = 0;
     n.dist = 1;
     if (n.tcap == 0) {
-      n.link = kFree | kOrphan;
+      n.tree = kFree;
+      n.parent = kOrphan;
       continue;
     }
+    n.parent = kTerminal;
     // Only a root with a residual arc into another tree (or to a free node) can grow; the
     // rest become active later if a neighbour leaves their tree (Adopt activates them).
     bool grows = false;
     const Node &r = row[x + 1], &l = row[x - 1], &d = row[x + w], &u = row[x - w];
     if (n.tcap > 0) {
-      n.link = kSourceTree | kTerminal;
+      n.tree = kSourceTree;
       grows = (n.cap[kRight] > 0 && r.tcap <= 0) || (n.cap[kLeft] > 0 && l.tcap <= 0) ||
               (n.cap[kDown] > 0 && d.tcap <= 0) || (n.cap[kUp] > 0 && u.tcap <= 0);
     } else {
-      n.link = kSinkTree | kTerminal;
+      n.tree = kSinkTree;
       grows = (r.cap[kLeft] > 0 && r.tcap >= 0) || (l.cap[kRight] > 0 && l.tcap >= 0) ||
               (d.cap[kUp] > 0 && d.tcap >= 0) || (u.cap[kDown] > 0 && u.tcap >= 0);
     }
@@ -338,21 +337,21 @@ bool GridMaxflow::Grow(int32_t p, int32_t* s_node, int* s_dir) {
     Node& m = nodes_[q];
     const int32_t c = kSource ? n.cap[dir] : m.cap[dir ^ 1];
     if (c <= 0) continue;
-    const uint8_t m_tree = Tree(m);
-    if (m_tree == kFree) {
-      m.link = static_cast<uint8_t>((m.link & kQueued) | tree | (dir ^ 1));
+    if (m.tree == kFree) {
+      m.tree = tree;
+      m.parent = static_cast<uint8_t>(dir ^ 1);
       m.ts = n.ts;
-      m.dist = Near(n.dist);
+      m.dist = static_cast<uint16_t>(n.dist == 0xffff ? 0xffff : n.dist + 1);
       Activate(q);
-    } else if (m_tree != tree) {
+    } else if (m.tree != tree) {
       *s_node = kSource ? p : q;
       *s_dir = kSource ? dir : (dir ^ 1);
       return true;
     } else if (m.ts <= n.ts && m.dist > n.dist) {
       // p is a closer parent for q than the one it has.
-      m.link = static_cast<uint8_t>((m.link & ~kParentMask) | (dir ^ 1));
+      m.parent = static_cast<uint8_t>(dir ^ 1);
       m.ts = n.ts;
-      m.dist = static_cast<uint8_t>(n.dist + 1);
+      m.dist = static_cast<uint16_t>(n.dist + 1);
     }
   }
   return false;
@@ -366,28 +365,24 @@ int64_t GridMaxflow::Solve() {
 
   int32_t current = kNotActive;
   for (;;) {
-    if (current == kNotActive || Tree(nodes_[current]) == kFree) current = NextActive();
+    if (current == kNotActive || nodes_[current].tree == kFree) current = NextActive();
     if (current == kNotActive) break;
     const int32_t p = current;
     int32_t touch_s = 0;
     int touch_dir = 0;
-    const bool touched = Tree(nodes_[p]) == kSourceTree ? Grow<true>(p, &touch_s, &touch_dir)
-                                                        : Grow<false>(p, &touch_s, &touch_dir);
+    const bool touched = nodes_[p].tree == kSourceTree ? Grow<true>(p, &touch_s, &touch_dir)
+                                                       : Grow<false>(p, &touch_s, &touch_dir);
     if (!touched) {
       current = kNotActive;
       continue;
     }
-    if (++time_ == kLastTime) {
-      // The stamps wrap: every verified distance becomes unverified, which only costs walks.
-      for (int32_t q = 0; q < count_; ++q) nodes_[q].ts = 0;
-      time_ = 1;
-    }
+    ++time_;
     Augment(touch_s, touch_dir);
     while (orphan_count_ > 0) {
       const int32_t o = orphans_[orphan_head_];
       orphan_head_ = orphan_head_ + 1 == max_nodes_ ? 0 : orphan_head_ + 1;
       --orphan_count_;
-      if (Tree(nodes_[o]) == kSourceTree) {
+      if (nodes_[o].tree == kSourceTree) {
         Adopt<true>(o);
       } else {
         Adopt<false>(o);

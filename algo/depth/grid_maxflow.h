@@ -60,7 +60,7 @@ class GridMaxflow {
   int64_t Solve();
 
   // After Solve: true when p is on the source side of the minimum cut.
-  bool InSource(int32_t p) const { return (nodes_[p].link & kTreeMask) == kSourceTree; }
+  bool InSource(int32_t p) const { return nodes_[p].tree == kSourceTree; }
 
   // Node storage that graphs of at most width x height nodes never touch, lent to the caller
   // until a larger graph begins: its size in bytes, and where it starts (nullptr when none).
@@ -71,27 +71,20 @@ class GridMaxflow {
 
  private:
   friend struct GridMaxflowProbe;
-  // A node's link byte: its parent (bits 0-2: a Dir, kTerminal or kOrphan), its tree (bits 3-4)
-  // and whether it waits in the active queue (bit 5), so that a node fits 24 bytes.
-  static constexpr uint8_t kTerminal = 4, kOrphan = 5, kParentMask = 7;
-  static constexpr uint8_t kFree = 0, kSourceTree = 8, kSinkTree = 16, kTreeMask = 24;
-  static constexpr uint8_t kQueued = 32;
+  static constexpr uint8_t kFree = 0, kSourceTree = 1, kSinkTree = 2;
+  static constexpr uint8_t kTerminal = 4, kOrphan = 5;  // parent values besides a Dir
   static constexpr int32_t kNotActive = -1;
-  // Time stamps are 16 bits: at this many augmentations, every stamp is cleared (Solve).
-  static constexpr int32_t kLastTime = 0xffff;
-  static constexpr uint8_t kFarthest = 0xff;  // distances saturate here
 
   struct Node {
-    int32_t cap[4] = {};     // residual capacity of the arc to each neighbour
-    int32_t tcap = 0;        // residual terminal capacity: > 0 from the source, < 0 to the sink
-    uint16_t ts = 0;         // time stamp of the last verified distance to a terminal
-    uint8_t dist = 1;        // distance to the terminal (saturating; only a heuristic)
-    uint8_t link = kOrphan;  // parent | tree | kQueued
+    int32_t cap[4] = {};       // residual capacity of the arc to each neighbour
+    int32_t tcap = 0;          // residual terminal capacity: > 0 from the source, < 0 to the sink
+    int32_t queued = 0;        // 1 while in the active queue
+    int32_t ts = 0;            // time stamp of the last verified distance to a terminal
+    uint16_t dist = 1;         // distance to the terminal (saturating; only a heuristic)
+    uint8_t parent = kOrphan;  // a Dir, kTerminal or kOrphan
+    uint8_t tree = kFree;      // kFree, kSourceTree or kSinkTree
   };
-  static_assert(sizeof(Node) == 24);
-  static uint8_t Parent(const Node& n) { return n.link & kParentMask; }
-  static uint8_t Tree(const Node& n) { return n.link & kTreeMask; }
-  static uint8_t Near(uint8_t dist) { return dist == kFarthest ? kFarthest : dist + 1; }
+  static_assert(sizeof(Node) == 32);
 
   void Start(int32_t width, int32_t height);
   void PushRow(int32_t y);
