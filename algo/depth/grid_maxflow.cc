@@ -106,61 +106,70 @@ void GridMaxflow::PushOrphan(int32_t p) {
   ++orphan_count_;
 }
 
-// s_node is in the source tree, its neighbour in direction `dir` in the sink tree.
+// s_node is in the source tree, its neighbour in direction `dir` in the sink tree. The walks
+// to the roots that find the bottleneck record the paths' first nodes, so the updates that follow
+// are independent steps instead of another chain of dependent loads.
 void GridMaxflow::Augment(int32_t s_node, int dir) {
   const int32_t t_node = s_node + offset_[dir];
   int32_t bottleneck = nodes_[s_node].cap[dir];
   // Source side: arcs parent -> child, up to the root's source capacity.
-  for (int32_t p = s_node;;) {
+  int32_t s_len = 0, p = s_node;
+  for (;;) {
     const Node& n = nodes_[p];
-    if (n.parent == kTerminal) {
-      if (n.tcap < bottleneck) bottleneck = n.tcap;
-      break;
-    }
+    if (n.parent == kTerminal) break;
+    path_[s_len < kPath ? s_len : kPath] = p;
+    ++s_len;
     const int32_t parent = p + offset_[n.parent];
     const int32_t c = nodes_[parent].cap[n.parent ^ 1];
-    if (c < bottleneck) bottleneck = c;
+    bottleneck = c < bottleneck ? c : bottleneck;
     p = parent;
   }
+  const int32_t s_root = p;
+  bottleneck = nodes_[s_root].tcap < bottleneck ? nodes_[s_root].tcap : bottleneck;
   // Sink side: arcs child -> parent, down to the root's sink capacity.
-  for (int32_t p = t_node;;) {
+  int32_t* const t_path = path_ + kPath + 1;
+  int32_t t_len = 0;
+  for (p = t_node;;) {
     const Node& n = nodes_[p];
-    if (n.parent == kTerminal) {
-      if (-n.tcap < bottleneck) bottleneck = -n.tcap;
-      break;
-    }
-    if (n.cap[n.parent] < bottleneck) bottleneck = n.cap[n.parent];
+    if (n.parent == kTerminal) break;
+    t_path[t_len < kPath ? t_len : kPath] = p;
+    ++t_len;
+    const int32_t c = n.cap[n.parent];
+    bottleneck = c < bottleneck ? c : bottleneck;
     p += offset_[n.parent];
   }
+  const int32_t t_root = p;
+  bottleneck = -nodes_[t_root].tcap < bottleneck ? -nodes_[t_root].tcap : bottleneck;
 
   nodes_[s_node].cap[dir] -= bottleneck;
   nodes_[t_node].cap[dir ^ 1] += bottleneck;
-  for (int32_t p = s_node;;) {
-    Node& n = nodes_[p];
-    if (n.parent == kTerminal) {
-      n.tcap -= bottleneck;
-      if (n.tcap == 0) PushOrphan(p);
-      break;
-    }
+  // Paths longer than the record go on by walking.
+  auto source_step = [&](int32_t q) {
+    Node& n = nodes_[q];
     const int d = n.parent;
-    const int32_t parent = p + offset_[d];
+    const int32_t parent = q + offset_[d];
     n.cap[d] += bottleneck;
-    if ((nodes_[parent].cap[d ^ 1] -= bottleneck) == 0) PushOrphan(p);
-    p = parent;
+    if ((nodes_[parent].cap[d ^ 1] -= bottleneck) == 0) PushOrphan(q);
+    return parent;
+  };
+  for (int32_t i = 0; i < s_len && i < kPath; ++i) source_step(path_[i]);
+  if (s_len > kPath) {
+    for (p = source_step(path_[kPath - 1]); p != s_root;) p = source_step(p);
   }
-  for (int32_t p = t_node;;) {
-    Node& n = nodes_[p];
-    if (n.parent == kTerminal) {
-      n.tcap += bottleneck;
-      if (n.tcap == 0) PushOrphan(p);
-      break;
-    }
+  if ((nodes_[s_root].tcap -= bottleneck) == 0) PushOrphan(s_root);
+  auto sink_step = [&](int32_t q) {
+    Node& n = nodes_[q];
     const int d = n.parent;
-    const int32_t parent = p + offset_[d];
+    const int32_t parent = q + offset_[d];
     nodes_[parent].cap[d ^ 1] += bottleneck;
-    if ((n.cap[d] -= bottleneck) == 0) PushOrphan(p);
-    p = parent;
+    if ((n.cap[d] -= bottleneck) == 0) PushOrphan(q);
+    return parent;
+  };
+  for (int32_t i = 0; i < t_len && i < kPath; ++i) sink_step(t_path[i]);
+  if (t_len > kPath) {
+    for (p = sink_step(t_path[kPath - 1]); p != t_root;) p = sink_step(p);
   }
+  if ((nodes_[t_root].tcap += bottleneck) == 0) PushOrphan(t_root);
   flow_ += bottleneck;
 }
 

@@ -105,7 +105,10 @@ class GridMaxflow {
   // FIFO of active nodes, max_nodes_ entries (a node is queued at most once): unlike a linked
   // list, it shows the nodes to come, which are prefetched.
   int32_t* queue_ = nullptr;
-  int32_t* live_ = nullptr;  // per row, the columns x0, x1 the row passes look at (RowDone)
+  int32_t* live_ = nullptr;
+  // Augment's record of the two paths' first nodes (each kPath, and a slot that takes the rest).
+  static constexpr int32_t kPath = 255;
+  int32_t path_[2 * (kPath + 1)];  // per row, the columns x0, x1 the row passes look at (RowDone)
   int32_t max_nodes_ = 0, max_width_ = 0;
   int32_t width_ = 0, height_ = 0, count_ = 0;
   int32_t offset_[4] = {};           // node index step in each direction
