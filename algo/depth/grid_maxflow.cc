@@ -303,6 +303,49 @@ void GridMaxflow::ChainRow(Node* row, int32_t w) {
   }
 }
 
+// Moves excess down the columns toward the deficits it can reach (as ChainRow along the rows),
+// row by row over the whole graph. An arc down has capacity only where both rows are live, so
+// each row pair looks at the columns common to both.
+void GridMaxflow::ChainColumns() {
+  const int32_t w = width_, h = height_;
+  if (h < 2) return;
+  int32_t* demand = orphans_;  // free until the search
+  // Row y's demands, over columns lo..hi-1 of rows y and y + 1 (the pair's common columns).
+  int32_t below_lo = 0, below_hi = 0;
+  for (int32_t y = h - 2; y >= 0; --y) {
+    const int32_t lo = live_[2 * y] > live_[2 * y + 2] ? live_[2 * y] : live_[2 * y + 2];
+    const int32_t hi = live_[2 * y + 1] < live_[2 * y + 3] ? live_[2 * y + 1] : live_[2 * y + 3];
+    const Node* row = nodes_ + y * w;
+    int32_t* dem = demand + y * w;
+    for (int32_t x = lo; x < hi; ++x) {
+      const int32_t more = x >= below_lo && x < below_hi ? dem[x + w] : 0;
+      const int32_t want = more - row[x + w].tcap;
+      const int32_t c = row[x].cap[kDown];
+      dem[x] = want <= 0 ? 0 : (want < c ? want : c);
+    }
+    below_lo = lo;
+    below_hi = hi > lo ? hi : lo;
+  }
+  for (int32_t y = 0; y + 1 < h; ++y) {
+    const int32_t lo = live_[2 * y] > live_[2 * y + 2] ? live_[2 * y] : live_[2 * y + 2];
+    const int32_t hi = live_[2 * y + 1] < live_[2 * y + 3] ? live_[2 * y + 1] : live_[2 * y + 3];
+    Node* row = nodes_ + y * w;
+    const int32_t* dem = demand + y * w;
+    for (int32_t x = lo; x < hi; ++x) {
+      Node& from = row[x];
+      int32_t d = from.tcap < dem[x] ? from.tcap : dem[x];
+      if (d <= 0) continue;
+      Node& to = row[x + w];
+      const int32_t met = -to.tcap < d ? -to.tcap : d;
+      flow_ += met > 0 ? met : 0;
+      from.tcap -= d;
+      to.tcap += d;
+      from.cap[kDown] -= d;
+      to.cap[kUp] += d;
+    }
+  }
+}
+
 // Roots of row y; needs the final balances of rows y - 1..y + 1.
 void GridMaxflow::InitRow(int32_t y) {
   const int32_t w = width_;
@@ -368,6 +411,7 @@ bool GridMaxflow::Grow(int32_t p, int32_t* s_node, int* s_dir) {
 
 int64_t GridMaxflow::Solve() {
   while (pushed_ < height_) PushRow(pushed_++);
+  ChainColumns();
   while (inited_ < height_) InitRow(inited_++);
   orphan_head_ = orphan_count_ = 0;
   time_ = 0;

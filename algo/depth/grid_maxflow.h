@@ -50,7 +50,6 @@ class GridMaxflow {
     live_[2 * y] = x0;
     live_[2 * y + 1] = x1;
     if (y >= 1) PushRow(pushed_++);
-    if (y >= 2) InitRow(inited_++);
   }
 
   // Ends the graph after its first `height` rows (all RowDone), as if it had been begun so.
@@ -90,6 +89,7 @@ class GridMaxflow {
   void PushRow(int32_t y);
   void ChainRow(Node* row, int32_t w);
   void InitRow(int32_t y);
+  void ChainColumns();
   void Activate(int32_t p);
   int32_t NextActive();
   template <bool kSource>
