@@ -39,7 +39,7 @@ void GridMaxflow::Start(int32_t width, int32_t height) {
   offset_[kDown] = width;
   offset_[kUp] = -width;
   flow_ = 0;
-  pushed_ = inited_ = 0;
+  pushed_ = 0;
   queue_head_ = queue_count_ = 0;
 }
 
@@ -240,36 +240,10 @@ void GridMaxflow::Adopt(int32_t p) {
   n.tree = kFree;
 }
 
-// Before any tree search: moves row y's excess rightward to deficits (ChainRow), then
-// augments every path source -> p -> q -> sink over one arc down or up (the asymmetric split of
-// the pair terms leaves many such neighbouring pairs). Needs row y + 1 set, and is the last
-// change to row y's terminal balances.
+// Before any tree search: moves row y's excess rightward to deficits (ChainRow).
 void GridMaxflow::PushRow(int32_t y) {
-  const int32_t w = width_;
-  auto push = [&](Node& from, Node& to, int dir) {
-    int32_t d = from.tcap < -to.tcap ? from.tcap : -to.tcap;
-    d = d < from.cap[dir] ? d : from.cap[dir];
-    from.tcap -= d;
-    to.tcap += d;
-    from.cap[dir] -= d;
-    to.cap[dir ^ 1] += d;
-    flow_ += d;
-  };
-  Node* row = nodes_ + y * w;
   const int32_t x0 = live_[2 * y], x1 = live_[2 * y + 1];
-  if (x1 - x0 >= 2) ChainRow(row + x0, x1 - x0);
-  if (y + 1 >= height_) return;
-  // A pair needs two nodes with balances: both within their rows' live columns.
-  const int32_t lo = x0 > live_[2 * y + 2] ? x0 : live_[2 * y + 2];
-  const int32_t hi = x1 < live_[2 * y + 3] ? x1 : live_[2 * y + 3];
-  for (int32_t x = lo; x < hi; ++x) {
-    Node& n = row[x];
-    Node& m = row[x + w];
-    if (n.tcap > 0 && m.tcap < 0)
-      push(n, m, kDown);
-    else if (n.tcap < 0 && m.tcap > 0)
-      push(m, n, kUp);
-  }
+  if (x1 - x0 >= 2) ChainRow(nodes_ + y * width_ + x0, x1 - x0);
 }
 
 // Moves excess rightward along the row toward the deficits it can reach. Moving excess d from a
@@ -304,11 +278,15 @@ void GridMaxflow::ChainRow(Node* row, int32_t w) {
 }
 
 // Moves excess down the columns toward the deficits it can reach (as ChainRow along the rows),
-// row by row over the whole graph. An arc down has capacity only where both rows are live, so
-// each row pair looks at the columns common to both.
+// row by row over the whole graph (an arc down has capacity only where both rows are live, so
+// each row pair looks at the columns common to both), then roots the trees (InitRow) a row
+// behind, while the rows are in cache.
 void GridMaxflow::ChainColumns() {
   const int32_t w = width_, h = height_;
-  if (h < 2) return;
+  if (h < 2) {
+    for (int32_t y = 0; y < h; ++y) InitRow(y);
+    return;
+  }
   int32_t* demand = orphans_;  // free until the search
   // Row y's demands, over columns lo..hi-1 of rows y and y + 1 (the pair's common columns).
   int32_t below_lo = 0, below_hi = 0;
@@ -343,7 +321,11 @@ void GridMaxflow::ChainColumns() {
       from.cap[kDown] -= d;
       to.cap[kUp] += d;
     }
+    // Row y's balances are final: row y - 1's roots can be set.
+    if (y >= 1) InitRow(y - 1);
   }
+  InitRow(h - 2);
+  InitRow(h - 1);
 }
 
 // Roots of row y; needs the final balances of rows y - 1..y + 1.
@@ -412,7 +394,6 @@ bool GridMaxflow::Grow(int32_t p, int32_t* s_node, int* s_dir) {
 int64_t GridMaxflow::Solve() {
   while (pushed_ < height_) PushRow(pushed_++);
   ChainColumns();
-  while (inited_ < height_) InitRow(inited_++);
   orphan_head_ = orphan_count_ = 0;
   time_ = 0;
 

@@ -26,8 +26,8 @@ class GridMaxflow {
   void Carve(Arena& arena, int32_t max_width, int32_t max_height);
 
   // Starts a new graph of width x height nodes whose every node the caller then sets once with
-  // SetNode, row by row, calling RowDone after each row (no clearing pass: the rows' pushes
-  // and the initial trees are prepared two rows behind, while the rows are still in cache).
+  // SetNode, row by row, calling RowDone after each row (no clearing pass: each row's chain of
+  // pushes runs as it is done, while the row is still in cache).
   void Begin(int32_t width, int32_t height);
   // Sets node p: its terminal balance (positive: source->p, negative: p->sink) and its arcs to
   // the right and down neighbours, which must be 0 in the last column and the last row; the sister
@@ -49,7 +49,8 @@ class GridMaxflow {
   void RowDone(int32_t y, int32_t x0, int32_t x1) {
     live_[2 * y] = x0;
     live_[2 * y + 1] = x1;
-    if (y >= 1) PushRow(pushed_++);
+    PushRow(y);
+    pushed_ = y + 1;
   }
 
   // Ends the graph after its first `height` rows (all RowDone), as if it had been begun so.
@@ -111,8 +112,8 @@ class GridMaxflow {
   int32_t path_[2 * (kPath + 1)];  // per row, the columns x0, x1 the row passes look at (RowDone)
   int32_t max_nodes_ = 0, max_width_ = 0;
   int32_t width_ = 0, height_ = 0, count_ = 0;
-  int32_t offset_[4] = {};           // node index step in each direction
-  int32_t pushed_ = 0, inited_ = 0;  // rows whose pushes / initial trees are done
+  int32_t offset_[4] = {};  // node index step in each direction
+  int32_t pushed_ = 0;      // rows whose pushes along the row are done
   int32_t queue_head_ = 0, queue_count_ = 0;
   int32_t orphan_head_ = 0, orphan_count_ = 0;
   int32_t time_ = 0;
