@@ -381,12 +381,9 @@ bool GridMaxflow::Grow(int32_t p, int32_t* s_node, int* s_dir) {
       *s_node = kSource ? p : q;
       *s_dir = kSource ? dir : (dir ^ 1);
       return true;
-    } else if (m.ts <= n.ts && m.dist > n.dist) {
-      // p is a closer parent for q than the one it has.
-      m.parent = static_cast<uint8_t>(dir ^ 1);
-      m.ts = n.ts;
-      m.dist = static_cast<uint16_t>(n.dist + 1);
     }
+    // (A node of p's own tree keeps its parent even when p is closer to the terminal: moving it
+    // under p cost more than the shorter paths saved, on teddy's graphs 0.71x against 0.78x.)
   }
   return false;
 }
