@@ -39,7 +39,6 @@ void GridMaxflow::Start(int32_t width, int32_t height) {
   offset_[kDown] = width;
   offset_[kUp] = -width;
   flow_ = 0;
-  pushed_ = 0;
   queue_head_ = queue_count_ = 0;
 }
 
@@ -240,19 +239,13 @@ void GridMaxflow::Adopt(int32_t p) {
   n.tree = kFree;
 }
 
-// Before any tree search: moves row y's excess rightward to deficits (ChainRow).
-void GridMaxflow::PushRow(int32_t y) {
-  const int32_t x0 = live_[2 * y], x1 = live_[2 * y + 1];
-  if (x1 - x0 >= 2) ChainRow(nodes_ + y * width_ + x0, x1 - x0);
-}
-
-// Moves excess rightward along the row toward the deficits it can reach. Moving excess d from a
-// node to its neighbour over an arc of residual at least d leaves every cut's capacity as it
-// was, so the minimum cuts are the same; flow_ counts what meets a deficit. (Moving leftward as
-// well cost more than it saved the tree search on the depth stage's graphs.)
-void GridMaxflow::ChainRow(Node* row, int32_t w) {
+// Moves excess rightward along the row toward the deficits it can reach (`demand`: w entries of
+// scratch). Moving excess d from a node to its neighbour over an arc of residual at least d
+// leaves every cut's capacity as it was, so the minimum cuts are the same; flow_ counts what
+// meets a deficit. (Moving leftward as well cost more than it saved the tree search on the depth
+// stage's graphs.)
+void GridMaxflow::ChainRow(Node* row, int32_t w, int32_t* demand) {
   // What the nodes right of x still lack that the arc x -> x + 1 can carry.
-  int32_t* demand = orphans_;  // free until Solve
   demand[w - 1] = 0;
   bool excess = row[w - 1].tcap > 0, deficit = row[w - 1].tcap < 0;
   for (int32_t x = w - 2; x >= 0; --x) {
@@ -277,14 +270,23 @@ void GridMaxflow::ChainRow(Node* row, int32_t w) {
   }
 }
 
-// Moves excess down the columns toward the deficits it can reach (as ChainRow along the rows),
-// row by row over the whole graph (an arc down has capacity only where both rows are live, so
-// each row pair looks at the columns common to both), then roots the trees (InitRow) a row
-// behind, while the rows are in cache.
-void GridMaxflow::ChainColumns() {
+// Before any tree search, one sweep down the graph: excess moves down the columns toward the
+// deficits it can reach, then along each row (ChainRow), and the trees are rooted a row behind
+// (InitRow), while the rows are in cache. On the depth stage's graphs, the column chain before
+// the row chain leaves the search far less to do: on teddy, 0.66x the time of the row chain
+// alone (the same transformation as ChainRow's, over arcs down; an arc down has capacity only
+// where both rows are live, so each row pair looks at the columns common to both).
+void GridMaxflow::Prepare() {
   const int32_t w = width_, h = height_;
+  auto chain_row = [&](int32_t y, int32_t* scratch) {
+    const int32_t x0 = live_[2 * y], x1 = live_[2 * y + 1];
+    if (x1 - x0 >= 2) ChainRow(nodes_ + y * w + x0, x1 - x0, scratch);
+  };
   if (h < 2) {
-    for (int32_t y = 0; y < h; ++y) InitRow(y);
+    for (int32_t y = 0; y < h; ++y) {
+      chain_row(y, orphans_);
+      InitRow(y);
+    }
     return;
   }
   int32_t* demand = orphans_;  // free until the search
@@ -321,9 +323,12 @@ void GridMaxflow::ChainColumns() {
       from.cap[kDown] -= d;
       to.cap[kUp] += d;
     }
+    // Row y's column demands are spent: their room is the row chain's scratch.
+    chain_row(y, demand + y * w);
     // Row y's balances are final: row y - 1's roots can be set.
     if (y >= 1) InitRow(y - 1);
   }
+  chain_row(h - 1, demand);
   InitRow(h - 2);
   InitRow(h - 1);
 }
@@ -389,8 +394,7 @@ bool GridMaxflow::Grow(int32_t p, int32_t* s_node, int* s_dir) {
 }
 
 int64_t GridMaxflow::Solve() {
-  while (pushed_ < height_) PushRow(pushed_++);
-  ChainColumns();
+  Prepare();
   orphan_head_ = orphan_count_ = 0;
   time_ = 0;
 
