@@ -151,10 +151,9 @@ void GridMaxflow::Augment(int32_t s_node, int dir) {
     if ((nodes_[parent].cap[d ^ 1] -= bottleneck) == 0) PushOrphan(q);
     return parent;
   };
-  for (int32_t i = 0; i < s_len && i < kPath; ++i) source_step(path_[i]);
-  if (s_len > kPath) {
-    for (p = source_step(path_[kPath - 1]); p != s_root;) p = source_step(p);
-  }
+  p = s_root;
+  for (int32_t i = 0; i < s_len && i < kPath; ++i) p = source_step(path_[i]);
+  while (p != s_root) p = source_step(p);
   if ((nodes_[s_root].tcap -= bottleneck) == 0) PushOrphan(s_root);
   auto sink_step = [&](int32_t q) {
     Node& n = nodes_[q];
@@ -164,10 +163,9 @@ void GridMaxflow::Augment(int32_t s_node, int dir) {
     if ((n.cap[d] -= bottleneck) == 0) PushOrphan(q);
     return parent;
   };
-  for (int32_t i = 0; i < t_len && i < kPath; ++i) sink_step(t_path[i]);
-  if (t_len > kPath) {
-    for (p = sink_step(t_path[kPath - 1]); p != t_root;) p = sink_step(p);
-  }
+  p = t_root;
+  for (int32_t i = 0; i < t_len && i < kPath; ++i) p = sink_step(t_path[i]);
+  while (p != t_root) p = sink_step(p);
   if ((nodes_[t_root].tcap += bottleneck) == 0) PushOrphan(t_root);
   flow_ += bottleneck;
 }

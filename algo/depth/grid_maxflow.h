@@ -133,6 +133,10 @@ struct GridMaxflowProbe {
     mf.nodes_[p].cap[dir] += cap_pq;
     mf.nodes_[p + mf.offset_[dir]].cap[dir ^ 1] += cap_qp;
   }
+  // After Solve: the residual capacity of the arc from p in direction `dir`.
+  static int32_t Residual(const GridMaxflow& mf, int32_t p, GridMaxflow::Dir dir) {
+    return mf.nodes_[p].cap[dir];
+  }
 };
 
 }  // namespace lb

@@ -299,8 +299,9 @@ TEST_F(MaxflowTest, LongWindingPathAgrees) {
     const int32_t side = trial < 2 ? 33 : 64;
     const bool near_sink = trial % 2 == 1;
     Graph g = RandomGraph(rng, side, side, 0);
-    std::vector<int32_t> path;  // the corridor's nodes, source end first
-    std::vector<int32_t*> arc;  // arc[i]: the capacity of path[i] -> path[i + 1]
+    std::vector<int32_t> path;   // the corridor's nodes, source end first
+    std::vector<int32_t*> arc;   // arc[i]: the capacity of path[i] -> path[i + 1]
+    std::vector<int32_t*> back;  // back[i]: the capacity of path[i + 1] -> path[i]
     auto link = [&](int32_t p, int32_t q) {
       int32_t* forward = q == p + 1   ? &g.right_fwd[p]
                          : q == p - 1 ? &g.right_bwd[q]
@@ -311,6 +312,7 @@ TEST_F(MaxflowTest, LongWindingPathAgrees) {
       *forward = cap(rng);
       *backward = cap(rng);
       arc.push_back(forward);
+      back.push_back(backward);
     };
     for (int32_t y = 0; y < side; y += 2) {
       const bool rightward = (y / 2) % 2 == 0;
@@ -339,6 +341,16 @@ TEST_F(MaxflowTest, LongWindingPathAgrees) {
     for (size_t i = 0; i <= narrowest; ++i) source_side[path[i]] = true;
     for (int32_t p = 0; p < side * side; ++p) {
       ASSERT_EQ(mf_.InSource(p), source_side[p]) << trial << " " << p;
+    }
+    // The flow of 2 went along the whole corridor, once: every arc of it carries exactly 2.
+    for (size_t i = 0; i + 1 < path.size(); ++i) {
+      const int32_t p = path[i], q = path[i + 1];
+      const GridMaxflow::Dir dir = q == p + 1   ? GridMaxflow::kRight
+                                   : q == p - 1 ? GridMaxflow::kLeft
+                                                : GridMaxflow::kDown;
+      const GridMaxflow::Dir sister = static_cast<GridMaxflow::Dir>(dir ^ 1);
+      ASSERT_EQ(GridMaxflowProbe::Residual(mf_, p, dir), *arc[i] - 2) << trial << " " << i;
+      ASSERT_EQ(GridMaxflowProbe::Residual(mf_, q, sister), *back[i] + 2) << trial << " " << i;
     }
     if (side <= 40) {
       ASSERT_EQ(TextbookMaxflow(g), expected);
