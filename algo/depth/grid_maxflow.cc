@@ -39,7 +39,6 @@ void GridMaxflow::Start(int32_t width, int32_t height) {
   offset_[kDown] = width;
   offset_[kUp] = -width;
   flow_ = 0;
-  pushed_ = inited_ = 0;
   queue_head_ = queue_count_ = 0;
 }
 
@@ -106,61 +105,68 @@ void GridMaxflow::PushOrphan(int32_t p) {
   ++orphan_count_;
 }
 
-// s_node is in the source tree, its neighbour in direction `dir` in the sink tree.
+// s_node is in the source tree, its neighbour in direction `dir` in the sink tree. The walks
+// to the roots that find the bottleneck record the paths' first nodes, so the updates that follow
+// are independent steps instead of another chain of dependent loads.
 void GridMaxflow::Augment(int32_t s_node, int dir) {
   const int32_t t_node = s_node + offset_[dir];
   int32_t bottleneck = nodes_[s_node].cap[dir];
   // Source side: arcs parent -> child, up to the root's source capacity.
-  for (int32_t p = s_node;;) {
+  int32_t s_len = 0, p = s_node;
+  for (;;) {
     const Node& n = nodes_[p];
-    if (n.parent == kTerminal) {
-      if (n.tcap < bottleneck) bottleneck = n.tcap;
-      break;
-    }
+    if (n.parent == kTerminal) break;
+    path_[s_len < kPath ? s_len : kPath] = p;
+    ++s_len;
     const int32_t parent = p + offset_[n.parent];
     const int32_t c = nodes_[parent].cap[n.parent ^ 1];
-    if (c < bottleneck) bottleneck = c;
+    bottleneck = c < bottleneck ? c : bottleneck;
     p = parent;
   }
+  const int32_t s_root = p;
+  bottleneck = nodes_[s_root].tcap < bottleneck ? nodes_[s_root].tcap : bottleneck;
   // Sink side: arcs child -> parent, down to the root's sink capacity.
-  for (int32_t p = t_node;;) {
+  int32_t* const t_path = path_ + kPath + 1;
+  int32_t t_len = 0;
+  for (p = t_node;;) {
     const Node& n = nodes_[p];
-    if (n.parent == kTerminal) {
-      if (-n.tcap < bottleneck) bottleneck = -n.tcap;
-      break;
-    }
-    if (n.cap[n.parent] < bottleneck) bottleneck = n.cap[n.parent];
+    if (n.parent == kTerminal) break;
+    t_path[t_len < kPath ? t_len : kPath] = p;
+    ++t_len;
+    const int32_t c = n.cap[n.parent];
+    bottleneck = c < bottleneck ? c : bottleneck;
     p += offset_[n.parent];
   }
+  const int32_t t_root = p;
+  bottleneck = -nodes_[t_root].tcap < bottleneck ? -nodes_[t_root].tcap : bottleneck;
 
   nodes_[s_node].cap[dir] -= bottleneck;
   nodes_[t_node].cap[dir ^ 1] += bottleneck;
-  for (int32_t p = s_node;;) {
-    Node& n = nodes_[p];
-    if (n.parent == kTerminal) {
-      n.tcap -= bottleneck;
-      if (n.tcap == 0) PushOrphan(p);
-      break;
-    }
+  // Paths longer than the record go on by walking.
+  auto source_step = [&](int32_t q) {
+    Node& n = nodes_[q];
     const int d = n.parent;
-    const int32_t parent = p + offset_[d];
+    const int32_t parent = q + offset_[d];
     n.cap[d] += bottleneck;
-    if ((nodes_[parent].cap[d ^ 1] -= bottleneck) == 0) PushOrphan(p);
-    p = parent;
-  }
-  for (int32_t p = t_node;;) {
-    Node& n = nodes_[p];
-    if (n.parent == kTerminal) {
-      n.tcap += bottleneck;
-      if (n.tcap == 0) PushOrphan(p);
-      break;
-    }
+    if ((nodes_[parent].cap[d ^ 1] -= bottleneck) == 0) PushOrphan(q);
+    return parent;
+  };
+  p = s_root;
+  for (int32_t i = 0; i < s_len && i < kPath; ++i) p = source_step(path_[i]);
+  while (p != s_root) p = source_step(p);
+  if ((nodes_[s_root].tcap -= bottleneck) == 0) PushOrphan(s_root);
+  auto sink_step = [&](int32_t q) {
+    Node& n = nodes_[q];
     const int d = n.parent;
-    const int32_t parent = p + offset_[d];
+    const int32_t parent = q + offset_[d];
     nodes_[parent].cap[d ^ 1] += bottleneck;
-    if ((n.cap[d] -= bottleneck) == 0) PushOrphan(p);
-    p = parent;
-  }
+    if ((n.cap[d] -= bottleneck) == 0) PushOrphan(q);
+    return parent;
+  };
+  p = t_root;
+  for (int32_t i = 0; i < t_len && i < kPath; ++i) p = sink_step(t_path[i]);
+  while (p != t_root) p = sink_step(p);
+  if ((nodes_[t_root].tcap += bottleneck) == 0) PushOrphan(t_root);
   flow_ += bottleneck;
 }
 
@@ -231,45 +237,13 @@ void GridMaxflow::Adopt(int32_t p) {
   n.tree = kFree;
 }
 
-// Before any tree search: moves row y's excess rightward to deficits (ChainRow), then
-// augments every path source -> p -> q -> sink over one arc down or up (the asymmetric split of
-// the pair terms leaves many such neighbouring pairs). Needs row y + 1 set, and is the last
-// change to row y's terminal balances.
-void GridMaxflow::PushRow(int32_t y) {
-  const int32_t w = width_;
-  auto push = [&](Node& from, Node& to, int dir) {
-    int32_t d = from.tcap < -to.tcap ? from.tcap : -to.tcap;
-    d = d < from.cap[dir] ? d : from.cap[dir];
-    from.tcap -= d;
-    to.tcap += d;
-    from.cap[dir] -= d;
-    to.cap[dir ^ 1] += d;
-    flow_ += d;
-  };
-  Node* row = nodes_ + y * w;
-  const int32_t x0 = live_[2 * y], x1 = live_[2 * y + 1];
-  if (x1 - x0 >= 2) ChainRow(row + x0, x1 - x0);
-  if (y + 1 >= height_) return;
-  // A pair needs two nodes with balances: both within their rows' live columns.
-  const int32_t lo = x0 > live_[2 * y + 2] ? x0 : live_[2 * y + 2];
-  const int32_t hi = x1 < live_[2 * y + 3] ? x1 : live_[2 * y + 3];
-  for (int32_t x = lo; x < hi; ++x) {
-    Node& n = row[x];
-    Node& m = row[x + w];
-    if (n.tcap > 0 && m.tcap < 0)
-      push(n, m, kDown);
-    else if (n.tcap < 0 && m.tcap > 0)
-      push(m, n, kUp);
-  }
-}
-
-// Moves excess rightward along the row toward the deficits it can reach. Moving excess d from a
-// node to its neighbour over an arc of residual at least d leaves every cut's capacity as it
-// was, so the minimum cuts are the same; flow_ counts what meets a deficit. (Moving leftward as
-// well cost more than it saved the tree search on the depth stage's graphs.)
-void GridMaxflow::ChainRow(Node* row, int32_t w) {
+// Moves excess rightward along the row toward the deficits it can reach (`demand`: w entries of
+// scratch). Moving excess d from a node to its neighbour over an arc of residual at least d
+// leaves every cut's capacity as it was, so the minimum cuts are the same; flow_ counts what
+// meets a deficit. (Moving leftward as well cost more than it saved the tree search on the depth
+// stage's graphs.)
+void GridMaxflow::ChainRow(Node* row, int32_t w, int32_t* demand) {
   // What the nodes right of x still lack that the arc x -> x + 1 can carry.
-  int32_t* demand = orphans_;  // free until Solve
   demand[w - 1] = 0;
   bool excess = row[w - 1].tcap > 0, deficit = row[w - 1].tcap < 0;
   for (int32_t x = w - 2; x >= 0; --x) {
@@ -292,6 +266,69 @@ void GridMaxflow::ChainRow(Node* row, int32_t w) {
     from.cap[kRight] -= d;
     to.cap[kLeft] += d;
   }
+}
+
+// Before any tree search, one sweep down the graph: excess moves down the columns toward the
+// deficits it can reach, then along each row (ChainRow), and the trees are rooted a row behind
+// (InitRow), while the rows are in cache. On the depth stage's graphs, the column chain before
+// the row chain leaves the search far less to do: on teddy, 0.66x the time of the row chain
+// alone (the same transformation as ChainRow's, over arcs down; an arc down has capacity only
+// where both rows are live, so each row pair looks at the columns common to both).
+void GridMaxflow::Prepare() {
+  const int32_t w = width_, h = height_;
+  auto chain_row = [&](int32_t y, int32_t* scratch) {
+    const int32_t x0 = live_[2 * y], x1 = live_[2 * y + 1];
+    if (x1 - x0 >= 2) ChainRow(nodes_ + y * w + x0, x1 - x0, scratch);
+  };
+  if (h < 2) {
+    for (int32_t y = 0; y < h; ++y) {
+      chain_row(y, orphans_);
+      InitRow(y);
+    }
+    return;
+  }
+  int32_t* demand = orphans_;  // free until the search
+  // Row y's demands, over columns lo..hi-1 of rows y and y + 1 (the pair's common columns).
+  int32_t below_lo = 0, below_hi = 0;
+  for (int32_t y = h - 2; y >= 0; --y) {
+    const int32_t lo = live_[2 * y] > live_[2 * y + 2] ? live_[2 * y] : live_[2 * y + 2];
+    const int32_t hi = live_[2 * y + 1] < live_[2 * y + 3] ? live_[2 * y + 1] : live_[2 * y + 3];
+    const Node* row = nodes_ + y * w;
+    int32_t* dem = demand + y * w;
+    for (int32_t x = lo; x < hi; ++x) {
+      const int32_t more = x >= below_lo && x < below_hi ? dem[x + w] : 0;
+      const int32_t want = more - row[x + w].tcap;
+      const int32_t c = row[x].cap[kDown];
+      dem[x] = want <= 0 ? 0 : (want < c ? want : c);
+    }
+    below_lo = lo;
+    below_hi = hi > lo ? hi : lo;
+  }
+  for (int32_t y = 0; y + 1 < h; ++y) {
+    const int32_t lo = live_[2 * y] > live_[2 * y + 2] ? live_[2 * y] : live_[2 * y + 2];
+    const int32_t hi = live_[2 * y + 1] < live_[2 * y + 3] ? live_[2 * y + 1] : live_[2 * y + 3];
+    Node* row = nodes_ + y * w;
+    const int32_t* dem = demand + y * w;
+    for (int32_t x = lo; x < hi; ++x) {
+      Node& from = row[x];
+      int32_t d = from.tcap < dem[x] ? from.tcap : dem[x];
+      if (d <= 0) continue;
+      Node& to = row[x + w];
+      const int32_t met = -to.tcap < d ? -to.tcap : d;
+      flow_ += met > 0 ? met : 0;
+      from.tcap -= d;
+      to.tcap += d;
+      from.cap[kDown] -= d;
+      to.cap[kUp] += d;
+    }
+    // Row y's column demands are spent: their room is the row chain's scratch.
+    chain_row(y, demand + y * w);
+    // Row y's balances are final: row y - 1's roots can be set.
+    if (y >= 1) InitRow(y - 1);
+  }
+  chain_row(h - 1, demand);
+  InitRow(h - 2);
+  InitRow(h - 1);
 }
 
 // Roots of row y; needs the final balances of rows y - 1..y + 1.
@@ -347,19 +384,15 @@ bool GridMaxflow::Grow(int32_t p, int32_t* s_node, int* s_dir) {
       *s_node = kSource ? p : q;
       *s_dir = kSource ? dir : (dir ^ 1);
       return true;
-    } else if (m.ts <= n.ts && m.dist > n.dist) {
-      // p is a closer parent for q than the one it has.
-      m.parent = static_cast<uint8_t>(dir ^ 1);
-      m.ts = n.ts;
-      m.dist = static_cast<uint16_t>(n.dist + 1);
     }
+    // (A node of p's own tree keeps its parent even when p is closer to the terminal: moving it
+    // under p cost more than the shorter paths saved, on teddy's graphs 0.71x against 0.78x.)
   }
   return false;
 }
 
 int64_t GridMaxflow::Solve() {
-  while (pushed_ < height_) PushRow(pushed_++);
-  while (inited_ < height_) InitRow(inited_++);
+  Prepare();
   orphan_head_ = orphan_count_ = 0;
   time_ = 0;
 

@@ -26,8 +26,7 @@ class GridMaxflow {
   void Carve(Arena& arena, int32_t max_width, int32_t max_height);
 
   // Starts a new graph of width x height nodes whose every node the caller then sets once with
-  // SetNode, row by row, calling RowDone after each row (no clearing pass: the rows' pushes
-  // and the initial trees are prepared two rows behind, while the rows are still in cache).
+  // SetNode, row by row, calling RowDone after each row (no clearing pass).
   void Begin(int32_t width, int32_t height);
   // Sets node p: its terminal balance (positive: source->p, negative: p->sink) and its arcs to
   // the right and down neighbours, which must be 0 in the last column and the last row; the sister
@@ -41,16 +40,15 @@ class GridMaxflow {
     n.tcap = balance;
   }
   // A node with no balance and no arcs, set as a whole (one store): what SetNode(p, 0, 0, 0)
-  // gives, already as the search's free node, so the row passes may skip it (RowDone).
+  // gives, already as the search's free node, so the passes before the search may skip it
+  // (RowDone).
   void SetIdle(int32_t p) { nodes_[p] = Node{}; }
   // Every node of rows 0..y is set. With x0..x1: row y's nodes outside columns x0..x1-1 were set
-  // with SetIdle, and the row passes skip them.
+  // with SetIdle, and the passes before the search skip them.
   void RowDone(int32_t y) { RowDone(y, 0, width_); }
   void RowDone(int32_t y, int32_t x0, int32_t x1) {
     live_[2 * y] = x0;
     live_[2 * y + 1] = x1;
-    if (y >= 1) PushRow(pushed_++);
-    if (y >= 2) InitRow(inited_++);
   }
 
   // Ends the graph after its first `height` rows (all RowDone), as if it had been begun so.
@@ -87,9 +85,9 @@ class GridMaxflow {
   static_assert(sizeof(Node) == 32);
 
   void Start(int32_t width, int32_t height);
-  void PushRow(int32_t y);
-  void ChainRow(Node* row, int32_t w);
+  void ChainRow(Node* row, int32_t w, int32_t* demand);
   void InitRow(int32_t y);
+  void Prepare();
   void Activate(int32_t p);
   int32_t NextActive();
   template <bool kSource>
@@ -105,11 +103,13 @@ class GridMaxflow {
   // FIFO of active nodes, max_nodes_ entries (a node is queued at most once): unlike a linked
   // list, it shows the nodes to come, which are prefetched.
   int32_t* queue_ = nullptr;
-  int32_t* live_ = nullptr;  // per row, the columns x0, x1 the row passes look at (RowDone)
+  int32_t* live_ = nullptr;  // per row, the columns x0, x1 Prepare looks at (RowDone)
+  // Augment's record of the two paths' first nodes (each kPath, and a slot that takes the rest).
+  static constexpr int32_t kPath = 255;
+  int32_t path_[2 * (kPath + 1)] = {};
   int32_t max_nodes_ = 0, max_width_ = 0;
   int32_t width_ = 0, height_ = 0, count_ = 0;
-  int32_t offset_[4] = {};           // node index step in each direction
-  int32_t pushed_ = 0, inited_ = 0;  // rows whose pushes / initial trees are done
+  int32_t offset_[4] = {};  // node index step in each direction
   int32_t queue_head_ = 0, queue_count_ = 0;
   int32_t orphan_head_ = 0, orphan_count_ = 0;
   int32_t time_ = 0;
@@ -132,6 +132,10 @@ struct GridMaxflowProbe {
                       int32_t cap_qp) {
     mf.nodes_[p].cap[dir] += cap_pq;
     mf.nodes_[p + mf.offset_[dir]].cap[dir ^ 1] += cap_qp;
+  }
+  // After Solve: the residual capacity of the arc from p in direction `dir`.
+  static int32_t Residual(const GridMaxflow& mf, int32_t p, GridMaxflow::Dir dir) {
+    return mf.nodes_[p].cap[dir];
   }
 };
 

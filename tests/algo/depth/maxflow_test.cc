@@ -234,6 +234,130 @@ TEST_F(MaxflowTest, StreamedRowsMatchTextbookAndEdgeBuiltCut) {
   }
 }
 
+// As the depth stage builds its graphs: only some pixels are free (SetNode), the others idle
+// (SetIdle), each row done with the columns from its first free node to its last, rows with no
+// free node between others, arcs only between two free nodes. The flow, and the least source
+// side against the same graph built arc by arc.
+TEST_F(MaxflowTest, StreamedRowsWithIdleNodesMatchTextbook) {
+  std::mt19937 rng(77);
+  std::uniform_int_distribution<int32_t> side(1, 12);
+  GridMaxflow edges;
+  std::vector<uint8_t> memory(Planned());
+  Arena arena(memory.data(), memory.size());
+  edges.Carve(arena, kMaxSide, kMaxSide);
+  for (int trial = 0; trial < 1500; ++trial) {
+    const int32_t w = side(rng), h = side(rng);
+    Graph g = RandomGraph(rng, w, h, trial % 2 ? 6 : 500);
+    std::bernoulli_distribution free_draw(trial % 3 == 0 ? 0.9 : 0.5);
+    std::vector<bool> free(static_cast<size_t>(w * h));
+    for (size_t p = 0; p < free.size(); ++p) free[p] = free_draw(rng);
+    int64_t direct = 0;
+    for (int32_t y = 0; y < h; ++y) {
+      for (int32_t x = 0; x < w; ++x) {
+        const int32_t p = y * w + x;
+        g.right_bwd[p] = g.down_bwd[p] = 0;
+        if (x + 1 == w || !free[p] || !free[p + 1]) g.right_fwd[p] = 0;
+        if (y + 1 == h || !free[p] || !free[p + w]) g.down_fwd[p] = 0;
+        if (!free[p]) g.source[p] = g.sink[p] = 0;
+        direct += std::min(g.source[p], g.sink[p]);
+      }
+    }
+    mf_.Begin(w, h);
+    for (int32_t y = 0; y < h; ++y) {
+      int32_t first = w, last = -1;
+      for (int32_t x = 0; x < w; ++x) {
+        const int32_t p = y * w + x;
+        if (!free[p]) {
+          mf_.SetIdle(p);
+          continue;
+        }
+        first = std::min(first, x);
+        last = x;
+        mf_.SetNode(p, g.source[p] - g.sink[p], g.right_fwd[p], g.down_fwd[p]);
+      }
+      mf_.RowDone(y, last < 0 ? 0 : first, last + 1);
+    }
+    std::vector<bool> reachable;
+    const int64_t expected = TextbookMaxflow(g, &reachable);
+    ASSERT_EQ(mf_.Solve() + direct, expected) << "trial " << trial << " " << w << "x" << h;
+    ASSERT_EQ(CutCapacity(g, mf_), expected) << "trial " << trial;
+    for (int32_t p = 0; p < w * h; ++p) ASSERT_EQ(mf_.InSource(p), reachable[p]) << trial;
+    ASSERT_EQ(Solve(g, edges), expected);
+  }
+}
+
+// A corridor that winds through the whole grid, the source at one end and the sink at the
+// other: the augmenting path is far longer than the record Augment keeps of it (a thousand
+// nodes a side on 64 x 64), and no push along a row or column can shorten it (no row or column
+// has both an excess and a deficit). One path: the flow is its narrowest arc, and the least
+// source side is the corridor up to that arc's first occurrence. The narrowest arc is put near
+// either end, where the trees' paths are longest from where they meet.
+TEST_F(MaxflowTest, LongWindingPathAgrees) {
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int32_t> cap(3, 400);
+  for (int trial = 0; trial < 4; ++trial) {
+    const int32_t side = trial < 2 ? 33 : 64;
+    const bool near_sink = trial % 2 == 1;
+    Graph g = RandomGraph(rng, side, side, 0);
+    std::vector<int32_t> path;   // the corridor's nodes, source end first
+    std::vector<int32_t*> arc;   // arc[i]: the capacity of path[i] -> path[i + 1]
+    std::vector<int32_t*> back;  // back[i]: the capacity of path[i + 1] -> path[i]
+    auto link = [&](int32_t p, int32_t q) {
+      int32_t* forward = q == p + 1   ? &g.right_fwd[p]
+                         : q == p - 1 ? &g.right_bwd[q]
+                                      : &g.down_fwd[p];
+      int32_t* backward = q == p + 1   ? &g.right_bwd[p]
+                          : q == p - 1 ? &g.right_fwd[q]
+                                       : &g.down_bwd[p];
+      *forward = cap(rng);
+      *backward = cap(rng);
+      arc.push_back(forward);
+      back.push_back(backward);
+    };
+    for (int32_t y = 0; y < side; y += 2) {
+      const bool rightward = (y / 2) % 2 == 0;
+      for (int32_t i = 0; i < side; ++i) {
+        const int32_t p = y * side + (rightward ? i : side - 1 - i);
+        if (!path.empty()) link(path.back(), p);
+        path.push_back(p);
+      }
+      // Down through the wall row below, at the end the corridor reached.
+      if (y + 2 < side) {
+        const int32_t p = (y + 1) * side + (rightward ? side - 1 : 0);
+        link(path.back(), p);
+        path.push_back(p);
+      }
+    }
+    g.source[path.front()] = 1000;
+    g.sink[path.back()] = 1000;
+    const size_t narrowest = near_sink ? arc.size() - 40 : 40;
+    *arc[narrowest] = 2;  // below every other capacity
+    const int64_t expected = 2;
+    ASSERT_GT(path.size(), static_cast<size_t>(side * side / 2));
+    ASSERT_EQ(Solve(g, mf_), expected) << trial;
+    ASSERT_EQ(CutCapacity(g, mf_), expected) << trial;
+    // Off the corridor, nodes have no arcs: never on the source side.
+    std::vector<bool> source_side(static_cast<size_t>(side * side), false);
+    for (size_t i = 0; i <= narrowest; ++i) source_side[path[i]] = true;
+    for (int32_t p = 0; p < side * side; ++p) {
+      ASSERT_EQ(mf_.InSource(p), source_side[p]) << trial << " " << p;
+    }
+    // The flow of 2 went along the whole corridor, once: every arc of it carries exactly 2.
+    for (size_t i = 0; i + 1 < path.size(); ++i) {
+      const int32_t p = path[i], q = path[i + 1];
+      const GridMaxflow::Dir dir = q == p + 1   ? GridMaxflow::kRight
+                                   : q == p - 1 ? GridMaxflow::kLeft
+                                                : GridMaxflow::kDown;
+      const GridMaxflow::Dir sister = static_cast<GridMaxflow::Dir>(dir ^ 1);
+      ASSERT_EQ(GridMaxflowProbe::Residual(mf_, p, dir), *arc[i] - 2) << trial << " " << i;
+      ASSERT_EQ(GridMaxflowProbe::Residual(mf_, q, sister), *back[i] + 2) << trial << " " << i;
+    }
+    if (side <= 40) {
+      ASSERT_EQ(TextbookMaxflow(g), expected);
+    }
+  }
+}
+
 TEST_F(MaxflowTest, LargeCapacitiesDoNotOverflow) {
   std::mt19937 rng(3);
   for (int trial = 0; trial < 100; ++trial) {
