@@ -263,6 +263,10 @@ class DepthStage {
 // (slow: D for every label).
 struct DepthStageProbe {
   static int64_t TrackedEnergy(const DepthStage& stage) { return stage.energy_; }
+  // Garbage in every max-flow node before the next move (GridMaxflowProbe::Poison).
+  static void PoisonSolver(DepthStage& stage, uint8_t byte) {
+    GridMaxflowProbe::Poison(stage.maxflow_, byte);
+  }
   static bool ExpandMove(DepthStage& stage, int32_t alpha,
                          int32_t window = DepthConfig::kMaxLabels) {
     stage.window_ = window;

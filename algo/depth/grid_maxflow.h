@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 #include "algo/core/arena.h"
 
@@ -136,6 +137,13 @@ struct GridMaxflowProbe {
   // After Solve: the residual capacity of the arc from p in direction `dir`.
   static int32_t Residual(const GridMaxflow& mf, int32_t p, GridMaxflow::Dir dir) {
     return mf.nodes_[p].cap[dir];
+  }
+  // Fills all node storage with `byte`, as if another graph had left garbage everywhere: a caller
+  // that sets only the nodes its graph can reach must then still get the same cut.
+  static void Poison(GridMaxflow& mf, uint8_t byte) {
+    memset(static_cast<void*>(mf.storage_), byte,
+           sizeof(GridMaxflow::Node) *
+               (static_cast<size_t>(mf.max_nodes_) + 2 * static_cast<size_t>(mf.max_width_)));
   }
 };
 

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <cstring>
 #include <vector>
 
 #include "algo/depth/depth_stage.h"
@@ -60,6 +61,45 @@ void Check(const char* name, double bound) {
   ::testing::Test::RecordProperty("bad_percent", std::to_string(bad[0]));
   ::testing::Test::RecordProperty("bad_percent_refined", std::to_string(bad[1]));
   EXPECT_LE(bad[0], bound) << name;
+}
+
+// A move sets only the max-flow nodes a free node can reach (expansion_move.cc: Reach); the
+// others keep whatever an earlier graph left there. So garbage in all of them before every move
+// must change no label and no energy, in full and in restricted moves, on a real scene (the
+// synthetic ones in depth_stage_test rarely put a free node where a wrong read would show).
+TEST(MiddleburyTest, MovesReadNoSolverNodeTheyDidNotSet) {
+  const std::string dir = middlebury::DataDir();
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/middlebury is absent: nothing to measure";
+  middlebury::Set set;
+  ASSERT_TRUE(middlebury::Load(dir, "tsukuba", &set).ok());
+  DepthConfig c = MiddleburyConfig(set);
+  c.max_cycles = 0;  // winner-take-all labels: the moves below have work to do
+  const size_t bytes = DepthStage::RequiredBytes(c);
+  std::vector<uint8_t> memory[2];
+  DepthStage stages[2];
+  const std::vector<ConstImageU8> views = set.Views();
+  std::vector<uint16_t> disp(static_cast<size_t>(set.width) * set.height);
+  for (int i = 0; i < 2; ++i) {
+    memory[i].assign(bytes + Arena::kAlign, 0);
+    Arena arena(Arena::AlignUp(memory[i].data()), bytes);
+    ASSERT_TRUE(stages[i].Configure(c, arena).ok());
+    ASSERT_TRUE(stages[i].Compute(views.data(), MakeView(disp.data(), set.width, set.height)).ok());
+  }
+  DepthStage &clean = stages[0], &poisoned = stages[1];
+  const size_t n = disp.size();
+  int32_t lowered = 0;
+  for (int32_t window : {DepthConfig::kMaxLabels, 2, 1}) {
+    for (int32_t alpha = 0; alpha < c.labels; ++alpha) {
+      DepthStageProbe::PoisonSolver(poisoned, alpha % 2 == 0 ? 0x5a : 0xa5);
+      const bool a = DepthStageProbe::ExpandMove(clean, alpha, window);
+      ASSERT_EQ(DepthStageProbe::ExpandMove(poisoned, alpha, window), a) << alpha;
+      ASSERT_EQ(memcmp(poisoned.labels(), clean.labels(), n), 0)
+          << "window " << window << ", alpha " << alpha;
+      ASSERT_EQ(DepthStageProbe::TrackedEnergy(poisoned), DepthStageProbe::TrackedEnergy(clean));
+      lowered += a ? 1 : 0;
+    }
+  }
+  EXPECT_GT(lowered, 0) << "no move lowered the energy: the comparison saw no cut";
 }
 
 TEST(MiddleburyTest, Tsukuba) { Check("tsukuba", 2.0); }
