@@ -215,6 +215,16 @@ void DataTerm::ComputeSpanBand(const Scratch& s, int32_t disp_q8, const int32_t*
   const uint16_t* rows[3 * 15];
   for (int32_t y = y0; y < y1; ++y) {
     window_rows(y + 1);
+    // As ComputeBand: ask early for the views' next rows, which the prefetcher misses.
+    int32_t a, b;
+    if (hull(y + 2, &a, &b)) {
+      const int32_t next = Clamp(y + 2, 0, height_ - 1);
+      const size_t bytes = static_cast<size_t>(3) * (b - a);
+      for (int32_t j = 0; j < others; ++j) {
+        Prefetch(images_[view(j)].Row(next) + 3 * a, bytes);
+        Prefetch(census_[view(j)] + static_cast<ptrdiff_t>(next) * 3 * w + a, bytes);
+      }
+    }
     const int32_t x0 = spans[2 * y], x1 = spans[2 * y + 1];
     if (x0 >= x1) continue;
     for (int32_t j = 0; j < others; ++j) {
