@@ -57,6 +57,7 @@ void DataTerm::Carve(Arena& arena, int32_t width, int32_t height, int32_t views,
     s.hsum = arena.Allocate<uint16_t>(static_cast<size_t>(width) * 3 * (views - 1));
     s.ref_lanes = arena.Allocate<int32_t>(static_cast<size_t>(width) * 4);
   }
+  spans_ = arena.Allocate<int32_t>(static_cast<size_t>(height) * 2);
   runner_ = &inline_;
   UseSimd(true);
 }
@@ -142,16 +143,20 @@ void DataTerm::PrepareRefLanes(const Scratch& s, int32_t y, int32_t x0, int32_t 
                         RefLanesEnd(w, c1), s.ref_lanes + a, w);
 }
 
-void DataTerm::ComputeRect(int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0, int32_t y1,
-                           uint16_t* out, ptrdiff_t stride) {
+int32_t DataTerm::Bands(int32_t rows, int64_t pixels) const {
   // A band's first two rows of 3-sums are its overhead, and a task costs a wake-up: bands of
   // at least kMinBandRows rows and kMinBandPixels pixels, a few per worker to even out the load,
   // and one band on a single worker (more would only add their overhead).
   constexpr int32_t kMinBandRows = 8, kMinBandPixels = 8192, kBandsPerWorker = 4;
-  const int32_t rows = y1 - y0, cols = x1 - x0;
   int32_t bands = runner_->workers() > 1 ? runner_->workers() * kBandsPerWorker : 1;
   bands = Min(bands, rows / kMinBandRows);
-  bands = Min(bands, static_cast<int32_t>(int64_t{rows} * cols / kMinBandPixels));
+  return Min(bands, static_cast<int32_t>(pixels / kMinBandPixels));
+}
+
+void DataTerm::ComputeRect(int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0, int32_t y1,
+                           uint16_t* out, ptrdiff_t stride) {
+  const int32_t rows = y1 - y0, cols = x1 - x0;
+  const int32_t bands = Bands(rows, int64_t{rows} * cols);
   if (bands <= 1) {
     ComputeBand(scratch_[0], disp_q8, x0, x1, y0, y1, out, stride);
     return;
@@ -161,6 +166,72 @@ void DataTerm::ComputeRect(int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0, 
     const int32_t b1 = y0 + static_cast<int32_t>(int64_t{rows} * (band + 1) / bands);
     ComputeBand(scratch_[worker], disp_q8, x0, x1, b0, b1, out + (b0 - y0) * stride, stride);
   });
+}
+
+void DataTerm::ComputeSpans(int32_t disp_q8, const int32_t* spans, int32_t y0, int32_t y1,
+                            uint16_t* out, ptrdiff_t stride) {
+  const int32_t rows = y1 - y0;
+  int64_t pixels = 0;
+  for (int32_t y = y0; y < y1; ++y) pixels += Max(spans[2 * y + 1] - spans[2 * y], 0);
+  const int32_t bands = Bands(rows, pixels);
+  if (bands <= 1) {
+    ComputeSpanBand(scratch_[0], disp_q8, spans, y0, y1, out, stride);
+    return;
+  }
+  // Bands of equal rows: the spans of a restricted move are spread over the image.
+  ParallelFor(*runner_, bands, [&](int32_t band, int32_t worker) {
+    const int32_t b0 = y0 + static_cast<int32_t>(int64_t{rows} * band / bands);
+    const int32_t b1 = y0 + static_cast<int32_t>(int64_t{rows} * (band + 1) / bands);
+    ComputeSpanBand(scratch_[worker], disp_q8, spans, b0, b1, out + (b0 - y0) * stride, stride);
+  });
+}
+
+void DataTerm::ComputeSpanBand(const Scratch& s, int32_t disp_q8, const int32_t* spans, int32_t y0,
+                               int32_t y1, uint16_t* out, ptrdiff_t stride) const {
+  const int32_t w = width_;
+  const int32_t others = views_ - 1;
+  auto ring = [&](int32_t j, int32_t row) {
+    return s.hsum + (static_cast<size_t>(j) * 3 + static_cast<size_t>((row - y0 + 1) % 3)) * w;
+  };
+  auto view = [&](int32_t j) { return j < reference_ ? j : j + 1; };
+  // The 3-sums of row r are read by rows r - 1 .. r + 1 of the band: the hull of their spans.
+  auto hull = [&](int32_t r, int32_t* a, int32_t* b) {
+    *a = w;
+    *b = 0;
+    for (int32_t y = Max(r - 1, y0); y <= r + 1 && y < y1; ++y) {
+      if (spans[2 * y] >= spans[2 * y + 1]) continue;
+      *a = Min(*a, spans[2 * y]);
+      *b = Max(*b, spans[2 * y + 1]);
+    }
+    return *a < *b;
+  };
+  auto window_rows = [&](int32_t r) {
+    int32_t a, b;
+    if (!hull(r, &a, &b)) return;
+    PrepareRefLanes(s, r, a, b);
+    for (int32_t j = 0; j < others; ++j) WindowRow(s, view(j), r, disp_q8, a, b, ring(j, r));
+  };
+  for (int32_t r = y0 - 1; r <= y0; ++r) window_rows(r);
+  const uint16_t* rows[3 * 15];
+  for (int32_t y = y0; y < y1; ++y) {
+    window_rows(y + 1);
+    // As ComputeBand: ask early for the views' next rows, which the prefetcher misses.
+    int32_t a, b;
+    if (hull(y + 2, &a, &b)) {
+      const int32_t next = Clamp(y + 2, 0, height_ - 1);
+      const size_t bytes = static_cast<size_t>(3) * (b - a);
+      for (int32_t j = 0; j < others; ++j) {
+        Prefetch(images_[view(j)].Row(next) + 3 * a, bytes);
+        Prefetch(census_[view(j)] + static_cast<ptrdiff_t>(next) * 3 * w + a, bytes);
+      }
+    }
+    const int32_t x0 = spans[2 * y], x1 = spans[2 * y + 1];
+    if (x0 >= x1) continue;
+    for (int32_t j = 0; j < others; ++j) {
+      for (int32_t k = 0; k < 3; ++k) rows[3 * j + k] = ring(j, y - 1 + k);
+    }
+    kernels_->select(rows, others, x0, x1, out + (y - y0) * stride);
+  }
 }
 
 void DataTerm::ComputeBand(const Scratch& s, int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0,

@@ -63,6 +63,16 @@ class DataTerm {
   // ComputeRows, bit for bit.
   void ComputeRect(int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0, int32_t y1, uint16_t* out,
                    ptrdiff_t stride);
+  // Rows y0..y1-1, each over its own columns: row y over spans[2 * y] .. spans[2 * y + 1] - 1
+  // (none when not less), out still pointing at (0, y0); the values of ComputeRows, bit for bit.
+  // For callers whose rows need different columns (a restricted move): the ring's 3-sums of a row
+  // cover only the hull of the spans of the rows that read them, and a band pays its 2 starting
+  // rows once rather than per rectangle.
+  void ComputeSpans(int32_t disp_q8, const int32_t* spans, int32_t y0, int32_t y1, uint16_t* out,
+                    ptrdiff_t stride);
+  // A buffer of 2 * height entries for the caller to fill with ComputeSpans' spans (carved here
+  // so that the caller needs no memory of its own).
+  int32_t* span_buffer() { return spans_; }
 
   // Plane sweep (warp_cost.h): the homography of each view for the label of the next ComputeRows
   // calls (borrowed; disp_q8 is then ignored), or nullptr for the rectified shifts.
@@ -96,6 +106,10 @@ class DataTerm {
   void CensusOfView(const Scratch& s, int32_t view);
   void ComputeBand(const Scratch& s, int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0,
                    int32_t y1, uint16_t* out, ptrdiff_t stride) const;
+  void ComputeSpanBand(const Scratch& s, int32_t disp_q8, const int32_t* spans, int32_t y0,
+                       int32_t y1, uint16_t* out, ptrdiff_t stride) const;
+  // How many bands a request of `rows` rows and `pixels` pixels is cut into.
+  int32_t Bands(int32_t rows, int64_t pixels) const;
 
   int32_t width_ = 0, height_ = 0, views_ = 0, reference_ = 0;
   DataTermParams params_;
@@ -104,6 +118,7 @@ class DataTerm {
   const Kernels* kernels_ = nullptr;
   const PlaneHomography* planes_ = nullptr;
   uint8_t* census_[16] = {};
+  int32_t* spans_ = nullptr;
   Scratch scratch_[kMaxWorkers];
   int32_t workers_ = 1;
   InlineRunner inline_;

@@ -320,34 +320,43 @@ bool DepthStage::Expand(int32_t alpha) {
 
 // A restricted move needs D only at the pixels it may free (a label near alpha in their 3x3
 // neighbourhood) and, for the sub-label fit, at those that may take alpha + 1 next (near_span,
-// MoveRects): per strip of rows, over the columns next to such a label in the strip's rows and
-// the rows either side. The others keep kNotComputed, which pass 1 never reads (they are fixed
-// as far from alpha whatever their D). Strips of 16 rows: the data term's first two rows of a
-// strip are its overhead.
+// MoveRects): per row, over the columns next to such a label in the row and the rows either
+// side, each row its own columns (the data term's ring then covers them all, and the image pays
+// its 2 starting rows once). The others keep kNotComputed, which pass 1 never reads (they are
+// fixed as far from alpha whatever their D). Written records a rectangle per run of rows with the
+// same columns, exactly where D was computed.
 void DepthStage::ComputeNear(int32_t disp_q8) {
-  constexpr int32_t kStrip = 16, kMinWidth = 34;
+  constexpr int32_t kMinWidth = 34;
   const Grid& g = fine_;
   const int32_t w = g.width, h = g.height;
-  for (int32_t ys = 0; ys < h; ys += kStrip) {
-    const int32_t ye = ys + kStrip < h ? ys + kStrip : h;
+  int32_t* spans = data_.span_buffer();
+  for (int32_t y = 0; y < h; ++y) {
     int32_t lo = w, hi = 0;
-    for (int32_t y = ys > 0 ? ys - 1 : 0; y <= ye && y < h; ++y) {
-      const int32_t a = g.near_span[2 * y], b = g.near_span[2 * y + 1];
+    for (int32_t r = y > 0 ? y - 1 : 0; r <= y + 1 && r < h; ++r) {
+      const int32_t a = g.near_span[2 * r], b = g.near_span[2 * r + 1];
       if (a >= b) continue;
       lo = a - 1 < lo ? a - 1 : lo;
       hi = b + 1 > hi ? b + 1 : hi;
     }
     lo = lo > 0 ? lo : 0;
     hi = hi < w ? hi : w;
-    if (lo >= hi) continue;
     // At least kMinWidth columns: the SIMD kernels' step, where narrow rows take the C ones.
-    if (hi - lo < kMinWidth && w >= kMinWidth) {
+    if (lo < hi && hi - lo < kMinWidth && w >= kMinWidth) {
       lo = (lo + hi - kMinWidth) / 2;
       lo = lo < 0 ? 0 : (lo + kMinWidth > w ? w - kMinWidth : lo);
       hi = lo + kMinWidth;
     }
-    data_.ComputeRect(disp_q8, lo, hi, ys, ye, g.cost_alpha + ys * w, w);
-    Written(Rect{lo, hi, ys, ye});
+    spans[2 * y] = lo < hi ? lo : 0;
+    spans[2 * y + 1] = lo < hi ? hi : 0;
+  }
+  data_.ComputeSpans(disp_q8, spans, 0, h, g.cost_alpha, w);
+  for (int32_t y0 = 0; y0 < h;) {
+    int32_t y1 = y0 + 1;
+    while (y1 < h && spans[2 * y1] == spans[2 * y0] && spans[2 * y1 + 1] == spans[2 * y0 + 1]) ++y1;
+    if (spans[2 * y0] < spans[2 * y0 + 1]) {
+      Written(Rect{spans[2 * y0], spans[2 * y0 + 1], y0, y1});
+    }
+    y0 = y1;
   }
 }
 

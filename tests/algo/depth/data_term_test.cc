@@ -188,6 +188,40 @@ TEST(DataTermTest, RectanglesEqualTheWholeImage) {
   }
 }
 
+// A restricted move computes each row over its own columns (ComputeSpans): rows of different
+// widths, empty rows between them and rows at the image's borders must give the whole image's
+// values bit for bit, and write nothing outside their spans.
+TEST(DataTermTest, RowSpansEqualTheWholeImage) {
+  const int32_t w = 70, h = 20;
+  const synth::Burst b = synth::MakeBurst(w, h, 5, 2, 1, 4, 10, 50, 5, 16, 9u);
+  Fixed f;
+  PrepareTerm(f, b, DataTermParams{});
+  int32_t* spans = f.term.span_buffer();
+  ASSERT_NE(spans, nullptr);
+  // Per row: wide, narrow, empty, at either border; the first and last rows included.
+  const std::pair<int32_t, int32_t> pick[] = {{0, 70}, {5, 40},  {0, 0},  {69, 70}, {17, 70},
+                                              {0, 1},  {30, 31}, {0, 33}, {40, 40}, {1, 2}};
+  for (int32_t y = 0; y < h; ++y) {
+    spans[2 * y] = pick[(y * 3) % 10].first;
+    spans[2 * y + 1] = pick[(y * 3) % 10].second;
+  }
+  for (int32_t disp_q8 : {0, 300, 1000}) {
+    std::vector<uint16_t> whole(static_cast<size_t>(w) * h);
+    f.term.ComputeRows(disp_q8, 0, h, whole.data(), w);
+    for (const auto& [y0, y1] : {std::pair{0, h}, {3, 11}, {19, 20}}) {
+      std::vector<uint16_t> out(whole.size(), 0xabcd);
+      f.term.ComputeSpans(disp_q8, spans, y0, y1, out.data() + y0 * w, w);
+      for (int32_t y = 0; y < h; ++y) {
+        for (int32_t x = 0; x < w; ++x) {
+          const bool inside = y >= y0 && y < y1 && x >= spans[2 * y] && x < spans[2 * y + 1];
+          ASSERT_EQ(out[y * w + x], inside ? whole[y * w + x] : 0xabcd)
+              << "x " << x << " y " << y << " rows [" << y0 << ", " << y1 << ")";
+        }
+      }
+    }
+  }
+}
+
 TEST(DataTermTest, TrueDisparityCostsLeastOnTexturedPlanes) {
   const synth::Burst b = synth::MakeBurst(64, 32, 5, 2, 2, 6, 20, 44, 8, 24, 5u);
   Fixed f;
