@@ -138,8 +138,9 @@ void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
   // chunk of up to kRunSpans spans maps its anchors in one tight loop, then goes to the kernel as
   // one run, or, where a plane has no map at some anchor, as the runs between (the spans
   // touching that anchor cost `invalid`).
-  int32_t ax[kRunSpans + 1], ay[kRunSpans + 1];
-  bool ok[kRunSpans + 1];
+  // Zeroed: an anchor that does not map leaves its entries unset, and they are copied along.
+  int32_t ax[kRunSpans + 1] = {}, ay[kRunSpans + 1] = {};
+  bool ok[kRunSpans + 1] = {};
   ok[0] = map(first, &ax[0], &ay[0]);
   for (int32_t x0 = first; x0 < x_end;) {
     // Spans of this chunk: while the span starting at x0 + kAnchorStep k begins before x_end.
