@@ -204,7 +204,8 @@ class DepthStage {
     }
   }
   void CutRect(int32_t alpha, const Rect& r);
-  int32_t ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1);
+  int32_t ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1, int32_t e0, int32_t e1);
+  void NearColumns(const Rect& r, int32_t y, int32_t* x0, int32_t* x1) const;
   void PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1);
   int32_t BuildRow(const Rect& r, int32_t y, int32_t node_row);
   void FreeSpan(const Rect& r, int32_t y, bool any);

@@ -31,7 +31,11 @@ namespace lb {
 // with b_p = V(fp, alpha) / w_pq, so u_p + sum(C - A) = u_p - b_p sum(w_pq) + sum(e_pq): one
 // branch-free pass per row. Row y keeps its e_pq to the right and down and that sum in the ring
 // slot y % 3 for pass 2. Returns kRowFree | kRowTake for the states present in the row.
-LB_CLONES_AVX2 int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1) {
+//
+// Columns x0..x1-1 are classified (the caller fixed the others as far from alpha), and the pairs
+// down are kept over e0..e1-1, which also covers the next row's x0..x1-1 (its sums read them).
+LB_CLONES_AVX2 int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1,
+                                               int32_t e0, int32_t e1) {
   Grid& g = grid();
   const int32_t w = g.width, h = g.height;
   const int32_t k = config_.smooth_trunc;
@@ -54,7 +58,7 @@ LB_CLONES_AVX2 int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t
     er[x] = wr[x] * (v(f[x], alpha) + v(f[x + 1], alpha) - v(f[x], f[x + 1]));
   }
   if (x1 == w) er[w - 1] = 0;
-  for (int32_t x = x0; x < x1; ++x) {
+  for (int32_t x = e0; x < e1; ++x) {
     ed[x] = wd[x] * (v(f[x], alpha) + v(fd[x], alpha) - v(f[x], fd[x]));
   }
   for (int32_t x = x0; x < x1; ++x) {
@@ -129,14 +133,15 @@ void DepthStage::PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1) {
 }
 
 // BuildRow's terms of pixels x0..x1-1 of a row (state st, the rows above and below up and
-// down), 0 for fixed pixels. The left and right neighbours are those within x0..x1-1: the first
-// and last pixel are peeled.
+// down), 0 for fixed pixels. The left neighbour of x0 and the right one of x1 - 1 are the row's
+// own when inside the rectangle's columns r0..r1-1, else they keep their labels: the first and
+// last pixel are peeled.
 LB_CLONES_AVX2 static void BuildTerms(const uint8_t* __restrict st, const uint8_t* __restrict up,
                                       const uint8_t* __restrict down, const int32_t* __restrict er,
                                       const int32_t* __restrict ed, const int32_t* __restrict eu,
                                       const int32_t* __restrict hi, int32_t x0, int32_t x1,
-                                      int32_t* __restrict balance, int32_t* __restrict cap_right,
-                                      int32_t* __restrict cap_down) {
+                                      int32_t r0, int32_t r1, int32_t* __restrict balance,
+                                      int32_t* __restrict cap_right, int32_t* __restrict cap_down) {
   constexpr uint8_t kFree = 0, kKeep = 1, kTake = 2;  // DepthStage's states
   auto terms = [&](int32_t x, uint8_t left, uint8_t right, int32_t e_left, int32_t e_right) {
     const int32_t free = st[x] == kFree ? -1 : 0;
@@ -146,13 +151,17 @@ LB_CLONES_AVX2 static void BuildTerms(const uint8_t* __restrict st, const uint8_
     cap_right[x] = (right == kFree ? e_right : 0) & free;
     cap_down[x] = (down[x] == kFree ? ed[x] : 0) & free;
   };
+  const uint8_t left = x0 > r0 ? st[x0 - 1] : kKeep;
+  const int32_t e_left = x0 > r0 ? er[x0 - 1] : 0;
+  const uint8_t right = x1 < r1 ? st[x1] : kKeep;
+  const int32_t e_right = x1 < r1 ? er[x1 - 1] : 0;
   if (x1 - x0 == 1) {
-    terms(x0, kKeep, kKeep, 0, 0);
+    terms(x0, left, right, e_left, e_right);
     return;
   }
-  terms(x0, kKeep, st[x0 + 1], 0, er[x0]);
+  terms(x0, left, st[x0 + 1], e_left, er[x0]);
   for (int32_t x = x0 + 1; x < x1 - 1; ++x) terms(x, st[x - 1], st[x + 1], er[x - 1], er[x]);
-  terms(x1 - 1, st[x1 - 2], kKeep, er[x1 - 2], 0);
+  terms(x1 - 1, st[x1 - 2], right, er[x1 - 2], e_right);
 }
 
 // Pass 2, one row behind pass 1: row y's nodes of the 2-label graph over the free pixels (node
@@ -177,27 +186,31 @@ int32_t DepthStage::BuildRow(const Rect& r, int32_t y, int32_t node_row) {
   int32_t* balance = move_rows_ + 11 * config_.width;
   int32_t* cap_right = move_rows_ + 12 * config_.width;
   int32_t* cap_down = move_rows_ + 13 * config_.width;
-  // Only the nodes a free node can reach are set (Reach); the others are never read.
+  // Only the nodes a free node can reach are set (Reach); the others are never read. The terms
+  // are needed only from the row's first free pixel to its last.
   int32_t x0 = r.x0, x1 = r.x1;
   Reach(r, y, &x0, &x1);
-  BuildTerms(st, up, down, er, ed, eu, hi, x0, x1, balance, cap_right, cap_down);
+  const int32_t* span = free_span_ + 2 * y;
+  const int32_t f0 = span[0], f1 = span[1];
+  if (f0 < f1)
+    BuildTerms(st, up, down, er, ed, eu, hi, f0, f1, r.x0, r.x1, balance, cap_right, cap_down);
   const int32_t base = node_row * (r.x1 - r.x0) - r.x0;
   if (x0 > r.x0) maxflow_.SetIdle(base + r.x0);
   if (x1 < r.x1) maxflow_.SetIdle(base + r.x1 - 1);
-  int32_t free_pixels = 0, first = x1, last = x0 - 1;
-  for (int32_t x = x0; x < x1; ++x) {
+  for (int32_t x = x0; x < f0; ++x) maxflow_.SetIdle(base + x);
+  int32_t free_pixels = 0;
+  for (int32_t x = f0; x < f1; ++x) {
     if (st[x] != kFree) {
       maxflow_.SetIdle(base + x);
       continue;
     }
     maxflow_.SetNode(base + x, balance[x], cap_right[x], cap_down[x]);
     ++free_pixels;
-    first = x < first ? x : first;
-    last = x;
   }
+  for (int32_t x = f1 > x0 ? f1 : x0; x < x1; ++x) maxflow_.SetIdle(base + x);
   // The solver's row passes look only from the first free pixel to the last.
   if (free_pixels > 0) {
-    maxflow_.RowDone(node_row, first - r.x0, last + 1 - r.x0);
+    maxflow_.RowDone(node_row, f0 - r.x0, f1 - r.x0);
   } else {
     maxflow_.RowDone(node_row, 0, 0);
   }
@@ -235,6 +248,29 @@ void DepthStage::Reach(const Rect& r, int32_t y, int32_t* x0, int32_t* x1) const
   *x1 = hi < r.x1 ? hi : r.x1;
 }
 
+// The columns of row y (within r) that pass 1 may not fix as far from alpha: those within one of
+// a label near alpha (near_span) in the rows y - 1..y + 1; all of r for a full move. Empty at
+// r.x0 when none.
+void DepthStage::NearColumns(const Rect& r, int32_t y, int32_t* x0, int32_t* x1) const {
+  if (window_ >= config_.labels - 1) {
+    *x0 = r.x0;
+    *x1 = r.x1;
+    return;
+  }
+  const Grid& g = fine_;
+  int32_t lo = r.x1, hi = r.x0;
+  for (int32_t k = y > 0 ? y - 1 : 0; k <= y + 1 && k < g.height; ++k) {
+    const int32_t a = g.near_span[2 * k], b = g.near_span[2 * k + 1];
+    if (a >= b) continue;
+    lo = a - 1 < lo ? a - 1 : lo;
+    hi = b + 1 > hi ? b + 1 : hi;
+  }
+  lo = lo > r.x0 ? lo : r.x0;
+  hi = hi < r.x1 ? hi : r.x1;
+  *x0 = lo < hi ? lo : r.x0;
+  *x1 = lo < hi ? hi : r.x0;
+}
+
 // Classifies and builds the rectangle's rows, cuts the graph and settles its free pixels.
 void DepthStage::CutRect(int32_t alpha, const Rect& r) {
   Grid& g = grid();
@@ -244,10 +280,26 @@ void DepthStage::CutRect(int32_t alpha, const Rect& r) {
   // a free pixel are left out at either end, and written as empty rows only between two others.
   int32_t y_lo = r.y1, y_hi = -1, g_lo = -1, rows = 0, pending = 0, free_pixels = 0;
   int32_t present = 0;
+  // Pass 1 looks only at the columns of each row that are not far from alpha (NearColumns); the
+  // others keep their labels.
+  int32_t next0 = r.x0, next1 = r.x1;
+  NearColumns(r, r.y0, &next0, &next1);
   for (int32_t y = r.y0; y <= r.y1; ++y) {
     const int32_t above = present;
     if (y < r.y1) {
-      present = ClassifyRow(alpha, y, r.x0, r.x1);
+      const int32_t c0 = next0, c1 = next1;
+      next0 = next1 = r.x0;
+      if (y + 1 < r.y1) NearColumns(r, y + 1, &next0, &next1);
+      // The pairs down: over this row's columns and the next one's.
+      int32_t e0 = c0, e1 = c1;
+      if (next0 < next1) {
+        e0 = c0 < c1 && c0 < next0 ? c0 : next0;
+        e1 = c0 < c1 && c1 > next1 ? c1 : next1;
+      }
+      uint8_t* st = g.state + y * w;
+      memset(st + r.x0, kKeep, static_cast<size_t>(c0 - r.x0));
+      memset(st + c1, kKeep, static_cast<size_t>(r.x1 - c1));
+      present = ClassifyRow(alpha, y, c0, c1, e0, e1);
       g.row_took[y] |= (present & kRowTake) != 0 ? 1 : 0;
       FreeSpan(r, y, (present & kRowFree) != 0);
       if (present != 0) {
