@@ -6,13 +6,7 @@
 // With coarse_step 1: the winner-take-all labels, then cycles of full moves over every label.
 #include "algo/depth/depth_stage.h"
 
-// Plain C++ written to vectorize: on x86-64 also compiled for AVX2, chosen at load time by the
-// CPU; the same source, so the same bits.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define LB_CLONES_AVX2 __attribute__((target_clones("avx2", "default")))
-#else
-#define LB_CLONES_AVX2
-#endif
+#include "algo/core/clones.h"
 
 namespace lb {
 

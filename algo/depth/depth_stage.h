@@ -208,6 +208,10 @@ class DepthStage {
   void NearColumns(const Rect& r, int32_t y, int32_t* x0, int32_t* x1) const;
   void PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1);
   int32_t BuildRow(const Rect& r, int32_t y, int32_t node_row);
+  static void BuildTerms(const uint8_t* st, const uint8_t* up, const uint8_t* down,
+                         const int32_t* er, const int32_t* ed, const int32_t* eu, const int32_t* hi,
+                         int32_t x0, int32_t x1, int32_t r0, int32_t r1, int32_t* balance,
+                         int32_t* cap_right, int32_t* cap_down);
   void FreeSpan(const Rect& r, int32_t y, bool any);
   void Reach(const Rect& r, int32_t y, int32_t* x0, int32_t* x1) const;
   void RowLabels(Grid& g, int32_t y);  // counts row y's labels, from scratch

@@ -8,15 +8,8 @@
 
 #include <cstring>
 
+#include "algo/core/clones.h"
 #include "algo/core/int_math.h"
-
-// Pass 1 is plain C++ written to vectorize: on x86-64 it is also compiled for AVX2 (twice the
-// lanes), chosen at load time by the CPU; the same source, so the same bits.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define LB_CLONES_AVX2 __attribute__((target_clones("avx2", "default")))
-#else
-#define LB_CLONES_AVX2
-#endif
 
 namespace lb {
 
@@ -136,13 +129,11 @@ void DepthStage::PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1) {
 // down), 0 for fixed pixels. The left neighbour of x0 and the right one of x1 - 1 are the row's
 // own when inside the rectangle's columns r0..r1-1, else they keep their labels: the first and
 // last pixel are peeled.
-LB_CLONES_AVX2 static void BuildTerms(const uint8_t* __restrict st, const uint8_t* __restrict up,
-                                      const uint8_t* __restrict down, const int32_t* __restrict er,
-                                      const int32_t* __restrict ed, const int32_t* __restrict eu,
-                                      const int32_t* __restrict hi, int32_t x0, int32_t x1,
-                                      int32_t r0, int32_t r1, int32_t* __restrict balance,
-                                      int32_t* __restrict cap_right, int32_t* __restrict cap_down) {
-  constexpr uint8_t kFree = 0, kKeep = 1, kTake = 2;  // DepthStage's states
+LB_CLONES_AVX2 void DepthStage::BuildTerms(
+    const uint8_t* __restrict st, const uint8_t* __restrict up, const uint8_t* __restrict down,
+    const int32_t* __restrict er, const int32_t* __restrict ed, const int32_t* __restrict eu,
+    const int32_t* __restrict hi, int32_t x0, int32_t x1, int32_t r0, int32_t r1,
+    int32_t* __restrict balance, int32_t* __restrict cap_right, int32_t* __restrict cap_down) {
   auto terms = [&](int32_t x, uint8_t left, uint8_t right, int32_t e_left, int32_t e_right) {
     const int32_t free = st[x] == kFree ? -1 : 0;
     const int32_t b = hi[x] - (right == kTake ? e_right : 0) - (left != kKeep ? e_left : 0) -
@@ -151,9 +142,9 @@ LB_CLONES_AVX2 static void BuildTerms(const uint8_t* __restrict st, const uint8_
     cap_right[x] = (right == kFree ? e_right : 0) & free;
     cap_down[x] = (down[x] == kFree ? ed[x] : 0) & free;
   };
-  const uint8_t left = x0 > r0 ? st[x0 - 1] : kKeep;
+  const uint8_t left = x0 > r0 ? st[x0 - 1] : uint8_t{kKeep};
   const int32_t e_left = x0 > r0 ? er[x0 - 1] : 0;
-  const uint8_t right = x1 < r1 ? st[x1] : kKeep;
+  const uint8_t right = x1 < r1 ? st[x1] : uint8_t{kKeep};
   const int32_t e_right = x1 < r1 ? er[x1 - 1] : 0;
   if (x1 - x0 == 1) {
     terms(x0, left, right, e_left, e_right);
