@@ -7,7 +7,16 @@
 // capacity, and a parent is only ever linked through one, so neither can become a tree link.
 #include "algo/depth/grid_maxflow.h"
 
+#include <cstddef>
 #include <cstring>
+
+// The passes before the search in two copies, AVX2 and the baseline, chosen by the loader (the
+// vector code of one C source; either gives the same nodes).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define LB_CLONES_AVX2 __attribute__((target_clones("avx2", "default")))
+#else
+#define LB_CLONES_AVX2
+#endif
 
 namespace lb {
 
@@ -44,19 +53,23 @@ void GridMaxflow::Start(int32_t width, int32_t height) {
 
 void GridMaxflow::Begin(int32_t width, int32_t height) {
   Start(width, height);
-  const size_t row = sizeof(Node) * static_cast<size_t>(width);
-  memset(static_cast<void*>(storage_), 0, row);
-  memset(static_cast<void*>(nodes_ + count_), 0, row);
+  // The padding row above; the one below is written when the staged rows are spent (Prepare).
+  memset(static_cast<void*>(storage_), 0, sizeof(Node) * static_cast<size_t>(width));
+  const size_t stage_at = 16 * static_cast<size_t>(count_) + 64 * static_cast<size_t>(width);
+  stage_base_ = reinterpret_cast<int32_t*>(reinterpret_cast<uint8_t*>(storage_) + stage_at);
+  stage_ = stage_base_;
+  stage_width_ = width;
+  staged_ = true;
 }
 
 void GridMaxflow::Truncate(int32_t height) {
   height_ = height;
   count_ = width_ * height;
-  memset(static_cast<void*>(nodes_ + count_), 0, sizeof(Node) * static_cast<size_t>(width_));
 }
 
 void GridMaxflowProbe::Reset(GridMaxflow& mf, int32_t width, int32_t height) {
   mf.Start(width, height);
+  mf.staged_ = false;
   memset(static_cast<void*>(mf.storage_), 0,
          sizeof(GridMaxflow::Node) * static_cast<size_t>(mf.count_ + 2 * width));
   for (int32_t y = 0; y < height; ++y) {
@@ -237,130 +250,326 @@ void GridMaxflow::Adopt(int32_t p) {
   n.tree = kFree;
 }
 
-// Moves excess rightward along the row toward the deficits it can reach (`demand`: w entries of
-// scratch). Moving excess d from a node to its neighbour over an arc of residual at least d
-// leaves every cut's capacity as it was, so the minimum cuts are the same; flow_ counts what
-// meets a deficit. (Moving leftward as well cost more than it saved the tree search on the depth
-// stage's graphs.)
-void GridMaxflow::ChainRow(Node* row, int32_t w, int32_t* demand) {
-  // What the nodes right of x still lack that the arc x -> x + 1 can carry.
-  demand[w - 1] = 0;
-  bool excess = row[w - 1].tcap > 0, deficit = row[w - 1].tcap < 0;
-  for (int32_t x = w - 2; x >= 0; --x) {
-    const int32_t want = demand[x + 1] - row[x + 1].tcap;
-    const int32_t c = row[x].cap[kRight];
-    demand[x] = want <= 0 ? 0 : (want < c ? want : c);
-    excess |= row[x].tcap > 0;
-    deficit |= row[x].tcap < 0;
-  }
-  if (!excess || !deficit) return;  // nothing to meet
-  for (int32_t x = 0; x + 1 < w; ++x) {
-    Node& from = row[x];
-    Node& to = row[x + 1];
-    const int32_t d = from.tcap < demand[x] ? from.tcap : demand[x];
-    if (d <= 0) continue;
-    const int32_t met = -to.tcap < d ? -to.tcap : d;
-    if (met > 0) flow_ += met;
-    from.tcap -= d;
-    to.tcap += d;
-    from.cap[kRight] -= d;
-    to.cap[kLeft] += d;
-  }
+namespace {
+
+// The part of `want` that an arc of residual `cap` can carry: 0 when nothing is wanted.
+inline int32_t Carry(int32_t want, int32_t cap) {
+  return want <= 0 ? 0 : (want < cap ? want : cap);
 }
 
-// Before any tree search, one sweep down the graph: excess moves down the columns toward the
-// deficits it can reach, then along each row (ChainRow), and the trees are rooted a row behind
-// (InitRow), while the rows are in cache. On the depth stage's graphs, the column chain before
-// the row chain leaves the search far less to do: on teddy, 0.66x the time of the row chain
-// alone (the same transformation as ChainRow's, over arcs down; an arc down has capacity only
-// where both rows are live, so each row pair looks at the columns common to both).
-void GridMaxflow::Prepare() {
-  const int32_t w = width_, h = height_;
-  auto chain_row = [&](int32_t y, int32_t* scratch) {
-    const int32_t x0 = live_[2 * y], x1 = live_[2 * y + 1];
-    if (x1 - x0 >= 2) ChainRow(nodes_ + y * w + x0, x1 - x0, scratch);
+}  // namespace
+
+// Four int32 lanes (GCC's and Clang's vector extension: SSE2 on x86-64, NEON on ARM, plain
+// code elsewhere); comparisons give -1 or 0 per lane.
+typedef int32_t Lanes __attribute__((vector_size(16)));
+typedef uint32_t ULanes __attribute__((vector_size(16)));
+
+namespace {
+
+Lanes Load(const int32_t* p) {
+  Lanes v;
+  memcpy(&v, p, sizeof(v));
+  return v;
+}
+
+}  // namespace
+
+// Moves excess rightward along a row of n staged nodes toward the deficits it can reach, and
+// leaves in flow[x] what went from x to x + 1 (the residual of the arc back, which was 0).
+// Moving excess d from a node to its neighbour over an arc of residual at least d leaves every
+// cut's capacity as it was, so the minimum cuts are the same; returns what met a deficit.
+// (Moving leftward as well cost more than it saved the tree search on the depth stage's graphs.)
+// The caller passes the columns from the first excess to the last deficit: nothing moves
+// outside them.
+int64_t GridMaxflow::ChainRow(int32_t* tcap, int32_t* cap_right, int32_t* flow, int32_t n) {
+  // First what the nodes right of x still lack that the arc x -> x + 1 can carry.
+  flow[n - 1] = 0;
+  for (int32_t x = n - 2; x >= 0; --x) flow[x] = Carry(flow[x + 1] - tcap[x + 1], cap_right[x]);
+  int64_t met_total = 0;
+  for (int32_t x = 0; x + 1 < n; ++x) {
+    const int32_t d = tcap[x] < flow[x] ? tcap[x] : flow[x];
+    if (d <= 0) {
+      flow[x] = 0;
+      continue;
+    }
+    const int32_t met = -tcap[x + 1] < d ? -tcap[x + 1] : d;
+    met_total += met > 0 ? met : 0;
+    tcap[x] -= d;
+    tcap[x + 1] += d;
+    cap_right[x] -= d;
+    flow[x] = d;
+  }
+  return met_total;
+}
+
+// The first x in x0..x1-1 with tcap[x] > 0 (x1 when none), four at a time.
+static int32_t FirstExcess(const int32_t* tcap, int32_t x0, int32_t x1) {
+  int32_t x = x0;
+  for (; x + 4 <= x1; x += 4) {
+    const Lanes positive = Load(tcap + x) > 0;
+    const Lanes any = positive | __builtin_shufflevector(positive, positive, 2, 3, 0, 1);
+    if ((any[0] | any[1]) != 0) break;
+  }
+  while (x < x1 && tcap[x] <= 0) ++x;
+  return x;
+}
+
+// One past the last x in x0..x1-1 with tcap[x] < 0 (x0 when none), four at a time.
+static int32_t EndOfDeficits(const int32_t* tcap, int32_t x0, int32_t x1) {
+  int32_t x = x1;
+  for (; x - 4 >= x0; x -= 4) {
+    const Lanes negative = Load(tcap + x - 4) < 0;
+    const Lanes any = negative | __builtin_shufflevector(negative, negative, 2, 3, 0, 1);
+    if ((any[0] | any[1]) != 0) break;
+  }
+  while (x > x0 && tcap[x - 1] >= 0) --x;
+  return x;
+}
+
+// What InitRow reads besides row y's own staged rows: the final balances of rows y - 1 and
+// y + 1, the residual arcs down from row y - 1 and the flows down into rows y and y + 1 (zeros
+// for the padding rows), and row y's flows to the right (ChainRow).
+struct GridMaxflow::RowInit {
+  const int32_t* up_tcap;
+  const int32_t* up_cap_down;
+  const int32_t* flow_in;   // from row y - 1: the residual of row y's arcs up
+  const int32_t* flow_out;  // to row y + 1: the residual of row y + 1's arcs up
+  const int32_t* down_tcap;
+  const int32_t* flow_right;  // the residual of the arc left of x + 1 (0 at the last live x)
+};
+
+// Node words as InitRow writes them: cap[4], then tcap, queued, ts and (little-endian) dist,
+// parent, tree in one word.
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__);
+
+// Writes node row y whole, from its staged rows: roots where the balance is not 0, free nodes
+// elsewhere (and outside the live columns, whatever was staged there). Only a root with a
+// residual arc into another tree (or to a free node) can grow and is queued; the rest become
+// active later if a neighbour leaves their tree (Adopt activates them). Four nodes at a time,
+// the first live node alone (its left neighbour is not live: no arc carries anything there).
+LB_CLONES_AVX2 void GridMaxflow::InitRow(int32_t y, const RowInit& in) {
+  static_assert(sizeof(Node) == 8 * sizeof(int32_t) && offsetof(Node, tcap) == 16 &&
+                offsetof(Node, queued) == 20 && offsetof(Node, ts) == 24 &&
+                offsetof(Node, dist) == 28 && offsetof(Node, parent) == 30 &&
+                offsetof(Node, tree) == 31);
+  const int32_t w = width_;
+  const int32_t x0 = live_[2 * y], x1 = live_[2 * y + 1];
+  const int32_t* const stage = StageRow(y);
+  const int32_t* const tcap = stage;
+  const int32_t* const cap_right = stage + w;
+  const int32_t* const cap_down = stage + 2 * w;
+  Node* const row = nodes_ + y * w;
+  for (int32_t x = 0; x < x0; ++x) row[x] = Node{};
+  for (int32_t x = x1 > x0 ? x1 : x0; x < w; ++x) row[x] = Node{};
+  if (x1 <= x0) return;
+  auto one = [&](int32_t x, int32_t left_tcap, int32_t left_right, int32_t left_flow) {
+    Node& n = row[x];
+    const int32_t t = tcap[x], right = cap_right[x], down = cap_down[x], up = in.flow_in[x];
+    n.cap[kRight] = right;
+    n.cap[kLeft] = left_flow;
+    n.cap[kDown] = down;
+    n.cap[kUp] = up;
+    n.tcap = t;
+    n.queued = 0;
+    n.ts = 0;
+    n.dist = 1;
+    if (t == 0) {
+      n.tree = kFree;
+      n.parent = kOrphan;
+      return;
+    }
+    n.parent = kTerminal;
+    bool grows;
+    if (t > 0) {
+      n.tree = kSourceTree;
+      grows = (right > 0 && tcap[x + 1] <= 0) || (left_flow > 0 && left_tcap <= 0) ||
+              (down > 0 && in.down_tcap[x] <= 0) || (up > 0 && in.up_tcap[x] <= 0);
+    } else {
+      n.tree = kSinkTree;
+      grows = (in.flow_right[x] > 0 && tcap[x + 1] >= 0) || (left_right > 0 && left_tcap >= 0) ||
+              (in.flow_out[x] > 0 && in.down_tcap[x] >= 0) ||
+              (in.up_cap_down[x] > 0 && in.up_tcap[x] >= 0);
+    }
+    if (grows) {
+      n.queued = 1;
+      queue_[queue_count_++] = y * w + x;  // the queue is empty before the search: no wrap
+    }
   };
-  if (h < 2) {
-    for (int32_t y = 0; y < h; ++y) {
-      chain_row(y, orphans_);
-      InitRow(y);
+  one(x0, 0, 0, 0);
+  int32_t x = x0 + 1;
+  // Locals: the node stores below may alias `in` as far as the compiler knows.
+  const int32_t *const flow_in = in.flow_in, *const flow_out = in.flow_out;
+  const int32_t *const flow_right = in.flow_right, *const up_cap_down = in.up_cap_down;
+  const int32_t *const down_tcap = in.down_tcap, *const up_tcap = in.up_tcap;
+  uint8_t* out = reinterpret_cast<uint8_t*>(row + x);
+  const Lanes zero = {0, 0, 0, 0};
+  auto store = [&](int k, Lanes v) { memcpy(out + 16 * k, &v, sizeof(v)); };
+  for (; x + 4 <= x1; x += 4, out += 4 * sizeof(Node)) {
+    const Lanes t = Load(tcap + x), right = Load(cap_right + x), down = Load(cap_down + x);
+    const Lanes up = Load(flow_in + x), left = Load(flow_right + x - 1);
+    // The tests on signs are on the top bit of unsigned lanes (no overflow: every value is
+    // within +-2^30): a > 0 is the top bit of 0 - a, b <= 0 that of b - 1, b >= 0 that of ~b.
+    const ULanes ut = ULanes(t), t_left = ULanes(Load(tcap + x - 1));
+    const ULanes t_right = ULanes(Load(tcap + x + 1)), t_down = ULanes(Load(down_tcap + x));
+    const ULanes t_up = ULanes(Load(up_tcap + x));
+    // A source root grows over an arc with residual into a node that is not a source root, a
+    // sink root over an arc with residual from a node that is not a sink root.
+    const ULanes source_grows =
+        ((0u - ULanes(right)) & (t_right - 1u)) | ((0u - ULanes(left)) & (t_left - 1u)) |
+        ((0u - ULanes(down)) & (t_down - 1u)) | ((0u - ULanes(up)) & (t_up - 1u));
+    const ULanes sink_grows = ((0u - ULanes(Load(flow_right + x))) & ~t_right) |
+                              ((0u - ULanes(Load(cap_right + x - 1))) & ~t_left) |
+                              ((0u - ULanes(Load(flow_out + x))) & ~t_down) |
+                              ((0u - ULanes(Load(up_cap_down + x))) & ~t_up);
+    const Lanes queued = Lanes((((0u - ut) & source_grows) | (ut & sink_grows)) >> 31);
+    const Lanes source = t > 0, sink = t < 0;
+    // dist 1; parent kTerminal (4) on a root, else kOrphan (5); tree 1 or 2 on a root, else 0.
+    const Lanes last = (1 | (kOrphan << 16)) + ((source | sink) << 16) +
+                       ((source & (kSourceTree << 24)) | (sink & (kSinkTree << 24)));
+    // Transposed to nodes: (right, left, down, up) and (tcap, queued, ts = 0, last) per node.
+    const Lanes a0 = __builtin_shufflevector(right, left, 0, 4, 1, 5);
+    const Lanes a1 = __builtin_shufflevector(right, left, 2, 6, 3, 7);
+    const Lanes b0 = __builtin_shufflevector(down, up, 0, 4, 1, 5);
+    const Lanes b1 = __builtin_shufflevector(down, up, 2, 6, 3, 7);
+    const Lanes c0 = __builtin_shufflevector(t, queued, 0, 4, 1, 5);
+    const Lanes c1 = __builtin_shufflevector(t, queued, 2, 6, 3, 7);
+    const Lanes d0 = __builtin_shufflevector(zero, last, 0, 4, 1, 5);
+    const Lanes d1 = __builtin_shufflevector(zero, last, 2, 6, 3, 7);
+    store(0, __builtin_shufflevector(a0, b0, 0, 1, 4, 5));
+    store(1, __builtin_shufflevector(c0, d0, 0, 1, 4, 5));
+    store(2, __builtin_shufflevector(a0, b0, 2, 3, 6, 7));
+    store(3, __builtin_shufflevector(c0, d0, 2, 3, 6, 7));
+    store(4, __builtin_shufflevector(a1, b1, 0, 1, 4, 5));
+    store(5, __builtin_shufflevector(c1, d1, 0, 1, 4, 5));
+    store(6, __builtin_shufflevector(a1, b1, 2, 3, 6, 7));
+    store(7, __builtin_shufflevector(c1, d1, 2, 3, 6, 7));
+    const Lanes any = queued | __builtin_shufflevector(queued, queued, 2, 3, 0, 1);
+    if ((any[0] | any[1]) != 0) {
+      for (int32_t i = 0; i < 4; ++i) {
+        if (queued[i] != 0) queue_[queue_count_++] = y * w + x + i;
+      }
     }
-    return;
   }
-  int32_t* demand = orphans_;  // free until the search
-  // Row y's demands, over columns lo..hi-1 of rows y and y + 1 (the pair's common columns).
-  int32_t below_lo = 0, below_hi = 0;
-  for (int32_t y = h - 2; y >= 0; --y) {
-    const int32_t lo = live_[2 * y] > live_[2 * y + 2] ? live_[2 * y] : live_[2 * y + 2];
-    const int32_t hi = live_[2 * y + 1] < live_[2 * y + 3] ? live_[2 * y + 1] : live_[2 * y + 3];
-    const Node* row = nodes_ + y * w;
-    int32_t* dem = demand + y * w;
-    for (int32_t x = lo; x < hi; ++x) {
-      const int32_t more = x >= below_lo && x < below_hi ? dem[x + w] : 0;
-      const int32_t want = more - row[x + w].tcap;
-      const int32_t c = row[x].cap[kDown];
-      dem[x] = want <= 0 ? 0 : (want < c ? want : c);
-    }
-    below_lo = lo;
-    below_hi = hi > lo ? hi : lo;
-  }
-  for (int32_t y = 0; y + 1 < h; ++y) {
-    const int32_t lo = live_[2 * y] > live_[2 * y + 2] ? live_[2 * y] : live_[2 * y + 2];
-    const int32_t hi = live_[2 * y + 1] < live_[2 * y + 3] ? live_[2 * y + 1] : live_[2 * y + 3];
-    Node* row = nodes_ + y * w;
-    const int32_t* dem = demand + y * w;
-    for (int32_t x = lo; x < hi; ++x) {
-      Node& from = row[x];
-      int32_t d = from.tcap < dem[x] ? from.tcap : dem[x];
-      if (d <= 0) continue;
-      Node& to = row[x + w];
-      const int32_t met = -to.tcap < d ? -to.tcap : d;
-      flow_ += met > 0 ? met : 0;
-      from.tcap -= d;
-      to.tcap += d;
-      from.cap[kDown] -= d;
-      to.cap[kUp] += d;
-    }
-    // Row y's column demands are spent: their room is the row chain's scratch.
-    chain_row(y, demand + y * w);
-    // Row y's balances are final: row y - 1's roots can be set.
-    if (y >= 1) InitRow(y - 1);
-  }
-  chain_row(h - 1, demand);
-  InitRow(h - 2);
-  InitRow(h - 1);
+  for (; x < x1; ++x) one(x, tcap[x - 1], cap_right[x - 1], in.flow_right[x - 1]);
 }
 
-// Roots of row y; needs the final balances of rows y - 1..y + 1.
-void GridMaxflow::InitRow(int32_t y) {
+// The roots of a graph set on its nodes (GridMaxflowProbe), without the passes.
+void GridMaxflow::InitNodeRow(int32_t y) {
   const int32_t w = width_;
   Node* row = nodes_ + y * w;
-  for (int32_t x = live_[2 * y]; x < live_[2 * y + 1]; ++x) {
+  for (int32_t x = 0; x < w; ++x) {
     Node& n = row[x];
     n.queued = 0;
     n.ts = 0;
     n.dist = 1;
-    if (n.tcap == 0) {
-      n.tree = kFree;
-      n.parent = kOrphan;
-      continue;
-    }
-    n.parent = kTerminal;
-    // Only a root with a residual arc into another tree (or to a free node) can grow; the
-    // rest become active later if a neighbour leaves their tree (Adopt activates them).
-    bool grows = false;
-    const Node &r = row[x + 1], &l = row[x - 1], &d = row[x + w], &u = row[x - w];
-    if (n.tcap > 0) {
-      n.tree = kSourceTree;
-      grows = (n.cap[kRight] > 0 && r.tcap <= 0) || (n.cap[kLeft] > 0 && l.tcap <= 0) ||
-              (n.cap[kDown] > 0 && d.tcap <= 0) || (n.cap[kUp] > 0 && u.tcap <= 0);
-    } else {
-      n.tree = kSinkTree;
-      grows = (r.cap[kLeft] > 0 && r.tcap >= 0) || (l.cap[kRight] > 0 && l.tcap >= 0) ||
-              (d.cap[kUp] > 0 && d.tcap >= 0) || (u.cap[kDown] > 0 && u.tcap >= 0);
-    }
-    if (grows) Activate(static_cast<int32_t>(&n - nodes_));
+    n.parent = n.tcap == 0 ? kOrphan : kTerminal;
+    n.tree = n.tcap == 0 ? kFree : (n.tcap > 0 ? kSourceTree : kSinkTree);
+    if (n.tcap != 0) Activate(y * w + x);
   }
+}
+
+// Before any tree search, over the staged rows: excess moves down the columns toward the
+// deficits it can reach (the demands bottom up, then the pushes top down), then along each row
+// (ChainRow), and each node row is written once, a row behind. On the depth stage's graphs, the
+// column chain before the row chain leaves the search far less to do: on teddy, 0.66x the time
+// of the row chain alone (the same transformation as ChainRow's, over arcs down; an arc down has
+// capacity only where both rows are live, so each row pair looks at the columns common to both).
+// The column passes are independent across x: plain loops the compiler vectorizes.
+void GridMaxflow::Prepare() {
+  const int32_t w = width_, h = height_;
+  if (!staged_) {
+    for (int32_t y = 0; y < h; ++y) InitNodeRow(y);
+    return;
+  }
+  // The padding row above is zeros, and so is any row of it read as int32.
+  const int32_t* const zeros = reinterpret_cast<const int32_t*>(storage_);
+  auto common = [&](int32_t y, int32_t* lo, int32_t* hi) {
+    *lo = live_[2 * y] > live_[2 * y + 2] ? live_[2 * y] : live_[2 * y + 2];
+    *hi = live_[2 * y + 1] < live_[2 * y + 3] ? live_[2 * y + 1] : live_[2 * y + 3];
+    *hi = *hi > *lo ? *hi : *lo;
+  };
+  // Row y's demands (its 4th staged row), over the columns lo..hi-1 common to rows y and y + 1:
+  // what row y + 1 lacks, plus what the column below it lacks where that pair has columns.
+  int32_t below_lo = 0, below_hi = 0;
+  for (int32_t y = h - 2; y >= 0; --y) {
+    int32_t lo, hi;
+    common(y, &lo, &hi);
+    const int32_t* const tcap_below = StageRow(y + 1);
+    const int32_t* const demand_below = tcap_below + 3 * w;
+    const int32_t* const cap_down = StageRow(y) + 2 * w;
+    int32_t* const demand = StageRow(y) + 3 * w;
+    const int32_t a = below_lo < lo ? lo : (below_lo > hi ? hi : below_lo);
+    const int32_t b = below_hi < a ? a : (below_hi > hi ? hi : below_hi);
+    for (int32_t x = lo; x < a; ++x) demand[x] = Carry(-tcap_below[x], cap_down[x]);
+    for (int32_t x = a; x < b; ++x) {
+      demand[x] = Carry(demand_below[x] - tcap_below[x], cap_down[x]);
+    }
+    for (int32_t x = b; x < hi; ++x) demand[x] = Carry(-tcap_below[x], cap_down[x]);
+    below_lo = lo;
+    below_hi = hi;
+  }
+  int64_t met = 0;
+  RowInit in{};
+  for (int32_t y = 0; y < h; ++y) {
+    int32_t* const tcap = StageRow(y);
+    int32_t* const cap_right = tcap + w;
+    int32_t* const cap_down = tcap + 2 * w;
+    int32_t* const down_flow = tcap + 3 * w;
+    if (y + 1 < h) {
+      int32_t lo, hi;
+      common(y, &lo, &hi);
+      int32_t* const tcap_below = StageRow(y + 1);
+      int64_t row_met = 0;
+      for (int32_t x = lo; x < hi; ++x) {
+        const int32_t t = tcap[x], t_below = tcap_below[x];
+        int32_t d = t < down_flow[x] ? t : down_flow[x];
+        d = d > 0 ? d : 0;
+        const int32_t m = -t_below < d ? -t_below : d;
+        row_met += m > 0 ? m : 0;
+        tcap[x] = t - d;
+        tcap_below[x] = t_below + d;
+        cap_down[x] -= d;
+        down_flow[x] = d;
+      }
+      met += row_met;
+      // Elsewhere in either row's live columns nothing went down.
+      const int32_t u0 = live_[2 * y] < live_[2 * y + 2] ? live_[2 * y] : live_[2 * y + 2];
+      const int32_t u1 = live_[2 * y + 1] > live_[2 * y + 3] ? live_[2 * y + 1] : live_[2 * y + 3];
+      const int32_t a = lo < hi ? lo : u0, b = lo < hi ? hi : u0;
+      for (int32_t x = u0; x < a; ++x) down_flow[x] = 0;
+      for (int32_t x = b; x < u1; ++x) down_flow[x] = 0;
+    }
+    // Row y's balances are final after its row chain; row y - 1's nodes can be written.
+    const int32_t x0 = live_[2 * y], x1 = live_[2 * y + 1];
+    int32_t* const flow_right = orphans_ + static_cast<ptrdiff_t>(y) * w;  // free until the search
+    // The row chain from the first excess to the last deficit; nothing moves elsewhere.
+    const int32_t a = FirstExcess(tcap, x0, x1);
+    int32_t b = a < x1 ? EndOfDeficits(tcap, a, x1) : a;
+    if (b - a >= 2) {
+      met += ChainRow(tcap + a, cap_right + a, flow_right + a, b - a);
+    } else {
+      b = a;
+    }
+    for (int32_t x = x0; x < a; ++x) flow_right[x] = 0;
+    for (int32_t x = b; x < x1; ++x) flow_right[x] = 0;
+    if (y >= 1) {
+      in.flow_out = tcap - w;  // row y - 1's flows down
+      in.down_tcap = tcap;
+      in.flow_right = flow_right - w;
+      InitRow(y - 1, in);
+      in.up_tcap = tcap - 4 * w;
+      in.up_cap_down = tcap - 2 * w;
+      in.flow_in = tcap - w;
+    } else {
+      in.up_tcap = in.up_cap_down = in.flow_in = zeros;
+    }
+  }
+  in.flow_out = in.down_tcap = zeros;
+  in.flow_right = orphans_ + static_cast<ptrdiff_t>(h - 1) * w;
+  InitRow(h - 1, in);
+  flow_ += met;
+  // The padding row below, over the staged rows now spent.
+  memset(static_cast<void*>(nodes_ + count_), 0, sizeof(Node) * static_cast<size_t>(w));
 }
 
 // Scans p's arcs out of its tree: claims free neighbours, and on touching the other tree returns
