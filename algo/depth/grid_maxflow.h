@@ -17,6 +17,8 @@
 
 namespace lb {
 
+struct GridMaxflowRows;  // what InitRow reads (grid_maxflow.cc)
+
 class GridMaxflow {
  public:
   static constexpr int32_t kMaxCapacity = 1 << 28;
@@ -92,9 +94,11 @@ class GridMaxflow {
     return stage_base_ + 4 * static_cast<ptrdiff_t>(width_) * y;
   }
   int64_t ChainRow(int32_t* tcap, int32_t* cap_right, int32_t* flow, int32_t n);
-  struct RowInit;
-  void InitRow(int32_t y, const RowInit& in);
+  void InitRow(int32_t y, const GridMaxflowRows& in);
   void InitNodeRow(int32_t y);
+  void Common(int32_t y, int32_t* lo, int32_t* hi) const;
+  void ColumnDemands();
+  int64_t PushDown(int32_t y);
   void Prepare();
   void Activate(int32_t p);
   int32_t NextActive();
@@ -123,7 +127,9 @@ class GridMaxflow {
   // width_ again, in a type the staging stores cannot alias: SetNode's callers keep it in a
   // register instead of reloading it after every store.
   ptrdiff_t stage_width_ = 0;
-  bool staged_ = false;       // false for GridMaxflowProbe's graphs, set on the nodes directly
+  bool staged_ = false;    // false for GridMaxflowProbe's graphs, set on the nodes directly
+  bool avx2_ = false;      // InitRow's eight-lane copy can run (asked once, at Carve)
+  bool cpu_avx2_ = false;  // what the CPU has (avx2_ follows it unless a test turns it off)
   // Augment's record of the two paths' first nodes (each kPath, and a slot that takes the rest).
   static constexpr int32_t kPath = 255;
   int32_t path_[2 * (kPath + 1)] = {};
@@ -157,6 +163,9 @@ struct GridMaxflowProbe {
   static int32_t Residual(const GridMaxflow& mf, int32_t p, GridMaxflow::Dir dir) {
     return mf.nodes_[p].cap[dir];
   }
+  // Whether the passes before the search may use their eight-lane copy (when the CPU has it):
+  // off, they take the four-lane one, which must give the same nodes.
+  static void UseEightLanes(GridMaxflow& mf, bool on) { mf.avx2_ = on && mf.cpu_avx2_; }
   // Fills all node storage with `byte`, as if another graph had left garbage everywhere: a caller
   // that sets only the nodes its graph can reach must then still get the same cut.
   static void Poison(GridMaxflow& mf, uint8_t byte) {
