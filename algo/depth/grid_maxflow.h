@@ -120,8 +120,8 @@ class GridMaxflow {
   // balance, cap right, cap down, and the column pass's demand (then the flow it sent down).
   // Their block lies in the upper half of the graph's own node storage, from byte
   // 16 * width * height + 64 * width (Begin's height) to the end of its padding row: node row y
-  // ends at byte 32 * width * (y + 2) and staged row y starts at or after it, so Prepare writes
-  // each node row over staged rows it has already read. Spare is not touched.
+  // ends at byte 32 * width * (y + 2), at or before the start of staged row y - 1, the first one
+  // Prepare still reads when it writes node row y. Spare is not touched.
   int32_t* stage_base_ = nullptr;
   int32_t* stage_ = nullptr;  // stage_base_ shifted so that stage_[p] is node p's balance
   // width_ again, in a type the staging stores cannot alias: SetNode's callers keep it in a
