@@ -313,7 +313,8 @@ int64_t GridMaxflow::ChainRow(int32_t* tcap, int32_t* cap_right, int32_t* flow, 
   // row is, skipped four at a time.
   const Lanes zero = {0, 0, 0, 0};
   flow[n - 1] = 0;
-  int32_t want = 0;  // flow[x + 1]
+  int32_t want = 0;   // flow[x + 1]
+  int32_t first = n;  // the first x where something is wanted
   for (int32_t x = n - 2; x >= 0;) {
     if (want == 0) {
       for (; x >= 3 && !AnyNegative4(tcap + x - 2); x -= 4) memcpy(flow + x - 3, &zero, 16);
@@ -322,11 +323,14 @@ int64_t GridMaxflow::ChainRow(int32_t* tcap, int32_t* cap_right, int32_t* flow, 
     }
     want = Carry(want - tcap[x + 1], cap_right[x]);
     flow[x] = want;
+    first = want > 0 ? x : first;
     --x;
   }
-  // Then the excess moves where something is wanted (elsewhere the flow stays 0).
+  // Then the excess moves where something is wanted (elsewhere the flow stays 0), from the
+  // first such column: the words just stored left of it are not read back at once (a wide load
+  // over two fresh narrow stores waits for them).
   int64_t met_total = 0;
-  for (int32_t x = 0;;) {
+  for (int32_t x = first;;) {
     for (; x + 4 <= n && !AnyNonzero4(flow + x); x += 4) {
     }
     for (; x + 1 < n && flow[x] == 0; ++x) {
