@@ -17,6 +17,8 @@
 
 namespace lb {
 
+struct GridMaxflowRows;  // what InitRow reads (grid_maxflow.cc)
+
 class GridMaxflow {
  public:
   static constexpr int32_t kMaxCapacity = 1 << 28;
@@ -29,27 +31,29 @@ class GridMaxflow {
   // Starts a new graph of width x height nodes whose every node the caller then sets once with
   // SetNode, row by row, calling RowDone after each row (no clearing pass).
   void Begin(int32_t width, int32_t height);
-  // Sets node p: its terminal balance (positive: source->p, negative: p->sink) and its arcs to
-  // the right and down neighbours, which must be 0 in the last column and the last row; the sister
-  // arcs from those neighbours are 0.
+  // Sets node p (of the row after the last RowDone): its terminal balance (positive: source->p,
+  // negative: p->sink) and its arcs to the right and down neighbours, which must be 0 in the
+  // last column and the last row; the sister arcs from those neighbours are 0. The values go to
+  // the row's staging block (three dense rows), not to the node: the passes before the search
+  // read them densely and write each node once.
   void SetNode(int32_t p, int32_t balance, int32_t cap_right, int32_t cap_down) {
-    Node& n = nodes_[p];
-    n.cap[kRight] = cap_right;
-    n.cap[kLeft] = 0;
-    n.cap[kDown] = cap_down;
-    n.cap[kUp] = 0;
-    n.tcap = balance;
+    int32_t* s = stage_ + p;
+    s[0] = balance;
+    s[stage_width_] = cap_right;
+    s[2 * stage_width_] = cap_down;
   }
-  // A node with no balance and no arcs, set as a whole (one store): what SetNode(p, 0, 0, 0)
-  // gives, already as the search's free node, so the passes before the search may skip it
-  // (RowDone).
-  void SetIdle(int32_t p) { nodes_[p] = Node{}; }
+  // A node with no balance and no arcs: what SetNode(p, 0, 0, 0) gives. Outside the columns
+  // RowDone names, the passes before the search write it as the search's free node without
+  // reading what was set.
+  void SetIdle(int32_t p) { SetNode(p, 0, 0, 0); }
   // Every node of rows 0..y is set. With x0..x1: row y's nodes outside columns x0..x1-1 were set
   // with SetIdle, and the passes before the search skip them.
   void RowDone(int32_t y) { RowDone(y, 0, width_); }
   void RowDone(int32_t y, int32_t x0, int32_t x1) {
     live_[2 * y] = x0;
     live_[2 * y + 1] = x1;
+    // Node p = y' * width + x of the next row y' = y + 1 is staged at 4 * width * y' + x.
+    stage_ = stage_base_ + 3 * stage_width_ * (y + 1);
   }
 
   // Ends the graph after its first `height` rows (all RowDone), as if it had been begun so.
@@ -86,8 +90,15 @@ class GridMaxflow {
   static_assert(sizeof(Node) == 32);
 
   void Start(int32_t width, int32_t height);
-  void ChainRow(Node* row, int32_t w, int32_t* demand);
-  void InitRow(int32_t y);
+  int32_t* StageRow(int32_t y) const {
+    return stage_base_ + 4 * static_cast<ptrdiff_t>(width_) * y;
+  }
+  int64_t ChainRow(int32_t* tcap, int32_t* cap_right, int32_t* flow, int32_t n);
+  void InitRow(int32_t y, const GridMaxflowRows& in);
+  void InitNodeRow(int32_t y);
+  void Common(int32_t y, int32_t* lo, int32_t* hi) const;
+  void ColumnDemands();
+  int64_t PushDown(int32_t y);
   void Prepare();
   void Activate(int32_t p);
   int32_t NextActive();
@@ -105,6 +116,20 @@ class GridMaxflow {
   // list, it shows the nodes to come, which are prefetched.
   int32_t* queue_ = nullptr;
   int32_t* live_ = nullptr;  // per row, the columns x0, x1 Prepare looks at (RowDone)
+  // Until Prepare, a graph's nodes are staged as 4 dense rows of width int32 per node row:
+  // balance, cap right, cap down, and the column pass's demand (then the flow it sent down).
+  // Their block lies in the upper half of the graph's own node storage, from byte
+  // 16 * width * height + 64 * width (Begin's height) to the end of its padding row: node row y
+  // ends at byte 32 * width * (y + 2), at or before the start of staged row y - 1, the first one
+  // Prepare still reads when it writes node row y. Spare is not touched.
+  int32_t* stage_base_ = nullptr;
+  int32_t* stage_ = nullptr;  // stage_base_ shifted so that stage_[p] is node p's balance
+  // width_ again, in a type the staging stores cannot alias: SetNode's callers keep it in a
+  // register instead of reloading it after every store.
+  ptrdiff_t stage_width_ = 0;
+  bool staged_ = false;    // false for GridMaxflowProbe's graphs, set on the nodes directly
+  bool avx2_ = false;      // InitRow's eight-lane copy can run (asked once, at Carve)
+  bool cpu_avx2_ = false;  // what the CPU has (avx2_ follows it unless a test turns it off)
   // Augment's record of the two paths' first nodes (each kPath, and a slot that takes the rest).
   static constexpr int32_t kPath = 255;
   int32_t path_[2 * (kPath + 1)] = {};
@@ -138,6 +163,9 @@ struct GridMaxflowProbe {
   static int32_t Residual(const GridMaxflow& mf, int32_t p, GridMaxflow::Dir dir) {
     return mf.nodes_[p].cap[dir];
   }
+  // Whether the passes before the search may use their eight-lane copy (when the CPU has it):
+  // off, they take the four-lane one, which must give the same nodes.
+  static void UseEightLanes(GridMaxflow& mf, bool on) { mf.avx2_ = on && mf.cpu_avx2_; }
   // Fills all node storage with `byte`, as if another graph had left garbage everywhere: a caller
   // that sets only the nodes its graph can reach must then still get the same cut.
   static void Poison(GridMaxflow& mf, uint8_t byte) {

@@ -286,6 +286,104 @@ TEST_F(MaxflowTest, StreamedRowsWithIdleNodesMatchTextbook) {
   }
 }
 
+// Rows as wide as the solver's vector passes take (eight and four nodes at a time, with the rest
+// one by one), graphs truncated after Begin, storage full of garbage before each graph and only
+// the nodes a free node can reach set (as the depth stage does): the flow and the least source
+// side against the textbook, and the same residual on every arc whether the passes before the
+// search ran eight or four lanes at a time.
+TEST_F(MaxflowTest, WideStreamedRowsMatchTextbookWithAnyLanes) {
+  std::mt19937 rng(31337);
+  std::uniform_int_distribution<int32_t> width(9, 33), height(1, 6), tail(0, 3), byte(0, 255);
+  GridMaxflow four;
+  std::vector<uint8_t> memory(Planned());
+  Arena arena(memory.data(), memory.size());
+  four.Carve(arena, kMaxSide, kMaxSide);
+  GridMaxflowProbe::UseEightLanes(four, false);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int32_t w = width(rng), h = height(rng), extra = tail(rng);
+    Graph g = RandomGraph(rng, w, h, trial % 2 ? 7 : 800);
+    // Free pixels in runs, whole rows free now and then (first and last column live).
+    std::vector<bool> free(static_cast<size_t>(w * h));
+    for (int32_t y = 0; y < h; ++y) {
+      const int mode = static_cast<int>(rng() % 3);
+      const int32_t a = static_cast<int32_t>(rng() % static_cast<uint32_t>(w));
+      const int32_t b = a + static_cast<int32_t>(rng() % static_cast<uint32_t>(w - a + 1));
+      for (int32_t x = 0; x < w; ++x) {
+        const bool in_run = x >= a && x < b;
+        free[y * w + x] = mode == 0 ? true : (mode == 1 ? in_run : (in_run && rng() % 4 != 0));
+      }
+    }
+    int64_t direct = 0;
+    for (int32_t y = 0; y < h; ++y) {
+      for (int32_t x = 0; x < w; ++x) {
+        const int32_t p = y * w + x;
+        g.right_bwd[p] = g.down_bwd[p] = 0;
+        if (x + 1 == w || !free[p] || !free[p + 1]) g.right_fwd[p] = 0;
+        if (y + 1 == h || !free[p] || !free[p + w]) g.down_fwd[p] = 0;
+        if (!free[p]) g.source[p] = g.sink[p] = 0;
+        direct += std::min(g.source[p], g.sink[p]);
+      }
+    }
+    auto first_last = [&](int32_t y, int32_t* first, int32_t* last) {
+      *first = w;
+      *last = -1;
+      for (int32_t x = 0; x < w; ++x) {
+        if (free[y * w + x]) {
+          *first = std::min(*first, x);
+          *last = x;
+        }
+      }
+    };
+    for (GridMaxflow* mf : {&mf_, &four}) {
+      GridMaxflowProbe::Poison(*mf, static_cast<uint8_t>(byte(rng)));
+      mf->Begin(w, h + extra);
+      for (int32_t y = 0; y < h; ++y) {
+        // The nodes a free node can reach: free runs of rows y - 1..y + 1, one column either
+        // side, and the row's first and last nodes.
+        int32_t lo = w, hi = 0;
+        for (int32_t k = std::max(0, y - 1); k <= std::min(h - 1, y + 1); ++k) {
+          int32_t first, last;
+          first_last(k, &first, &last);
+          if (last < 0) continue;
+          lo = std::min(lo, first - 1);
+          hi = std::max(hi, last + 2);
+        }
+        lo = std::max(lo, 0);
+        hi = std::min(hi, w);
+        mf->SetIdle(y * w);
+        mf->SetIdle(y * w + w - 1);
+        for (int32_t x = lo; x < hi; ++x) {
+          const int32_t p = y * w + x;
+          if (free[p]) {
+            mf->SetNode(p, g.source[p] - g.sink[p], g.right_fwd[p], g.down_fwd[p]);
+          } else {
+            mf->SetIdle(p);
+          }
+        }
+        int32_t first, last;
+        first_last(y, &first, &last);
+        mf->RowDone(y, last < 0 ? 0 : first, last + 1);
+      }
+      if (extra > 0) mf->Truncate(h);
+    }
+    std::vector<bool> reachable;
+    const int64_t expected = TextbookMaxflow(g, &reachable);
+    ASSERT_EQ(mf_.Solve() + direct, expected) << "trial " << trial << " " << w << "x" << h;
+    ASSERT_EQ(four.Solve() + direct, expected) << "trial " << trial;
+    ASSERT_EQ(CutCapacity(g, mf_), expected) << "trial " << trial;
+    for (int32_t p = 0; p < w * h; ++p) {
+      ASSERT_EQ(mf_.InSource(p), reachable[p]) << trial << " " << p;
+      ASSERT_EQ(four.InSource(p), reachable[p]) << trial << " " << p;
+      if (!free[p]) continue;
+      for (int dir = 0; dir < 4; ++dir) {
+        const auto d = static_cast<GridMaxflow::Dir>(dir);
+        ASSERT_EQ(GridMaxflowProbe::Residual(mf_, p, d), GridMaxflowProbe::Residual(four, p, d))
+            << trial << " " << p << " " << dir;
+      }
+    }
+  }
+}
+
 // A corridor that winds through the whole grid, the source at one end and the sink at the
 // other: the augmenting path is far longer than the record Augment keeps of it (a thousand
 // nodes a side on 64 x 64), and no push along a row or column can shorten it (no row or column
