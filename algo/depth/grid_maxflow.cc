@@ -10,14 +10,14 @@
 #include <cstddef>
 #include <cstring>
 
+#include "algo/core/clones.h"
+#include "algo/core/cpu.h"
+
 // The passes before the search in two copies, AVX2 and the baseline, chosen by the loader (the
 // vector code of one C source; either gives the same nodes).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define LB_CLONES_AVX2 __attribute__((target_clones("avx2", "default")))
 #define LB_HAVE_LANES8 1  // InitRow's eight-lane copy, for CPUs with AVX2
 #include <immintrin.h>
-#else
-#define LB_CLONES_AVX2
 #endif
 
 namespace lb {
@@ -31,7 +31,7 @@ void GridMaxflow::Carve(Arena& arena, int32_t max_width, int32_t max_height) {
   queue_ = arena.Allocate<int32_t>(static_cast<size_t>(max_nodes_));
   live_ = arena.Allocate<int32_t>(2 * static_cast<size_t>(max_height));
 #ifdef LB_HAVE_LANES8
-  cpu_avx2_ = __builtin_cpu_supports("avx2");
+  cpu_avx2_ = CurrentCpu().avx2;  // what the kernel tables are picked from
   avx2_ = cpu_avx2_;
 #endif
 }
