@@ -59,6 +59,17 @@ LB_AVX2 inline __m256i WeightedBits(__m256i v, __m256i lut) {
   return _mm256_add_epi8(lo, hi);
 }
 
+// cw * (bit count of i) for nibbles i = 0..15 (<= 40), in both lanes: a few vector operations,
+// since a scalar table costs more per call than a short row's pixels (the kernel runs per row,
+// view and label).
+LB_AVX2 inline __m256i WeightedBitTable(int32_t cw) {
+  const __m128i bits = _mm_setr_epi8(0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4);
+  const __m128i w = _mm_set1_epi16(static_cast<int16_t>(cw));
+  const __m128i lo = _mm_mullo_epi16(_mm_cvtepu8_epi16(bits), w);
+  const __m128i hi = _mm_mullo_epi16(_mm_cvtepu8_epi16(_mm_srli_si128(bits, 8)), w);
+  return _mm256_broadcastsi128_si256(_mm_packus_epi16(lo, hi));
+}
+
 // Three census planes: cw * Hamming distance <= 240.
 LB_AVX2 inline __m256i WeightedHamming(const uint8_t* a, const uint8_t* b, ptrdiff_t plane,
                                        __m256i lut) {
@@ -121,13 +132,10 @@ template <bool kFrac>
 LB_AVX2 void CostRowAvx2T(const uint8_t* ref, const uint8_t* img, const uint8_t* cref,
                           const uint8_t* cimg, ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc,
                           int32_t cw, uint8_t* out) {
-  int8_t table[16];
-  for (int32_t i = 0; i < 16; ++i) table[i] = static_cast<int8_t>(cw * __builtin_popcount(i));
-  const __m256i lut =
-      _mm256_broadcastsi128_si256(_mm_loadu_si128(reinterpret_cast<const __m128i*>(table)));
+  if (n < 32) return CostRowCAvx2(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+  const __m256i lut = WeightedBitTable(cw);
   const __m256i f128 = _mm256_set1_epi16(static_cast<int16_t>(f * 128));
   const __m256i trunc8 = _mm256_set1_epi8(static_cast<char>(trunc < 255 ? trunc : 255));
-  if (n < 32) return CostRowCAvx2(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
   for (int32_t step = 0; step < n; step += 32) {
     const int32_t x = step + 32 <= n ? step : n - 32;
     const Rgb32 r = LoadRgb32(ref + 3 * x);
@@ -169,44 +177,63 @@ LB_AVX2 void HSumRowAvx2(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* 
   }
 }
 
-// Signed 16-bit lanes (window sums <= 2295): a sorted list of the kKeep smallest in registers,
-// one insertion (min/max chain) per view; kept sum <= 18360, then mulhrs by the Q15 reciprocal
-// is (sum * recip + 2^14) >> 15, as in the reference.
+// Signed 16-bit lanes (window sums <= 2295). Only the SUM of the kKeep smallest is needed, not
+// their order: the first kKeep windows (A) and the others (B, kB = others - kKeep of them: kKeep
+// or kKeep - 1) are each sorted by a compare-exchange network, and the kKeep smallest of A and B
+// together are min(A_i, B_(kKeep-1-i)) (the first half of a bitonic merge; B's missing entry is
+// +inf, so A_0 alone). Kept sum <= 18360, then mulhrs by the Q15 reciprocal is
+// (sum * recip + 2^14) >> 15, as in the reference.
 LB_AVX2 inline __m256i Window(const uint16_t* const* rows, int32_t j, int32_t x) {
   return _mm256_add_epi16(_mm256_add_epi16(Load(rows[3 * j] + x), Load(rows[3 * j + 1] + x)),
                           Load(rows[3 * j + 2] + x));
 }
 
+LB_AVX2 inline void Exchange(__m256i* v, int32_t i, int32_t j) {
+  const __m256i lo = _mm256_min_epi16(v[i], v[j]);
+  v[j] = _mm256_max_epi16(v[i], v[j]);
+  v[i] = lo;
+}
+
+// Ascending sort of kN vectors lane by lane: the optimal 5 exchanges for 4, else insertion.
+template <int32_t kN>
+LB_AVX2 inline void SortNetwork(__m256i* v) {
+  if constexpr (kN == 4) {
+    Exchange(v, 0, 1);
+    Exchange(v, 2, 3);
+    Exchange(v, 0, 2);
+    Exchange(v, 1, 3);
+    Exchange(v, 1, 2);
+  } else {
+    for (int32_t i = 1; i < kN; ++i)
+      for (int32_t j = i; j > 0; --j) Exchange(v, j - 1, j);
+  }
+}
+
+template <int32_t kKeep, int32_t kB>
+LB_AVX2 void SelectRowAvx2T(const uint16_t* const* rows, int32_t x0, int32_t x1, uint16_t* out) {
+  const __m256i recip = _mm256_set1_epi16(static_cast<int16_t>(RecipQ15(kKeep)));
+  for (int32_t step = x0; step < x1; step += 16) {
+    const int32_t x = step + 16 <= x1 ? step : x1 - 16;
+    __m256i a[kKeep], b[kB > 0 ? kB : 1];
+    for (int32_t j = 0; j < kKeep; ++j) a[j] = Window(rows, j, x);
+    for (int32_t j = 0; j < kB; ++j) b[j] = Window(rows, kKeep + j, x);
+    SortNetwork<kKeep>(a);
+    SortNetwork<kB>(b);
+    __m256i sum = a[0];
+    if constexpr (kB == kKeep) sum = _mm256_min_epi16(a[0], b[kKeep - 1]);
+    for (int32_t i = 1; i < kKeep; ++i) {
+      sum = _mm256_add_epi16(sum, _mm256_min_epi16(a[i], b[kKeep - 1 - i]));
+    }
+    Store(out + x, kKeep == 1 ? sum : _mm256_mulhrs_epi16(sum, recip));
+  }
+}
+
 template <int32_t kKeep>
 LB_AVX2 void SelectRowAvx2T(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
                             uint16_t* out) {
-  const __m256i recip = _mm256_set1_epi16(static_cast<int16_t>(RecipQ15(kKeep)));
   if (x1 - x0 < 16) return SelectRowC(rows, others, x0, x1, out);
-  for (int32_t step = x0; step < x1; step += 16) {
-    const int32_t x = step + 16 <= x1 ? step : x1 - 16;
-    __m256i best[kKeep];
-    for (int32_t j = 0; j < kKeep; ++j) {
-      __m256i a = Window(rows, j, x);
-      for (int32_t i = 0; i < j; ++i) {
-        const __m256i lo = _mm256_min_epi16(best[i], a);
-        a = _mm256_max_epi16(best[i], a);
-        best[i] = lo;
-      }
-      best[j] = a;
-    }
-    for (int32_t j = kKeep; j < others; ++j) {
-      __m256i a = Window(rows, j, x);
-      for (int32_t i = 0; i < kKeep - 1; ++i) {
-        const __m256i lo = _mm256_min_epi16(best[i], a);
-        a = _mm256_max_epi16(best[i], a);
-        best[i] = lo;
-      }
-      best[kKeep - 1] = _mm256_min_epi16(best[kKeep - 1], a);
-    }
-    __m256i sum = best[0];
-    for (int32_t i = 1; i < kKeep; ++i) sum = _mm256_add_epi16(sum, best[i]);
-    Store(out + x, kKeep == 1 ? sum : _mm256_mulhrs_epi16(sum, recip));
-  }
+  if (others == 2 * kKeep) return SelectRowAvx2T<kKeep, kKeep>(rows, x0, x1, out);
+  SelectRowAvx2T<kKeep, kKeep - 1>(rows, x0, x1, out);
 }
 
 // The instance for each kept count (others + 1) / 2 = 1 .. kMaxBest.
