@@ -126,32 +126,58 @@ LB_AVX2 inline __m256i AbsDiff(__m256i a, __m256i b) {
   return _mm256_sub_epi8(_mm256_max_epu8(a, b), _mm256_min_epu8(a, b));
 }
 
-// 32 pixels per step, all in bytes: the interpolated Hamming cost is Lerp of cw * h0 and cw * h1
-// ((h0 * g + h1 * f) * cw = (cw h0) g + (cw h1) f exactly).
+// 32 pixels, all in bytes: the interpolated Hamming cost is Lerp of cw * h0 and cw * h1
+// ((h0 * g + h1 * f) * cw = (cw h0) g + (cw h1) f exactly). lut: WeightedBitTable(cw), trunc8:
+// min(trunc, 255) in every byte.
+template <bool kFrac>
+LB_AVX2 inline __attribute__((always_inline)) void CostStep(const uint8_t* ref, const uint8_t* img,
+                                                            const uint8_t* cref,
+                                                            const uint8_t* cimg, ptrdiff_t plane,
+                                                            __m256i f128, __m256i lut,
+                                                            __m256i trunc8, uint8_t* out) {
+  const Rgb32 r = LoadRgb32(ref);
+  const Rgb32 a = LoadRgb32(img);
+  __m256i d[3];
+  __m256i ham = WeightedHamming(cref, cimg, plane, lut);
+  if (kFrac) {
+    const Rgb32 b = LoadRgb32(img + 3);
+    for (int32_t k = 0; k < 3; ++k) d[k] = AbsDiff(r.v[k], Lerp(a.v[k], b.v[k], f128));
+    ham = Lerp(ham, WeightedHamming(cref, cimg + 1, plane, lut), f128);
+  } else {
+    for (int32_t k = 0; k < 3; ++k) d[k] = AbsDiff(r.v[k], a.v[k]);
+  }
+  const __m256i ad = _mm256_min_epu8(ChannelSum(d), trunc8);
+  Store(out, _mm256_adds_epu8(ad, ham));
+}
+
+// n >= 32 pixels, whole steps and then one overlapping the step before (the same bytes again).
+template <bool kFrac>
+LB_AVX2 inline void CostLoopAvx2(const uint8_t* ref, const uint8_t* img, const uint8_t* cref,
+                                 const uint8_t* cimg, ptrdiff_t plane, int32_t n, int32_t f,
+                                 __m256i lut, __m256i trunc8, uint8_t* out) {
+  const __m256i f128 = _mm256_set1_epi16(static_cast<int16_t>(f * 128));
+  int32_t x = 0;
+  for (; x + 32 <= n; x += 32) {
+    CostStep<kFrac>(ref + 3 * x, img + 3 * x, cref + x, cimg + x, plane, f128, lut, trunc8,
+                    out + x);
+  }
+  if (x < n) {
+    x = n - 32;
+    CostStep<kFrac>(ref + 3 * x, img + 3 * x, cref + x, cimg + x, plane, f128, lut, trunc8,
+                    out + x);
+  }
+}
+
+LB_AVX2 inline __m256i Trunc8(int32_t trunc) {
+  return _mm256_set1_epi8(static_cast<char>(trunc < 255 ? trunc : 255));
+}
+
 template <bool kFrac>
 LB_AVX2 void CostRowAvx2T(const uint8_t* ref, const uint8_t* img, const uint8_t* cref,
                           const uint8_t* cimg, ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc,
                           int32_t cw, uint8_t* out) {
   if (n < 32) return CostRowCAvx2(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
-  const __m256i lut = WeightedBitTable(cw);
-  const __m256i f128 = _mm256_set1_epi16(static_cast<int16_t>(f * 128));
-  const __m256i trunc8 = _mm256_set1_epi8(static_cast<char>(trunc < 255 ? trunc : 255));
-  for (int32_t step = 0; step < n; step += 32) {
-    const int32_t x = step + 32 <= n ? step : n - 32;
-    const Rgb32 r = LoadRgb32(ref + 3 * x);
-    const Rgb32 a = LoadRgb32(img + 3 * x);
-    __m256i d[3];
-    __m256i ham = WeightedHamming(cref + x, cimg + x, plane, lut);
-    if (kFrac) {
-      const Rgb32 b = LoadRgb32(img + 3 * x + 3);
-      for (int32_t k = 0; k < 3; ++k) d[k] = AbsDiff(r.v[k], Lerp(a.v[k], b.v[k], f128));
-      ham = Lerp(ham, WeightedHamming(cref + x, cimg + x + 1, plane, lut), f128);
-    } else {
-      for (int32_t k = 0; k < 3; ++k) d[k] = AbsDiff(r.v[k], a.v[k]);
-    }
-    const __m256i ad = _mm256_min_epu8(ChannelSum(d), trunc8);
-    Store(out + x, _mm256_adds_epu8(ad, ham));
-  }
+  CostLoopAvx2<kFrac>(ref, img, cref, cimg, plane, n, f, WeightedBitTable(cw), Trunc8(trunc), out);
 }
 
 LB_AVX2 void CostRowAvx2(const uint8_t* ref, const uint8_t* img, const uint8_t* cref,
@@ -168,12 +194,72 @@ LB_AVX2 inline __m256i Widen16(const uint8_t* p) {
   return _mm256_cvtepu8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
 }
 
+LB_AVX2 inline void HSumStep(const uint8_t* cost, uint16_t* hsum) {
+  const __m256i s = _mm256_add_epi16(Widen16(cost - 1), Widen16(cost));
+  Store(hsum, _mm256_add_epi16(s, Widen16(cost + 1)));
+}
+
 LB_AVX2 void HSumRowAvx2(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum) {
   if (x1 - x0 < 16) return HSumRowC(cost, x0, x1, hsum);
-  for (int32_t step = x0; step < x1; step += 16) {
-    const int32_t x = step + 16 <= x1 ? step : x1 - 16;
-    const __m256i s = _mm256_add_epi16(Widen16(cost + x - 1), Widen16(cost + x));
-    Store(hsum + x, _mm256_add_epi16(s, Widen16(cost + x + 1)));
+  int32_t x = x0;
+  for (; x + 32 <= x1; x += 32) {
+    HSumStep(cost + x, hsum + x);
+    HSumStep(cost + x + 16, hsum + x + 16);
+  }
+  if (x + 16 <= x1) {
+    HSumStep(cost + x, hsum + x);
+    x += 16;
+  }
+  if (x < x1) HSumStep(cost + x1 - 16, hsum + x1 - 16);
+}
+
+// The rectified row (RectRowWith's definition) with the constants set once for every view. A run
+// shorter than a vector step takes one whole step where the step's samples all lie in the image
+// (ending at the run's end, or else starting at its start), and the out-of-image runs are then
+// filled by whole vector stores: the costs a step or a fill writes outside its run are either
+// overwritten by those that follow or lie outside the columns the 3-sums read (the pixel row has
+// kPixelSlack bytes either side).
+LB_AVX2 void RectRowAvx2(const RectRow& r) {
+  const int32_t w = r.width;
+  const int32_t c0 = r.x0 > 0 ? r.x0 - 1 : 0, c1 = r.x1 < w ? r.x1 + 1 : w;
+  uint8_t* cost = r.pixel + kPixelSlack + 1;
+  const __m256i lut = WeightedBitTable(r.cw), trunc8 = Trunc8(r.trunc);
+  const __m256i invalid = _mm256_set1_epi8(static_cast<char>(r.invalid));
+  for (int32_t j = 0; j < r.others; ++j) {
+    const ValidSpan v = ValidColumns(r.shift_q8[j], w, c0, c1);
+    const int32_t n = v.x_hi - v.x_lo;
+    if (n >= 32) {
+      const uint8_t *ref = r.ref + 3 * v.x_lo, *img = r.img[j] + 3 * (v.x_lo + v.off);
+      const uint8_t *cref = r.cref + v.x_lo, *cimg = r.cimg[j] + v.x_lo + v.off;
+      if (v.f == 0) {
+        CostLoopAvx2<false>(ref, img, cref, cimg, w, n, 0, lut, trunc8, cost + v.x_lo);
+      } else {
+        CostLoopAvx2<true>(ref, img, cref, cimg, w, n, v.f, lut, trunc8, cost + v.x_lo);
+      }
+    } else if (n > 0) {
+      // Columns x .. x + 31 sample view pixels x + off .. x + off + 31 (+ 1 with a fraction).
+      const int32_t right = w - v.off - (v.f > 0 ? 1 : 0);
+      int32_t x = v.x_hi - 32;
+      if (x < 0 || x + v.off < 0) x = v.x_lo + 32 <= w && v.x_lo + 32 <= right ? v.x_lo : -1;
+      if (x >= 0) {
+        const __m256i f128 = _mm256_set1_epi16(static_cast<int16_t>(v.f * 128));
+        const uint8_t *ref = r.ref + 3 * x, *img = r.img[j] + 3 * (x + v.off);
+        const uint8_t *cref = r.cref + x, *cimg = r.cimg[j] + x + v.off;
+        if (v.f == 0) {
+          CostStep<false>(ref, img, cref, cimg, w, f128, lut, trunc8, cost + x);
+        } else {
+          CostStep<true>(ref, img, cref, cimg, w, f128, lut, trunc8, cost + x);
+        }
+      } else {
+        CostRowCAvx2(r.ref + 3 * v.x_lo, r.img[j] + 3 * (v.x_lo + v.off), r.cref + v.x_lo,
+                     r.cimg[j] + v.x_lo + v.off, w, n, v.f, r.trunc, r.cw, cost + v.x_lo);
+      }
+    }
+    for (int32_t x = v.x_lo; x > c0; x -= 32) Store(cost + x - 32, invalid);
+    for (int32_t x = v.x_hi; x < c1; x += 32) Store(cost + x, invalid);
+    if (r.x0 == 0) cost[-1] = cost[0];
+    if (r.x1 == w) cost[w] = cost[w - 1];
+    HSumRowAvx2(cost, r.x0, r.x1, r.hsum[j]);
   }
 }
 
@@ -244,9 +330,9 @@ constexpr SelectRowFn kAvx2ByKeep[kMaxBest] = {
 }  // namespace
 
 const DataTerm::Kernels* Avx2Kernels() {
-  static constexpr DataTerm::Kernels kAvx2 = {CensusRowAvx2,  CostRowAvx2,
-                                              HSumRowAvx2,    SelectByKeep<kAvx2ByKeep>,
-                                              PlaneSpansAvx2, PlaneLanesAvx2};
+  static constexpr DataTerm::Kernels kAvx2 = {
+      CensusRowAvx2, CostRowAvx2,    HSumRowAvx2,   SelectByKeep<kAvx2ByKeep>,
+      RectRowAvx2,   PlaneSpansAvx2, PlaneLanesAvx2};
   return __builtin_cpu_supports("avx2") ? &kAvx2 : nullptr;
 }
 

@@ -156,8 +156,13 @@ constexpr SelectRowFn kNeonByKeep[kMaxBest] = {
 }  // namespace
 
 const DataTerm::Kernels* NeonKernels() {
-  static constexpr DataTerm::Kernels kNeon = {
-      CensusRowNeon, CostRowNeon, HSumRowNeon, SelectByKeep<kNeonByKeep>, PlaneSpansNeon, nullptr};
+  static constexpr DataTerm::Kernels kNeon = {CensusRowNeon,
+                                              CostRowNeon,
+                                              HSumRowNeon,
+                                              SelectByKeep<kNeonByKeep>,
+                                              RectRowWith<CostRowNeon, HSumRowNeon>,
+                                              PlaneSpansNeon,
+                                              nullptr};
   return &kNeon;
 }
 

@@ -156,13 +156,15 @@ void SelectRowC(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t
   }
 }
 
-const DataTerm::Kernels kReference = {CensusRowC, CostRowC,    HSumRowC,
-                                      SelectRowC, PlaneSpansC, nullptr};
+const DataTerm::Kernels kReference = {
+    CensusRowC,  CostRowC, HSumRowC, SelectRowC, RectRowWith<CostRowC, HSumRowC>,
+    PlaneSpansC, nullptr};
 
 const DataTerm::Kernels* Ssse3Kernels() {
 #if defined(__x86_64__)
-  static constexpr DataTerm::Kernels kSsse3 = {CensusRowC, CostRowCSsse3, HSumRowC,
-                                               SelectRowC, PlaneSpansC,   nullptr};
+  static constexpr DataTerm::Kernels kSsse3 = {
+      CensusRowC,  CostRowCSsse3, HSumRowC, SelectRowC, RectRowWith<CostRowCSsse3, HSumRowC>,
+      PlaneSpansC, nullptr};
   return __builtin_cpu_supports("ssse3") ? &kSsse3 : nullptr;
 #else
   return nullptr;

@@ -112,6 +112,50 @@ TEST(DataTermKernels, HSumVariantsEqualTheReference) {
   }
 }
 
+TEST(DataTermKernels, RectRowVariantsEqualTheReference) {
+  LB_SKIP_WITHOUT_VARIANTS();
+  std::mt19937 rng(15);
+  for (int32_t w : kWidths) {
+    for (int32_t kind = 0; kind < 3; ++kind) {
+      const int32_t others = 1 + static_cast<int32_t>(rng() % dtk::kMaxOthers);
+      const std::vector<uint8_t> ref = Bytes(rng, 3 * w, kind);
+      const std::vector<uint8_t> cref = Bytes(rng, 3 * w, kind == 2 ? 2 : 0);
+      std::vector<std::vector<uint8_t>> img, cimg;
+      dtk::RectRow row;
+      row.ref = ref.data();
+      row.cref = cref.data();
+      row.others = others;
+      row.width = w;
+      row.x0 = static_cast<int32_t>(rng() % w);
+      row.x1 = row.x0 + 1 + static_cast<int32_t>(rng() % (w - row.x0));
+      row.trunc = kind == 2 ? 765 : static_cast<int32_t>(rng() % 100);
+      row.cw = kind == 2 ? 10 : static_cast<int32_t>(rng() % 11);
+      row.invalid = static_cast<int32_t>(rng() % 256);
+      for (int32_t j = 0; j < others; ++j) {
+        img.push_back(Bytes(rng, 3 * w, kind));
+        cimg.push_back(Bytes(rng, 3 * w, kind == 2 ? 2 : 0));
+        row.img[j] = img.back().data();
+        row.cimg[j] = cimg.back().data();
+        // Shifts inside the row, partly or wholly outside it, whole pixels and fractions.
+        const int32_t px = static_cast<int32_t>(rng() % (2 * w + 8)) - w - 4;
+        row.shift_q8[j] = px * 256 + (rng() % 3 == 0 ? 0 : static_cast<int32_t>(rng() % 256));
+      }
+      std::vector<uint8_t> pixel(w + 2 + 2 * dtk::kPixelSlack);
+      std::vector<std::vector<uint16_t>> want(others, std::vector<uint16_t>(w, 0xbeef));
+      for (int32_t j = 0; j < others; ++j) row.hsum[j] = want[j].data();
+      row.pixel = pixel.data();
+      dtk::kReference.rect_row(row);
+      for (const dtk::Variant& v : Others()) {
+        std::vector<std::vector<uint16_t>> got(others, std::vector<uint16_t>(w, 0xbeef));
+        for (int32_t j = 0; j < others; ++j) row.hsum[j] = got[j].data();
+        v.kernels->rect_row(row);
+        ASSERT_EQ(got, want) << v.name << " w " << w << " kind " << kind << " x0 " << row.x0
+                             << " x1 " << row.x1;
+      }
+    }
+  }
+}
+
 TEST(DataTermKernels, SelectVariantsEqualTheReference) {
   LB_SKIP_WITHOUT_VARIANTS();
   std::mt19937 rng(14);
