@@ -232,7 +232,6 @@ void DataTerm::ComputeSpanBand(const Scratch& s, int32_t disp_q8, const int32_t*
     WindowRows(s, r, a, b, &row, hsum);
   };
   for (int32_t r = y0 - 1; r <= y0; ++r) window_rows(r);
-  const uint16_t* rows[3 * dtk::kMaxOthers];
   for (int32_t y = y0; y < y1; ++y) {
     window_rows(y + 1);
     // As ComputeBand: ask early for the views' next rows, which the prefetcher misses.
@@ -247,10 +246,8 @@ void DataTerm::ComputeSpanBand(const Scratch& s, int32_t disp_q8, const int32_t*
     }
     const int32_t x0 = spans[2 * y], x1 = spans[2 * y + 1];
     if (x0 >= x1) continue;
-    for (int32_t j = 0; j < others; ++j) {
-      for (int32_t k = 0; k < 3; ++k) rows[3 * j + k] = ring(j, y - 1 + k);
-    }
-    kernels_->select(rows, others, x0, x1, out + (y - y0) * stride);
+    // The ring's three rows of each view are y - 1 .. y + 1.
+    kernels_->select(s.hsum, w, others, x0, x1, out + (y - y0) * stride);
   }
 }
 
@@ -269,7 +266,6 @@ void DataTerm::ComputeBand(const Scratch& s, int32_t disp_q8, int32_t x0, int32_
     WindowRows(s, r, x0, x1, &row, hsum);
   };
   for (int32_t r = y0 - 1; r <= y0; ++r) window_rows(r);
-  const uint16_t* rows[3 * dtk::kMaxOthers];
   const size_t row_bytes = static_cast<size_t>(3) * (x1 - x0);
   for (int32_t y = y0; y < y1; ++y) {
     window_rows(y + 1);
@@ -279,9 +275,9 @@ void DataTerm::ComputeBand(const Scratch& s, int32_t disp_q8, int32_t x0, int32_
       const int32_t next = Clamp(y + 2, 0, height_ - 1);
       Prefetch(images_[OtherView(j)].Row(next) + 3 * x0, row_bytes);
       Prefetch(census_[OtherView(j)] + static_cast<ptrdiff_t>(next) * 3 * w + x0, row_bytes);
-      for (int32_t k = 0; k < 3; ++k) rows[3 * j + k] = ring(j, y - 1 + k);
     }
-    kernels_->select(rows, others, x0, x1, out + (y - y0) * stride);
+    // The ring's three rows of each view are y - 1 .. y + 1.
+    kernels_->select(s.hsum, w, others, x0, x1, out + (y - y0) * stride);
   }
 }
 

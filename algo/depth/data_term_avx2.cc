@@ -269,9 +269,9 @@ LB_AVX2 void RectRowAvx2(const RectRow& r) {
 // together are min(A_i, B_(kKeep-1-i)) (the first half of a bitonic merge; B's missing entry is
 // +inf, so A_0 alone). Kept sum <= 18360, then mulhrs by the Q15 reciprocal is
 // (sum * recip + 2^14) >> 15, as in the reference.
-LB_AVX2 inline __m256i Window(const uint16_t* const* rows, int32_t j, int32_t x) {
-  return _mm256_add_epi16(_mm256_add_epi16(Load(rows[3 * j] + x), Load(rows[3 * j + 1] + x)),
-                          Load(rows[3 * j + 2] + x));
+LB_AVX2 inline __m256i Window(const uint16_t* view, ptrdiff_t stride) {
+  return _mm256_add_epi16(_mm256_add_epi16(Load(view), Load(view + stride)),
+                          Load(view + 2 * stride));
 }
 
 LB_AVX2 inline void Exchange(__m256i* v, int32_t i, int32_t j) {
@@ -296,13 +296,14 @@ LB_AVX2 inline void SortNetwork(__m256i* v) {
 }
 
 template <int32_t kKeep, int32_t kB>
-LB_AVX2 void SelectRowAvx2T(const uint16_t* const* rows, int32_t x0, int32_t x1, uint16_t* out) {
+LB_AVX2 void SelectRowAvx2T(const uint16_t* ring, ptrdiff_t stride, int32_t x0, int32_t x1,
+                            uint16_t* out) {
   const __m256i recip = _mm256_set1_epi16(static_cast<int16_t>(RecipQ15(kKeep)));
   for (int32_t step = x0; step < x1; step += 16) {
     const int32_t x = step + 16 <= x1 ? step : x1 - 16;
     __m256i a[kKeep], b[kB > 0 ? kB : 1];
-    for (int32_t j = 0; j < kKeep; ++j) a[j] = Window(rows, j, x);
-    for (int32_t j = 0; j < kB; ++j) b[j] = Window(rows, kKeep + j, x);
+    for (int32_t j = 0; j < kKeep; ++j) a[j] = Window(ring + 3 * j * stride + x, stride);
+    for (int32_t j = 0; j < kB; ++j) b[j] = Window(ring + 3 * (kKeep + j) * stride + x, stride);
     SortNetwork<kKeep>(a);
     SortNetwork<kB>(b);
     __m256i sum = a[0];
@@ -315,11 +316,11 @@ LB_AVX2 void SelectRowAvx2T(const uint16_t* const* rows, int32_t x0, int32_t x1,
 }
 
 template <int32_t kKeep>
-LB_AVX2 void SelectRowAvx2T(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
-                            uint16_t* out) {
-  if (x1 - x0 < 16) return SelectRowC(rows, others, x0, x1, out);
-  if (others == 2 * kKeep) return SelectRowAvx2T<kKeep, kKeep>(rows, x0, x1, out);
-  SelectRowAvx2T<kKeep, kKeep - 1>(rows, x0, x1, out);
+LB_AVX2 void SelectRowAvx2T(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t x0,
+                            int32_t x1, uint16_t* out) {
+  if (x1 - x0 < 16) return SelectRowC(ring, stride, others, x0, x1, out);
+  if (others == 2 * kKeep) return SelectRowAvx2T<kKeep, kKeep>(ring, stride, x0, x1, out);
+  SelectRowAvx2T<kKeep, kKeep - 1>(ring, stride, x0, x1, out);
 }
 
 // The instance for each kept count (others + 1) / 2 = 1 .. kMaxBest.

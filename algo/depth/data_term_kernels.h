@@ -86,7 +86,9 @@ struct DataTerm::Kernels {
   void (*cost)(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, const uint8_t* cimg,
                ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc, int32_t cw, uint8_t* out);
   void (*hsum)(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum);
-  void (*select)(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
+  // D of columns x0..x1-1 from the ring of 3-sums: other view j's three rows (in any order: only
+  // their sum counts) at ring + (3 * j + k) * stride, k = 0..2.
+  void (*select)(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t x0, int32_t x1,
                  uint16_t* out);
   // The rectified data term's row for every other view (dtk::RectRow): cost and hsum fused.
   void (*rect_row)(const dtk::RectRow& row);
@@ -103,13 +105,13 @@ namespace dtk {
 inline constexpr int32_t kMaxBest = 8;  // best half of up to 15 other views
 // A select kernel (the signature of Kernels::select); the SIMD twins keep one instance per
 // kept count, 1 .. kMaxBest, in a table.
-using SelectRowFn = void (*)(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
-                             uint16_t* out);
+using SelectRowFn = void (*)(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t x0,
+                             int32_t x1, uint16_t* out);
 // The select kernel that runs the instance of `by_keep` (kMaxBest entries) for the kept count.
 template <const SelectRowFn* by_keep>
-void SelectByKeep(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
+void SelectByKeep(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t x0, int32_t x1,
                   uint16_t* out) {
-  by_keep[(others + 1) / 2 - 1](rows, others, x0, x1, out);
+  by_keep[(others + 1) / 2 - 1](ring, stride, others, x0, x1, out);
 }
 
 // Q15 reciprocal of `keep`: the mean of the kept sums, rounded (error < 1 for D <= 2295).
@@ -139,7 +141,8 @@ void PlaneLanesAvx2(const uint8_t* ref, const uint8_t* cref, int32_t width, int3
 void PlaneSpansNeon(const WarpRow& row, const WarpRun& run, uint8_t* out);
 #endif
 void HSumRowC(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum);
-void SelectRowC(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1, uint16_t* out);
+void SelectRowC(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t x0, int32_t x1,
+                uint16_t* out);
 
 extern const DataTerm::Kernels kReference;
 // Each table when this build has it, else nullptr: AVX2 intrinsics (x86-64, also checked with

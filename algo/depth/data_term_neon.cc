@@ -109,23 +109,23 @@ void HSumRowNeon(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum) {
   }
 }
 
-inline int16x8_t Window(const uint16_t* const* rows, int32_t j, int32_t x) {
-  return vreinterpretq_s16_u16(
-      vaddq_u16(vaddq_u16(vld1q_u16(rows[3 * j] + x), vld1q_u16(rows[3 * j + 1] + x)),
-                vld1q_u16(rows[3 * j + 2] + x)));
+inline int16x8_t Window(const uint16_t* ring, ptrdiff_t stride, int32_t j, int32_t x) {
+  const uint16_t* view = ring + 3 * j * stride + x;
+  return vreinterpretq_s16_u16(vaddq_u16(vaddq_u16(vld1q_u16(view), vld1q_u16(view + stride)),
+                                         vld1q_u16(view + 2 * stride)));
 }
 
 // As the AVX2 kernel; vqrdmulh is (2 * sum * recip + 2^15) >> 16 = (sum * recip + 2^14) >> 15.
 template <int32_t kKeep>
-void SelectRowNeonT(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
+void SelectRowNeonT(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t x0, int32_t x1,
                     uint16_t* out) {
-  if (x1 - x0 < 8) return SelectRowC(rows, others, x0, x1, out);
+  if (x1 - x0 < 8) return SelectRowC(ring, stride, others, x0, x1, out);
   const int16x8_t recip = vdupq_n_s16(static_cast<int16_t>(kKeep == 1 ? 0 : RecipQ15(kKeep)));
   for (int32_t step = x0; step < x1; step += 8) {
     const int32_t x = step + 8 <= x1 ? step : x1 - 8;
     int16x8_t best[kKeep];
     for (int32_t j = 0; j < kKeep; ++j) {
-      int16x8_t a = Window(rows, j, x);
+      int16x8_t a = Window(ring, stride, j, x);
       for (int32_t i = 0; i < j; ++i) {
         const int16x8_t lo = vminq_s16(best[i], a);
         a = vmaxq_s16(best[i], a);
@@ -134,7 +134,7 @@ void SelectRowNeonT(const uint16_t* const* rows, int32_t others, int32_t x0, int
       best[j] = a;
     }
     for (int32_t j = kKeep; j < others; ++j) {
-      int16x8_t a = Window(rows, j, x);
+      int16x8_t a = Window(ring, stride, j, x);
       for (int32_t i = 0; i < kKeep - 1; ++i) {
         const int16x8_t lo = vminq_s16(best[i], a);
         a = vmaxq_s16(best[i], a);

@@ -163,21 +163,19 @@ TEST(DataTermKernels, SelectVariantsEqualTheReference) {
     for (int32_t others = 1; others <= 15; ++others) {
       const int32_t kind = static_cast<int32_t>(rng() % 3);
       // Horizontal 3-sums 0..765: random, or all at the cap (window sums of 2295), or 0 / 765.
-      std::vector<std::vector<uint16_t>> sums(3 * others, std::vector<uint16_t>(w));
-      std::vector<const uint16_t*> rows;
-      for (auto& r : sums) {
-        for (uint16_t& s : r) {
-          const uint32_t v = rng();
-          s = static_cast<uint16_t>(kind == 0 ? v % 766 : kind == 1 ? 765 : (v & 1) * 765);
-        }
-        rows.push_back(r.data());
+      // The ring: 3 rows per view, `stride` apart (a little more than the row).
+      const ptrdiff_t stride = w + 3;
+      std::vector<uint16_t> ring(static_cast<size_t>(3 * others * stride));
+      for (uint16_t& s : ring) {
+        const uint32_t v = rng();
+        s = static_cast<uint16_t>(kind == 0 ? v % 766 : kind == 1 ? 765 : (v & 1) * 765);
       }
       const int32_t x0 = static_cast<int32_t>(rng() % w);
       std::vector<uint16_t> want(w, 0xbeef);
-      dtk::kReference.select(rows.data(), others, x0, w, want.data());
+      dtk::kReference.select(ring.data(), stride, others, x0, w, want.data());
       for (const dtk::Variant& v : Others()) {
         std::vector<uint16_t> got(w, 0xbeef);
-        v.kernels->select(rows.data(), others, x0, w, got.data());
+        v.kernels->select(ring.data(), stride, others, x0, w, got.data());
         ASSERT_EQ(got, want) << v.name << " w " << w << " others " << others << " kind " << kind;
       }
     }
