@@ -309,23 +309,41 @@ LB_AVX2 inline void SortNetwork(__m256i* v) {
   }
 }
 
+// 16 columns: view j's rows at view[j], view[j] + stride, view[j] + 2 * stride.
+template <int32_t kKeep, int32_t kB>
+LB_AVX2 inline __attribute__((always_inline)) void SelectStep(const uint16_t* const* view,
+                                                              ptrdiff_t stride, __m256i recip,
+                                                              uint16_t* out) {
+  __m256i a[kKeep], b[kB > 0 ? kB : 1];
+  for (int32_t j = 0; j < kKeep; ++j) a[j] = Window(view[j], stride);
+  for (int32_t j = 0; j < kB; ++j) b[j] = Window(view[kKeep + j], stride);
+  SortNetwork<kKeep>(a);
+  SortNetwork<kB>(b);
+  __m256i sum = a[0];
+  if constexpr (kB == kKeep) sum = _mm256_min_epi16(a[0], b[kKeep - 1]);
+  for (int32_t i = 1; i < kKeep; ++i) {
+    sum = _mm256_add_epi16(sum, _mm256_min_epi16(a[i], b[kKeep - 1 - i]));
+  }
+  Store(out, kKeep == 1 ? sum : _mm256_mulhrs_epi16(sum, recip));
+}
+
+// Whole steps with each view's pointer moved along (no address arithmetic per view and step),
+// then one step overlapping the one before.
 template <int32_t kKeep, int32_t kB>
 LB_AVX2 void SelectRowAvx2T(const uint16_t* ring, ptrdiff_t stride, int32_t x0, int32_t x1,
                             uint16_t* out) {
+  constexpr int32_t kViews = kKeep + kB;
   const __m256i recip = _mm256_set1_epi16(static_cast<int16_t>(RecipQ15(kKeep)));
-  for (int32_t step = x0; step < x1; step += 16) {
-    const int32_t x = step + 16 <= x1 ? step : x1 - 16;
-    __m256i a[kKeep], b[kB > 0 ? kB : 1];
-    for (int32_t j = 0; j < kKeep; ++j) a[j] = Window(ring + 3 * j * stride + x, stride);
-    for (int32_t j = 0; j < kB; ++j) b[j] = Window(ring + 3 * (kKeep + j) * stride + x, stride);
-    SortNetwork<kKeep>(a);
-    SortNetwork<kB>(b);
-    __m256i sum = a[0];
-    if constexpr (kB == kKeep) sum = _mm256_min_epi16(a[0], b[kKeep - 1]);
-    for (int32_t i = 1; i < kKeep; ++i) {
-      sum = _mm256_add_epi16(sum, _mm256_min_epi16(a[i], b[kKeep - 1 - i]));
-    }
-    Store(out + x, kKeep == 1 ? sum : _mm256_mulhrs_epi16(sum, recip));
+  const uint16_t* view[kViews];
+  for (int32_t j = 0; j < kViews; ++j) view[j] = ring + 3 * j * stride + x0;
+  int32_t x = x0;
+  for (; x + 16 <= x1; x += 16) {
+    SelectStep<kKeep, kB>(view, stride, recip, out + x);
+    for (int32_t j = 0; j < kViews; ++j) view[j] += 16;
+  }
+  if (x < x1) {
+    for (int32_t j = 0; j < kViews; ++j) view[j] = ring + 3 * j * stride + x1 - 16;
+    SelectStep<kKeep, kB>(view, stride, recip, out + x1 - 16);
   }
 }
 
