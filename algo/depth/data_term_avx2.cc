@@ -212,7 +212,8 @@ LB_AVX2 inline void HSumStep(const uint8_t* cost, uint16_t* hsum) {
   Store(hsum, _mm256_add_epi16(s, Widen16(cost + 1)));
 }
 
-LB_AVX2 void HSumRowAvx2(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum) {
+LB_AVX2 inline __attribute__((always_inline)) void HSumLoopAvx2(const uint8_t* cost, int32_t x0,
+                                                                int32_t x1, uint16_t* hsum) {
   if (x1 - x0 < 16) return HSumRowC(cost, x0, x1, hsum);
   int32_t x = x0;
   for (; x + 32 <= x1; x += 32) {
@@ -224,6 +225,10 @@ LB_AVX2 void HSumRowAvx2(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* 
     x += 16;
   }
   if (x < x1) HSumStep(cost + x1 - 16, hsum + x1 - 16);
+}
+
+LB_AVX2 void HSumRowAvx2(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum) {
+  HSumLoopAvx2(cost, x0, x1, hsum);
 }
 
 // The rectified row (RectRowWith's definition) with the constants set once for every view. A run
@@ -273,7 +278,7 @@ LB_AVX2 void RectRowAvx2(const RectRow& r) {
     for (int32_t x = v.x_hi; x < c1; x += 32) Store(cost + x, invalid);
     if (r.x0 == 0) cost[-1] = cost[0];
     if (r.x1 == w) cost[w] = cost[w - 1];
-    HSumRowAvx2(cost, r.x0, r.x1, r.hsum[j]);
+    HSumLoopAvx2(cost, r.x0, r.x1, r.hsum[j]);
   }
 }
 
