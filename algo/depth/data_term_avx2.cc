@@ -139,10 +139,13 @@ LB_AVX2 inline __m256i AbsDiff(__m256i a, __m256i b) {
   return _mm256_sub_epi8(_mm256_max_epu8(a, b), _mm256_min_epu8(a, b));
 }
 
+// The sample's fraction: none (f = 0), a half (f = 128: an average), or any other.
+constexpr int32_t kWhole = 0, kFraction = 1, kHalf = 2;
+
 // 32 pixels, all in bytes: the interpolated Hamming cost is Lerp of cw * h0 and cw * h1
 // ((h0 * g + h1 * f) * cw = (cw h0) g + (cw h1) f exactly). lut: HamTables(cw), trunc8:
 // min(trunc, 255) in every byte.
-template <bool kFrac>
+template <int32_t kFrac>
 LB_AVX2 inline __attribute__((always_inline)) void CostStep(const uint8_t* ref, const uint8_t* img,
                                                             const uint8_t* cref,
                                                             const uint8_t* cimg, ptrdiff_t plane,
@@ -152,7 +155,12 @@ LB_AVX2 inline __attribute__((always_inline)) void CostStep(const uint8_t* ref, 
   const Rgb32 a = LoadRgb32(img);
   __m256i d[3];
   __m256i ham = WeightedHamming(cref, cimg, plane, lut);
-  if (kFrac) {
+  if constexpr (kFrac == kHalf) {
+    // f = 128: (128 a + 128 b + 128) >> 8 = (a + b + 1) >> 1, the byte average.
+    const Rgb32 b = LoadRgb32(img + 3);
+    for (int32_t k = 0; k < 3; ++k) d[k] = AbsDiff(r.v[k], _mm256_avg_epu8(a.v[k], b.v[k]));
+    ham = _mm256_avg_epu8(ham, WeightedHamming(cref, cimg + 1, plane, lut));
+  } else if constexpr (kFrac == kFraction) {
     const Rgb32 b = LoadRgb32(img + 3);
     for (int32_t k = 0; k < 3; ++k) d[k] = AbsDiff(r.v[k], Lerp(a.v[k], b.v[k], f128));
     ham = Lerp(ham, WeightedHamming(cref, cimg + 1, plane, lut), f128);
@@ -164,7 +172,7 @@ LB_AVX2 inline __attribute__((always_inline)) void CostStep(const uint8_t* ref, 
 }
 
 // n >= 32 pixels, whole steps and then one overlapping the step before (the same bytes again).
-template <bool kFrac>
+template <int32_t kFrac>
 LB_AVX2 inline void CostLoopAvx2(const uint8_t* ref, const uint8_t* img, const uint8_t* cref,
                                  const uint8_t* cimg, ptrdiff_t plane, int32_t n, int32_t f,
                                  HamLut lut, __m256i trunc8, uint8_t* out) {
@@ -185,7 +193,7 @@ LB_AVX2 inline __m256i Trunc8(int32_t trunc) {
   return _mm256_set1_epi8(static_cast<char>(trunc < 255 ? trunc : 255));
 }
 
-template <bool kFrac>
+template <int32_t kFrac>
 LB_AVX2 void CostRowAvx2T(const uint8_t* ref, const uint8_t* img, const uint8_t* cref,
                           const uint8_t* cimg, ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc,
                           int32_t cw, uint8_t* out) {
@@ -197,9 +205,11 @@ LB_AVX2 void CostRowAvx2(const uint8_t* ref, const uint8_t* img, const uint8_t* 
                          const uint8_t* cimg, ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc,
                          int32_t cw, uint8_t* out) {
   if (f == 0) {
-    CostRowAvx2T<false>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+    CostRowAvx2T<kWhole>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+  } else if (f == 128) {
+    CostRowAvx2T<kHalf>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
   } else {
-    CostRowAvx2T<true>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+    CostRowAvx2T<kFraction>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
   }
 }
 
@@ -251,9 +261,11 @@ LB_AVX2 void RectRowAvx2(const RectRow& r) {
       const uint8_t *ref = r.ref + 3 * v.x_lo, *img = r.img[j] + 3 * (v.x_lo + v.off);
       const uint8_t *cref = r.cref + v.x_lo, *cimg = r.cimg[j] + v.x_lo + v.off;
       if (v.f == 0) {
-        CostLoopAvx2<false>(ref, img, cref, cimg, w, n, 0, lut, trunc8, cost + v.x_lo);
+        CostLoopAvx2<kWhole>(ref, img, cref, cimg, w, n, 0, lut, trunc8, cost + v.x_lo);
+      } else if (v.f == 128) {
+        CostLoopAvx2<kHalf>(ref, img, cref, cimg, w, n, v.f, lut, trunc8, cost + v.x_lo);
       } else {
-        CostLoopAvx2<true>(ref, img, cref, cimg, w, n, v.f, lut, trunc8, cost + v.x_lo);
+        CostLoopAvx2<kFraction>(ref, img, cref, cimg, w, n, v.f, lut, trunc8, cost + v.x_lo);
       }
     } else if (n > 0) {
       // Columns x .. x + 31 sample view pixels x + off .. x + off + 31 (+ 1 with a fraction).
@@ -265,9 +277,11 @@ LB_AVX2 void RectRowAvx2(const RectRow& r) {
         const uint8_t *ref = r.ref + 3 * x, *img = r.img[j] + 3 * (x + v.off);
         const uint8_t *cref = r.cref + x, *cimg = r.cimg[j] + x + v.off;
         if (v.f == 0) {
-          CostStep<false>(ref, img, cref, cimg, w, f128, lut, trunc8, cost + x);
+          CostStep<kWhole>(ref, img, cref, cimg, w, f128, lut, trunc8, cost + x);
+        } else if (v.f == 128) {
+          CostStep<kHalf>(ref, img, cref, cimg, w, f128, lut, trunc8, cost + x);
         } else {
-          CostStep<true>(ref, img, cref, cimg, w, f128, lut, trunc8, cost + x);
+          CostStep<kFraction>(ref, img, cref, cimg, w, f128, lut, trunc8, cost + x);
         }
       } else {
         CostRowCAvx2(r.ref + 3 * v.x_lo, r.img[j] + 3 * (v.x_lo + v.off), r.cref + v.x_lo,
