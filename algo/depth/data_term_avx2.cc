@@ -139,8 +139,35 @@ LB_AVX2 inline __m256i AbsDiff(__m256i a, __m256i b) {
   return _mm256_sub_epi8(_mm256_max_epu8(a, b), _mm256_min_epu8(a, b));
 }
 
-// The sample's fraction: none (f = 0), a half (f = 128: an average), or any other.
-constexpr int32_t kWhole = 0, kFraction = 1, kHalf = 2;
+// The sample's fraction: none (f = 0), a half (f = 128: an average), a quarter or three
+// quarters (f = 64, 192: averages again, below), or any other.
+constexpr int32_t kWhole = 0, kFraction = 1, kHalf = 2, kQuarter = 3, kThreeQuarters = 4;
+
+// (192 a + 64 b + 128) >> 8 = (3 a + b + 2) >> 2 = avg(a, floor((a + b) / 2)): the floor of a
+// floor is the floor of the quotient, (2 a + 2 + a + b) / 4 = (a + floor((a + b) / 2) + 1) / 2
+// after the inner floor, and floor((a + b) / 2) = avg(a, b) - ((a ^ b) & 1).
+LB_AVX2 inline __m256i QuarterLerp(__m256i a, __m256i b) {
+  const __m256i floor_avg = _mm256_sub_epi8(
+      _mm256_avg_epu8(a, b), _mm256_and_si256(_mm256_xor_si256(a, b), _mm256_set1_epi8(1)));
+  return _mm256_avg_epu8(a, floor_avg);
+}
+
+inline int32_t FracKind(int32_t f) {
+  return f == 0     ? kWhole
+         : f == 128 ? kHalf
+         : f == 64  ? kQuarter
+         : f == 192 ? kThreeQuarters
+                    : kFraction;
+}
+
+// The fraction's interpolation of a (weight 256 - f) and b (weight f), rounded as Lerp.
+template <int32_t kFrac>
+LB_AVX2 inline __m256i Mix(__m256i a, __m256i b, __m256i f128) {
+  if constexpr (kFrac == kHalf) return _mm256_avg_epu8(a, b);  // (a + b + 1) >> 1
+  if constexpr (kFrac == kQuarter) return QuarterLerp(a, b);
+  if constexpr (kFrac == kThreeQuarters) return QuarterLerp(b, a);
+  return Lerp(a, b, f128);
+}
 
 // 32 pixels, all in bytes: the interpolated Hamming cost is Lerp of cw * h0 and cw * h1
 // ((h0 * g + h1 * f) * cw = (cw h0) g + (cw h1) f exactly). lut: HamTables(cw), trunc8:
@@ -155,15 +182,10 @@ LB_AVX2 inline __attribute__((always_inline)) void CostStep(const uint8_t* ref, 
   const Rgb32 a = LoadRgb32(img);
   __m256i d[3];
   __m256i ham = WeightedHamming(cref, cimg, plane, lut);
-  if constexpr (kFrac == kHalf) {
-    // f = 128: (128 a + 128 b + 128) >> 8 = (a + b + 1) >> 1, the byte average.
+  if constexpr (kFrac != kWhole) {
     const Rgb32 b = LoadRgb32(img + 3);
-    for (int32_t k = 0; k < 3; ++k) d[k] = AbsDiff(r.v[k], _mm256_avg_epu8(a.v[k], b.v[k]));
-    ham = _mm256_avg_epu8(ham, WeightedHamming(cref, cimg + 1, plane, lut));
-  } else if constexpr (kFrac == kFraction) {
-    const Rgb32 b = LoadRgb32(img + 3);
-    for (int32_t k = 0; k < 3; ++k) d[k] = AbsDiff(r.v[k], Lerp(a.v[k], b.v[k], f128));
-    ham = Lerp(ham, WeightedHamming(cref, cimg + 1, plane, lut), f128);
+    for (int32_t k = 0; k < 3; ++k) d[k] = AbsDiff(r.v[k], Mix<kFrac>(a.v[k], b.v[k], f128));
+    ham = Mix<kFrac>(ham, WeightedHamming(cref, cimg + 1, plane, lut), f128);
   } else {
     for (int32_t k = 0; k < 3; ++k) d[k] = AbsDiff(r.v[k], a.v[k]);
   }
@@ -204,12 +226,17 @@ LB_AVX2 void CostRowAvx2T(const uint8_t* ref, const uint8_t* img, const uint8_t*
 LB_AVX2 void CostRowAvx2(const uint8_t* ref, const uint8_t* img, const uint8_t* cref,
                          const uint8_t* cimg, ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc,
                          int32_t cw, uint8_t* out) {
-  if (f == 0) {
-    CostRowAvx2T<kWhole>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
-  } else if (f == 128) {
-    CostRowAvx2T<kHalf>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
-  } else {
-    CostRowAvx2T<kFraction>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+  switch (FracKind(f)) {
+    case kWhole:
+      return CostRowAvx2T<kWhole>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+    case kHalf:
+      return CostRowAvx2T<kHalf>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+    case kQuarter:
+      return CostRowAvx2T<kQuarter>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+    case kThreeQuarters:
+      return CostRowAvx2T<kThreeQuarters>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+    default:
+      return CostRowAvx2T<kFraction>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
   }
 }
 
@@ -260,12 +287,22 @@ LB_AVX2 void RectRowAvx2(const RectRow& r) {
     if (n >= 32) {
       const uint8_t *ref = r.ref + 3 * v.x_lo, *img = r.img[j] + 3 * (v.x_lo + v.off);
       const uint8_t *cref = r.cref + v.x_lo, *cimg = r.cimg[j] + v.x_lo + v.off;
-      if (v.f == 0) {
-        CostLoopAvx2<kWhole>(ref, img, cref, cimg, w, n, 0, lut, trunc8, cost + v.x_lo);
-      } else if (v.f == 128) {
-        CostLoopAvx2<kHalf>(ref, img, cref, cimg, w, n, v.f, lut, trunc8, cost + v.x_lo);
-      } else {
-        CostLoopAvx2<kFraction>(ref, img, cref, cimg, w, n, v.f, lut, trunc8, cost + v.x_lo);
+      uint8_t* out = cost + v.x_lo;
+      switch (FracKind(v.f)) {
+        case kWhole:
+          CostLoopAvx2<kWhole>(ref, img, cref, cimg, w, n, 0, lut, trunc8, out);
+          break;
+        case kHalf:
+          CostLoopAvx2<kHalf>(ref, img, cref, cimg, w, n, v.f, lut, trunc8, out);
+          break;
+        case kQuarter:
+          CostLoopAvx2<kQuarter>(ref, img, cref, cimg, w, n, v.f, lut, trunc8, out);
+          break;
+        case kThreeQuarters:
+          CostLoopAvx2<kThreeQuarters>(ref, img, cref, cimg, w, n, v.f, lut, trunc8, out);
+          break;
+        default:
+          CostLoopAvx2<kFraction>(ref, img, cref, cimg, w, n, v.f, lut, trunc8, out);
       }
     } else if (n > 0) {
       // Columns x .. x + 31 sample view pixels x + off .. x + off + 31 (+ 1 with a fraction).
@@ -276,10 +313,9 @@ LB_AVX2 void RectRowAvx2(const RectRow& r) {
         const __m256i f128 = _mm256_set1_epi16(static_cast<int16_t>(v.f * 128));
         const uint8_t *ref = r.ref + 3 * x, *img = r.img[j] + 3 * (x + v.off);
         const uint8_t *cref = r.cref + x, *cimg = r.cimg[j] + x + v.off;
+        // One step only: the general interpolation for every fraction.
         if (v.f == 0) {
           CostStep<kWhole>(ref, img, cref, cimg, w, f128, lut, trunc8, cost + x);
-        } else if (v.f == 128) {
-          CostStep<kHalf>(ref, img, cref, cimg, w, f128, lut, trunc8, cost + x);
         } else {
           CostStep<kFraction>(ref, img, cref, cimg, w, f128, lut, trunc8, cost + x);
         }

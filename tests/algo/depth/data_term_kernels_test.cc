@@ -53,7 +53,7 @@ TEST(DataTermKernels, CensusVariantsEqualTheReference) {
 TEST(DataTermKernels, CostVariantsEqualTheReference) {
   LB_SKIP_WITHOUT_VARIANTS();
   std::mt19937 rng(12);
-  const int32_t fracs[] = {0, 1, 2, 127, 128, 129, 254, 255};
+  const int32_t fracs[] = {0, 1, 2, 63, 64, 65, 127, 128, 129, 191, 192, 193, 254, 255};
   const int32_t truncs[] = {0, 1, 45, 254, 255, 256, 765};
   for (int32_t n : kWidths) {
     for (int32_t kind = 0; kind < 3; ++kind) {
@@ -138,7 +138,10 @@ TEST(DataTermKernels, RectRowVariantsEqualTheReference) {
         row.cimg[j] = cimg.back().data();
         // Shifts inside the row, partly or wholly outside it, whole pixels and fractions.
         const int32_t px = static_cast<int32_t>(rng() % (2 * w + 8)) - w - 4;
-        row.shift_q8[j] = px * 256 + (rng() % 3 == 0 ? 0 : static_cast<int32_t>(rng() % 256));
+        // Quarter-pixel labels' fractions (0, 64, 128, 192) half the time, any other else.
+        const int32_t f = rng() % 2 == 0 ? static_cast<int32_t>(rng() % 4) * 64
+                                         : static_cast<int32_t>(rng() % 256);
+        row.shift_q8[j] = px * 256 + f;
       }
       std::vector<uint8_t> pixel(w + 2 + 2 * dtk::kPixelSlack);
       std::vector<std::vector<uint16_t>> want(others, std::vector<uint16_t>(w, 0xbeef));
