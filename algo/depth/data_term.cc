@@ -232,18 +232,21 @@ void DataTerm::ComputeSpanBand(const Scratch& s, int32_t disp_q8, const int32_t*
   dtk::RectRow row;
   StartRows(disp_q8, &row);
   uint16_t* hsum[dtk::kMaxOthers];
-  auto window_rows = [&](int32_t r) {
-    int32_t a, b;
-    if (!hull(r, &a, &b)) return;
+  auto window_rows = [&](int32_t r, int32_t c0, int32_t c1) {
     for (int32_t j = 0; j < others; ++j) hsum[j] = ring(j, r);
-    WindowRows(s, r, a, b, &row, hsum);
+    WindowRows(s, r, c0, c1, &row, hsum);
   };
-  for (int32_t r = y0 - 1; r <= y0; ++r) window_rows(r);
+  int32_t a, b;
+  for (int32_t r = y0 - 1; r <= y0; ++r) {
+    if (hull(r, &a, &b)) window_rows(r, a, b);
+  }
+  // The hull of row y + 1, found one row earlier for its prefetch.
+  bool any = hull(y0 + 1, &a, &b);
   for (int32_t y = y0; y < y1; ++y) {
-    window_rows(y + 1);
+    if (any) window_rows(y + 1, a, b);
     // As ComputeBand: ask early for the views' next rows, which the prefetcher misses.
-    int32_t a, b;
-    if (hull(y + 2, &a, &b)) {
+    any = hull(y + 2, &a, &b);
+    if (any) {
       const int32_t next = Clamp(y + 2, 0, height_ - 1);
       const size_t bytes = static_cast<size_t>(3) * (b - a);
       for (int32_t j = 0; j < others; ++j) {

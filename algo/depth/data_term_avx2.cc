@@ -367,11 +367,11 @@ LB_AVX2 inline void SortNetwork(__m256i* v) {
 // 16 columns: view j's rows at view[j], view[j] + stride, view[j] + 2 * stride.
 template <int32_t kKeep, int32_t kB>
 LB_AVX2 inline __attribute__((always_inline)) void SelectStep(const uint16_t* const* view,
-                                                              ptrdiff_t stride, __m256i recip,
-                                                              uint16_t* out) {
+                                                              ptrdiff_t at, ptrdiff_t stride,
+                                                              __m256i recip, uint16_t* out) {
   __m256i a[kKeep], b[kB > 0 ? kB : 1];
-  for (int32_t j = 0; j < kKeep; ++j) a[j] = Window(view[j], stride);
-  for (int32_t j = 0; j < kB; ++j) b[j] = Window(view[kKeep + j], stride);
+  for (int32_t j = 0; j < kKeep; ++j) a[j] = Window(view[j] + at, stride);
+  for (int32_t j = 0; j < kB; ++j) b[j] = Window(view[kKeep + j] + at, stride);
   SortNetwork<kKeep>(a);
   SortNetwork<kB>(b);
   __m256i sum = a[0];
@@ -392,13 +392,18 @@ LB_AVX2 void SelectRowAvx2T(const uint16_t* ring, ptrdiff_t stride, int32_t x0, 
   const uint16_t* view[kViews];
   for (int32_t j = 0; j < kViews; ++j) view[j] = ring + 3 * j * stride + x0;
   int32_t x = x0;
-  for (; x + 16 <= x1; x += 16) {
-    SelectStep<kKeep, kB>(view, stride, recip, out + x);
-    for (int32_t j = 0; j < kViews; ++j) view[j] += 16;
+  for (; x + 32 <= x1; x += 32) {  // two steps a turn: the pointers move half as often
+    SelectStep<kKeep, kB>(view, 0, stride, recip, out + x);
+    SelectStep<kKeep, kB>(view, 16, stride, recip, out + x + 16);
+    for (int32_t j = 0; j < kViews; ++j) view[j] += 32;
+  }
+  if (x + 16 <= x1) {
+    SelectStep<kKeep, kB>(view, 0, stride, recip, out + x);
+    x += 16;
   }
   if (x < x1) {
     for (int32_t j = 0; j < kViews; ++j) view[j] = ring + 3 * j * stride + x1 - 16;
-    SelectStep<kKeep, kB>(view, stride, recip, out + x1 - 16);
+    SelectStep<kKeep, kB>(view, 0, stride, recip, out + x1 - 16);
   }
 }
 
