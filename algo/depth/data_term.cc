@@ -21,11 +21,11 @@ constexpr int32_t kLumaRows = 5;  // and 2 rows up and down
 // Four lines a step (up to three past the end: a prefetch never faults), so the loop's own
 // instructions cost less than the requests.
 inline void Prefetch(const uint8_t* p, size_t bytes) {
-  for (size_t i = 0; i < bytes; i += 256) {
-    __builtin_prefetch(p + i);
-    __builtin_prefetch(p + i + 64);
-    __builtin_prefetch(p + i + 128);
-    __builtin_prefetch(p + i + 192);
+  for (const uint8_t *q = p, *end = p + bytes; q < end; q += 256) {
+    __builtin_prefetch(q);
+    __builtin_prefetch(q + 64);
+    __builtin_prefetch(q + 128);
+    __builtin_prefetch(q + 192);
   }
 }
 
