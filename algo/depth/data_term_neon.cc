@@ -24,7 +24,10 @@ void CensusRowNeon(const uint8_t* const* rows, int32_t x0, int32_t x1, int32_t w
     const int8x16_t c = vreinterpretq_s8_u8(vld1q_u8(rows[2] + x));
     uint8x16_t plane = vdupq_n_u8(0);
     int32_t bit = 0;
+    // Unrolled whole, as the AVX2 kernel: the bit count and the plane stores are constants.
+#pragma GCC unroll 5
     for (int32_t dy = 0; dy < 5; ++dy) {
+#pragma GCC unroll 5
       for (int32_t dx = -2; dx <= 2; ++dx) {
         if (dy == 2 && dx == 0) continue;
         // Shift in one bit per neighbour: the compare mask is all ones where it is darker.
