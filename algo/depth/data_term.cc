@@ -217,7 +217,6 @@ void DataTerm::ComputeSpanBand(const Scratch& s, int32_t disp_q8, const int32_t*
   auto ring = [&](int32_t j, int32_t row) {
     return s.hsum + (static_cast<size_t>(j) * 3 + static_cast<size_t>((row - y0 + 1) % 3)) * w;
   };
-  auto view = [&](int32_t j) { return OtherView(j); };
   // The 3-sums of row r are read by rows r - 1 .. r + 1 of the band: the hull of their spans.
   auto hull = [&](int32_t r, int32_t* a, int32_t* b) {
     *a = w;
@@ -250,8 +249,8 @@ void DataTerm::ComputeSpanBand(const Scratch& s, int32_t disp_q8, const int32_t*
       const int32_t next = Clamp(y + 2, 0, height_ - 1);
       const size_t bytes = static_cast<size_t>(3) * (b - a);
       for (int32_t j = 0; j < others; ++j) {
-        Prefetch(images_[view(j)].Row(next) + 3 * a, bytes);
-        Prefetch(census_[view(j)] + static_cast<ptrdiff_t>(next) * 3 * w + a, bytes);
+        Prefetch(images_[OtherView(j)].Row(next) + 3 * a, bytes);
+        Prefetch(census_[OtherView(j)] + static_cast<ptrdiff_t>(next) * 3 * w + a, bytes);
       }
     }
     const int32_t x0 = spans[2 * y], x1 = spans[2 * y + 1];
