@@ -126,8 +126,6 @@ TEST(DataTermKernels, RectRowVariantsEqualTheReference) {
       row.cref = cref.data();
       row.others = others;
       row.width = w;
-      row.x0 = static_cast<int32_t>(rng() % w);
-      row.x1 = row.x0 + 1 + static_cast<int32_t>(rng() % (w - row.x0));
       row.trunc = kind == 2 ? 765 : static_cast<int32_t>(rng() % 100);
       row.cw = kind == 2 ? 10 : static_cast<int32_t>(rng() % 11);
       row.invalid = static_cast<int32_t>(rng() % 256);
@@ -144,16 +142,28 @@ TEST(DataTermKernels, RectRowVariantsEqualTheReference) {
         row.shift_q8[j] = px * 256 + f;
       }
       std::vector<uint8_t> pixel(w + 2 + 2 * dtk::kPixelSlack);
-      std::vector<std::vector<uint16_t>> want(others, std::vector<uint16_t>(w, 0xbeef));
-      for (int32_t j = 0; j < others; ++j) row.hsum[j] = want[j].data();
       row.pixel = pixel.data();
-      dtk::kReference.rect_row(row);
-      for (const dtk::Variant& v : Others()) {
-        std::vector<std::vector<uint16_t>> got(others, std::vector<uint16_t>(w, 0xbeef));
-        for (int32_t j = 0; j < others; ++j) row.hsum[j] = got[j].data();
-        v.kernels->rect_row(row);
-        ASSERT_EQ(got, want) << v.name << " w " << w << " kind " << kind << " x0 " << row.x0
-                             << " x1 " << row.x1;
+      // Columns: any, and a few at the row's start, middle and end (runs shorter than a
+      // vector step, which the SIMD kernels take at either end of their run).
+      const int32_t x0 = static_cast<int32_t>(rng() % w);
+      const int32_t narrow = w < 5 ? w : 5;
+      const int32_t windows[4][2] = {{x0, x0 + 1 + static_cast<int32_t>(rng() % (w - x0))},
+                                     {0, narrow},
+                                     {(w - narrow) / 2, (w - narrow) / 2 + narrow},
+                                     {w - narrow, w}};
+      for (const auto& cols : windows) {
+        row.x0 = cols[0];
+        row.x1 = cols[1];
+        std::vector<std::vector<uint16_t>> want(others, std::vector<uint16_t>(w, 0xbeef));
+        for (int32_t j = 0; j < others; ++j) row.hsum[j] = want[j].data();
+        dtk::kReference.rect_row(row);
+        for (const dtk::Variant& v : Others()) {
+          std::vector<std::vector<uint16_t>> got(others, std::vector<uint16_t>(w, 0xbeef));
+          for (int32_t j = 0; j < others; ++j) row.hsum[j] = got[j].data();
+          v.kernels->rect_row(row);
+          ASSERT_EQ(got, want) << v.name << " w " << w << " kind " << kind << " x0 " << row.x0
+                               << " x1 " << row.x1;
+        }
       }
     }
   }
