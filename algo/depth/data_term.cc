@@ -230,7 +230,7 @@ void DataTerm::ComputeSpanBand(const Scratch& s, int32_t disp_q8, const int32_t*
   };
   dtk::RectRow row;
   StartRows(disp_q8, &row);
-  uint16_t* hsum[dtk::kMaxOthers];
+  uint16_t* hsum[dtk::kMaxOthers] = {};
   auto window_rows = [&](int32_t r, int32_t c0, int32_t c1) {
     for (int32_t j = 0; j < others; ++j) hsum[j] = ring(j, r);
     WindowRows(s, r, c0, c1, &row, hsum);
@@ -269,7 +269,7 @@ void DataTerm::ComputeBand(const Scratch& s, int32_t disp_q8, int32_t x0, int32_
   };
   dtk::RectRow row;
   StartRows(disp_q8, &row);
-  uint16_t* hsum[dtk::kMaxOthers];
+  uint16_t* hsum[dtk::kMaxOthers] = {};
   auto window_rows = [&](int32_t r) {
     for (int32_t j = 0; j < others; ++j) hsum[j] = ring(j, r);
     WindowRows(s, r, x0, x1, &row, hsum);

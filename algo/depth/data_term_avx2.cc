@@ -373,7 +373,7 @@ template <int32_t kKeep, int32_t kB>
 LB_AVX2 inline __attribute__((always_inline)) void SelectStep(const uint16_t* const* view,
                                                               ptrdiff_t at, ptrdiff_t stride,
                                                               __m256i recip, uint16_t* out) {
-  __m256i a[kKeep], b[kB > 0 ? kB : 1];
+  __m256i a[kKeep], b[kB + (kB == 0 ? 1 : 0)];  // no empty array when kKeep is 1
   for (int32_t j = 0; j < kKeep; ++j) a[j] = Window(view[j] + at, stride);
   for (int32_t j = 0; j < kB; ++j) b[j] = Window(view[kKeep + j] + at, stride);
   SortNetwork<kKeep>(a);
