@@ -143,13 +143,13 @@ void DataTerm::StartRows(int32_t disp_q8, dtk::RectRow* row) const {
   }
 }
 
-void DataTerm::WindowRows(const Scratch& s, int32_t y, int32_t x0, int32_t x1, dtk::RectRow* row,
-                          uint16_t* const* hsum) const {
+void DataTerm::WindowRows(const Scratch& s, int32_t y, int32_t x0, int32_t x1,
+                          dtk::RectRow* row) const {
   const int32_t others = views_ - 1;
   if (planes_ != nullptr) {
     // Row by row, so the plane sweep prepares each reference row once for every view.
     PrepareRefLanes(s, y, x0, x1);
-    for (int32_t j = 0; j < others; ++j) WindowRow(s, OtherView(j), y, x0, x1, hsum[j]);
+    for (int32_t j = 0; j < others; ++j) WindowRow(s, OtherView(j), y, x0, x1, row->hsum[j]);
     return;
   }
   const int32_t r = Clamp(y, 0, height_ - 1), w = width_;
@@ -159,7 +159,6 @@ void DataTerm::WindowRows(const Scratch& s, int32_t y, int32_t x0, int32_t x1, d
   for (int32_t j = 0; j < others; ++j) {
     row->img[j] = images_[OtherView(j)].Row(r);
     row->cimg[j] = census_[OtherView(j)] + census_row;
-    row->hsum[j] = hsum[j];
   }
   row->x0 = x0;
   row->x1 = x1;
@@ -230,10 +229,9 @@ void DataTerm::ComputeSpanBand(const Scratch& s, int32_t disp_q8, const int32_t*
   };
   dtk::RectRow row;
   StartRows(disp_q8, &row);
-  uint16_t* hsum[dtk::kMaxOthers] = {};
   auto window_rows = [&](int32_t r, int32_t c0, int32_t c1) {
-    for (int32_t j = 0; j < others; ++j) hsum[j] = ring(j, r);
-    WindowRows(s, r, c0, c1, &row, hsum);
+    for (int32_t j = 0; j < others; ++j) row.hsum[j] = ring(j, r);
+    WindowRows(s, r, c0, c1, &row);
   };
   int32_t a, b;
   for (int32_t r = y0 - 1; r <= y0; ++r) {
@@ -269,10 +267,9 @@ void DataTerm::ComputeBand(const Scratch& s, int32_t disp_q8, int32_t x0, int32_
   };
   dtk::RectRow row;
   StartRows(disp_q8, &row);
-  uint16_t* hsum[dtk::kMaxOthers] = {};
   auto window_rows = [&](int32_t r) {
-    for (int32_t j = 0; j < others; ++j) hsum[j] = ring(j, r);
-    WindowRows(s, r, x0, x1, &row, hsum);
+    for (int32_t j = 0; j < others; ++j) row.hsum[j] = ring(j, r);
+    WindowRows(s, r, x0, x1, &row);
   };
   for (int32_t r = y0 - 1; r <= y0; ++r) window_rows(r);
   const size_t row_bytes = static_cast<size_t>(3) * (x1 - x0);

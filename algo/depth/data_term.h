@@ -107,12 +107,11 @@ class DataTerm {
   // The plane sweep's 3-sums of one view's row y, columns x0..x1-1.
   void WindowRow(const Scratch& s, int32_t view, int32_t y, int32_t x0, int32_t x1,
                  uint16_t* hsum) const;
-  // Every other view's 3-sums of row y (clamped to the image), columns x0..x1-1, into hsum[j]
-  // (other view j): the plane sweep view by view, the rectified shifts by one kernel call
-  // (Kernels::rect_row) with `row` set up by StartRows for the label.
+  // Every other view's 3-sums of row y (clamped to the image), columns x0..x1-1, into
+  // row->hsum[j] (other view j): the plane sweep view by view, the rectified shifts by one kernel
+  // call (Kernels::rect_row) with `row` set up by StartRows for the label.
   void StartRows(int32_t disp_q8, dtk::RectRow* row) const;
-  void WindowRows(const Scratch& s, int32_t y, int32_t x0, int32_t x1, dtk::RectRow* row,
-                  uint16_t* const* hsum) const;
+  void WindowRows(const Scratch& s, int32_t y, int32_t x0, int32_t x1, dtk::RectRow* row) const;
   // The view index of other view j (every view but the reference, in order).
   int32_t OtherView(int32_t j) const { return j < reference_ ? j : j + 1; }
   void CensusOfView(const Scratch& s, int32_t view);
