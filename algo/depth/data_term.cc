@@ -18,8 +18,15 @@ namespace {
 constexpr int32_t kLumaPad = 2;   // the census reaches 2 pixels left and right
 constexpr int32_t kLumaRows = 5;  // and 2 rows up and down
 
+// Four lines a step (up to three past the end: a prefetch never faults), so the loop's own
+// instructions cost less than the requests.
 inline void Prefetch(const uint8_t* p, size_t bytes) {
-  for (size_t i = 0; i < bytes; i += 64) __builtin_prefetch(p + i);
+  for (const uint8_t *q = p, *end = p + bytes; q < end; q += 256) {
+    __builtin_prefetch(q);
+    __builtin_prefetch(q + 64);
+    __builtin_prefetch(q + 128);
+    __builtin_prefetch(q + 192);
+  }
 }
 
 // BT.601 luma, Q8 weights summing to 256, rounded; stored +/-128 (xor 0x80) so signed byte
@@ -53,7 +60,7 @@ void DataTerm::Carve(Arena& arena, int32_t width, int32_t height, int32_t views,
   for (int32_t i = 0; i < workers_; ++i) {
     Scratch& s = scratch_[i];
     s.luma = arena.Allocate<uint8_t>(static_cast<size_t>(width + 2 * kLumaPad) * kLumaRows);
-    s.pixel = arena.Allocate<uint8_t>(static_cast<size_t>(width) + 2);
+    s.pixel = arena.Allocate<uint8_t>(static_cast<size_t>(width) + 2 + 2 * dtk::kPixelSlack);
     s.hsum = arena.Allocate<uint16_t>(static_cast<size_t>(width) * 3 * (views - 1));
     s.ref_lanes = arena.Allocate<int32_t>(static_cast<size_t>(width) * 4);
   }
@@ -93,41 +100,22 @@ void DataTerm::CensusOfView(const Scratch& s, int32_t v) {
   }
 }
 
-void DataTerm::PixelCostRow(int32_t view, int32_t y, int32_t disp_q8, int32_t x0, int32_t x1,
-                            uint8_t* out, const int32_t* ref_lanes) const {
-  const int32_t w = width_;
-  if (planes_ != nullptr) {
-    const WarpSource src{images_[reference_], images_[view], census_[reference_],
-                         census_[view],       ref_lanes,     w};
-    PlaneCostRow(planes_[view], src, y, params_, invalid_cost_, x0, x1, out, kernels_->plane);
-    return;
-  }
-  // Sample position in the view: x * 256 + shift_q8, the same fraction for every pixel.
-  const int32_t shift_q8 = -(view - reference_) * disp_q8;
-  const int32_t off = shift_q8 >> 8;  // floor
-  const int32_t f = shift_q8 & 255;   // Q8 weight of the right-hand sample
-  const int32_t x_lo = Clamp(-off, x0, x1);
-  const int32_t x_hi = Clamp(w - (f > 0 ? 1 : 0) - off, x_lo, x1);
-  const uint8_t invalid = static_cast<uint8_t>(invalid_cost_);
-  for (int32_t x = x0; x < x_lo; ++x) out[x] = invalid;
-  for (int32_t x = x_hi; x < x1; ++x) out[x] = invalid;
-  if (x_hi <= x_lo) return;
-  const ptrdiff_t row = static_cast<ptrdiff_t>(y) * 3 * w;
-  kernels_->cost(images_[reference_].Row(y) + 3 * x_lo, images_[view].Row(y) + 3 * (x_lo + off),
-                 census_[reference_] + row + x_lo, census_[view] + row + x_lo + off, w, x_hi - x_lo,
-                 f, params_.color_trunc, params_.census_weight, out + x_lo);
+void DataTerm::PixelCostRow(int32_t view, int32_t y, int32_t x0, int32_t x1, uint8_t* out,
+                            const int32_t* ref_lanes) const {
+  const WarpSource src{images_[reference_], images_[view], census_[reference_],
+                       census_[view],       ref_lanes,     width_};
+  PlaneCostRow(planes_[view], src, y, params_, invalid_cost_, x0, x1, out, kernels_->plane);
 }
 
 // Horizontal 3-sum of the pixel costs of row y (borders replicated) for columns x0..x1-1:
 // 0..765.
-void DataTerm::WindowRow(const Scratch& s, int32_t view, int32_t y, int32_t disp_q8, int32_t x0,
-                         int32_t x1, uint16_t* hsum) const {
+void DataTerm::WindowRow(const Scratch& s, int32_t view, int32_t y, int32_t x0, int32_t x1,
+                         uint16_t* hsum) const {
   const int32_t w = width_;
   uint8_t* cost = s.pixel + 1;
   const int32_t c0 = x0 > 0 ? x0 - 1 : 0, c1 = x1 < w ? x1 + 1 : w;
-  const bool lanes = planes_ != nullptr && kernels_->plane_lanes != nullptr;
-  PixelCostRow(view, Clamp(y, 0, height_ - 1), disp_q8, c0, c1, cost,
-               lanes ? s.ref_lanes : nullptr);
+  const bool lanes = kernels_->plane_lanes != nullptr;
+  PixelCostRow(view, Clamp(y, 0, height_ - 1), c0, c1, cost, lanes ? s.ref_lanes : nullptr);
   if (x0 == 0) cost[-1] = cost[0];
   if (x1 == w) cost[w] = cost[w - 1];
   kernels_->hsum(cost, x0, x1, hsum);
@@ -141,6 +129,41 @@ void DataTerm::PrepareRefLanes(const Scratch& s, int32_t y, int32_t x0, int32_t 
   kernels_->plane_lanes(images_[reference_].Row(row),
                         census_[reference_] + static_cast<ptrdiff_t>(row) * 3 * w, w, a,
                         RefLanesEnd(w, c1), s.ref_lanes + a, w);
+}
+
+void DataTerm::StartRows(int32_t disp_q8, dtk::RectRow* row) const {
+  row->others = views_ - 1;
+  row->width = width_;
+  row->trunc = params_.color_trunc;
+  row->cw = params_.census_weight;
+  row->invalid = invalid_cost_;
+  // Sample position in view v: x * 256 + shift_q8, the same fraction for every pixel.
+  for (int32_t j = 0; j < row->others; ++j) {
+    row->shift_q8[j] = -(OtherView(j) - reference_) * disp_q8;
+  }
+}
+
+void DataTerm::WindowRows(const Scratch& s, int32_t y, int32_t x0, int32_t x1,
+                          dtk::RectRow* row) const {
+  const int32_t others = views_ - 1;
+  if (planes_ != nullptr) {
+    // Row by row, so the plane sweep prepares each reference row once for every view.
+    PrepareRefLanes(s, y, x0, x1);
+    for (int32_t j = 0; j < others; ++j) WindowRow(s, OtherView(j), y, x0, x1, row->hsum[j]);
+    return;
+  }
+  const int32_t r = Clamp(y, 0, height_ - 1), w = width_;
+  const ptrdiff_t census_row = static_cast<ptrdiff_t>(r) * 3 * w;
+  row->ref = images_[reference_].Row(r);
+  row->cref = census_[reference_] + census_row;
+  for (int32_t j = 0; j < others; ++j) {
+    row->img[j] = images_[OtherView(j)].Row(r);
+    row->cimg[j] = census_[OtherView(j)] + census_row;
+  }
+  row->x0 = x0;
+  row->x1 = x1;
+  row->pixel = s.pixel;
+  kernels_->rect_row(*row);
 }
 
 int32_t DataTerm::Bands(int32_t rows, int64_t pixels) const {
@@ -193,7 +216,6 @@ void DataTerm::ComputeSpanBand(const Scratch& s, int32_t disp_q8, const int32_t*
   auto ring = [&](int32_t j, int32_t row) {
     return s.hsum + (static_cast<size_t>(j) * 3 + static_cast<size_t>((row - y0 + 1) % 3)) * w;
   };
-  auto view = [&](int32_t j) { return j < reference_ ? j : j + 1; };
   // The 3-sums of row r are read by rows r - 1 .. r + 1 of the band: the hull of their spans.
   auto hull = [&](int32_t r, int32_t* a, int32_t* b) {
     *a = w;
@@ -205,32 +227,34 @@ void DataTerm::ComputeSpanBand(const Scratch& s, int32_t disp_q8, const int32_t*
     }
     return *a < *b;
   };
-  auto window_rows = [&](int32_t r) {
-    int32_t a, b;
-    if (!hull(r, &a, &b)) return;
-    PrepareRefLanes(s, r, a, b);
-    for (int32_t j = 0; j < others; ++j) WindowRow(s, view(j), r, disp_q8, a, b, ring(j, r));
+  dtk::RectRow row;
+  StartRows(disp_q8, &row);
+  auto window_rows = [&](int32_t r, int32_t c0, int32_t c1) {
+    for (int32_t j = 0; j < others; ++j) row.hsum[j] = ring(j, r);
+    WindowRows(s, r, c0, c1, &row);
   };
-  for (int32_t r = y0 - 1; r <= y0; ++r) window_rows(r);
-  const uint16_t* rows[3 * 15];
+  int32_t a, b;
+  for (int32_t r = y0 - 1; r <= y0; ++r) {
+    if (hull(r, &a, &b)) window_rows(r, a, b);
+  }
+  // The hull of row y + 1, found one row earlier for its prefetch.
+  bool any = hull(y0 + 1, &a, &b);
   for (int32_t y = y0; y < y1; ++y) {
-    window_rows(y + 1);
+    if (any) window_rows(y + 1, a, b);
     // As ComputeBand: ask early for the views' next rows, which the prefetcher misses.
-    int32_t a, b;
-    if (hull(y + 2, &a, &b)) {
+    any = hull(y + 2, &a, &b);
+    if (any) {
       const int32_t next = Clamp(y + 2, 0, height_ - 1);
       const size_t bytes = static_cast<size_t>(3) * (b - a);
       for (int32_t j = 0; j < others; ++j) {
-        Prefetch(images_[view(j)].Row(next) + 3 * a, bytes);
-        Prefetch(census_[view(j)] + static_cast<ptrdiff_t>(next) * 3 * w + a, bytes);
+        Prefetch(images_[OtherView(j)].Row(next) + 3 * a, bytes);
+        Prefetch(census_[OtherView(j)] + static_cast<ptrdiff_t>(next) * 3 * w + a, bytes);
       }
     }
     const int32_t x0 = spans[2 * y], x1 = spans[2 * y + 1];
     if (x0 >= x1) continue;
-    for (int32_t j = 0; j < others; ++j) {
-      for (int32_t k = 0; k < 3; ++k) rows[3 * j + k] = ring(j, y - 1 + k);
-    }
-    kernels_->select(rows, others, x0, x1, out + (y - y0) * stride);
+    // The ring's three rows of each view are y - 1 .. y + 1.
+    kernels_->select(s.hsum, w, others, x0, x1, out + (y - y0) * stride);
   }
 }
 
@@ -241,26 +265,25 @@ void DataTerm::ComputeBand(const Scratch& s, int32_t disp_q8, int32_t x0, int32_
   auto ring = [&](int32_t j, int32_t row) {
     return s.hsum + (static_cast<size_t>(j) * 3 + static_cast<size_t>((row - y0 + 1) % 3)) * w;
   };
-  auto view = [&](int32_t j) { return j < reference_ ? j : j + 1; };
-  // Row by row, so the plane sweep prepares each reference row once for every view.
-  for (int32_t r = y0 - 1; r <= y0; ++r) {
-    PrepareRefLanes(s, r, x0, x1);
-    for (int32_t j = 0; j < others; ++j) WindowRow(s, view(j), r, disp_q8, x0, x1, ring(j, r));
-  }
-  const uint16_t* rows[3 * 15];
+  dtk::RectRow row;
+  StartRows(disp_q8, &row);
+  auto window_rows = [&](int32_t r) {
+    for (int32_t j = 0; j < others; ++j) row.hsum[j] = ring(j, r);
+    WindowRows(s, r, x0, x1, &row);
+  };
+  for (int32_t r = y0 - 1; r <= y0; ++r) window_rows(r);
   const size_t row_bytes = static_cast<size_t>(3) * (x1 - x0);
   for (int32_t y = y0; y < y1; ++y) {
-    PrepareRefLanes(s, y + 1, x0, x1);
+    window_rows(y + 1);
     for (int32_t j = 0; j < others; ++j) {
-      WindowRow(s, view(j), y + 1, disp_q8, x0, x1, ring(j, y + 1));
       // The views' next rows are far apart (a whole view each), so the hardware prefetcher
       // misses their starts; asking early hides the cache misses behind the other views.
       const int32_t next = Clamp(y + 2, 0, height_ - 1);
-      Prefetch(images_[view(j)].Row(next) + 3 * x0, row_bytes);
-      Prefetch(census_[view(j)] + static_cast<ptrdiff_t>(next) * 3 * w + x0, row_bytes);
-      for (int32_t k = 0; k < 3; ++k) rows[3 * j + k] = ring(j, y - 1 + k);
+      Prefetch(images_[OtherView(j)].Row(next) + 3 * x0, row_bytes);
+      Prefetch(census_[OtherView(j)] + static_cast<ptrdiff_t>(next) * 3 * w + x0, row_bytes);
     }
-    kernels_->select(rows, others, x0, x1, out + (y - y0) * stride);
+    // The ring's three rows of each view are y - 1 .. y + 1.
+    kernels_->select(s.hsum, w, others, x0, x1, out + (y - y0) * stride);
   }
 }
 

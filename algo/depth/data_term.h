@@ -31,6 +31,9 @@
 #include "algo/motion/plane_homography.h"
 
 namespace lb {
+namespace dtk {
+struct RectRow;
+}  // namespace dtk
 
 struct DataTermParams {
   int32_t color_trunc = 45;   // truncation of the summed |dR|+|dG|+|dB|, 0..765
@@ -94,15 +97,23 @@ class DataTerm {
     uint16_t* hsum = nullptr;      // per other view, 3 rows of horizontal 3-sums
     int32_t* ref_lanes = nullptr;  // plane sweep: the reference row as the kernel's lanes
   };
-  // Pixel costs of columns x0..x1-1 of row y (out indexed by x).
-  // ref_lanes: the plane sweep's prepared reference row (PrepareRefLanes), or nullptr.
-  void PixelCostRow(int32_t view, int32_t y, int32_t disp_q8, int32_t x0, int32_t x1, uint8_t* out,
-                    const int32_t* ref_lanes = nullptr) const;
+  // The plane sweep's pixel costs of columns x0..x1-1 of row y (out indexed by x).
+  // ref_lanes: the prepared reference row (PrepareRefLanes), or nullptr.
+  void PixelCostRow(int32_t view, int32_t y, int32_t x0, int32_t x1, uint8_t* out,
+                    const int32_t* ref_lanes) const;
   // The plane sweep: reference row y's lanes (warp_cost.h: RefLanes) into s.ref_lanes for the
   // columns every view's WindowRow(y, x0, x1) reads, when the kernel wants them.
   void PrepareRefLanes(const Scratch& s, int32_t y, int32_t x0, int32_t x1) const;
-  void WindowRow(const Scratch& s, int32_t view, int32_t y, int32_t disp_q8, int32_t x0, int32_t x1,
+  // The plane sweep's 3-sums of one view's row y, columns x0..x1-1.
+  void WindowRow(const Scratch& s, int32_t view, int32_t y, int32_t x0, int32_t x1,
                  uint16_t* hsum) const;
+  // Every other view's 3-sums of row y (clamped to the image), columns x0..x1-1, into
+  // row->hsum[j] (other view j): the plane sweep view by view, the rectified shifts by one kernel
+  // call (Kernels::rect_row) with `row` set up by StartRows for the label.
+  void StartRows(int32_t disp_q8, dtk::RectRow* row) const;
+  void WindowRows(const Scratch& s, int32_t y, int32_t x0, int32_t x1, dtk::RectRow* row) const;
+  // The view index of other view j (every view but the reference, in order).
+  int32_t OtherView(int32_t j) const { return j < reference_ ? j : j + 1; }
   void CensusOfView(const Scratch& s, int32_t view);
   void ComputeBand(const Scratch& s, int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0,
                    int32_t y1, uint16_t* out, ptrdiff_t stride) const;

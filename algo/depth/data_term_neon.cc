@@ -24,7 +24,10 @@ void CensusRowNeon(const uint8_t* const* rows, int32_t x0, int32_t x1, int32_t w
     const int8x16_t c = vreinterpretq_s8_u8(vld1q_u8(rows[2] + x));
     uint8x16_t plane = vdupq_n_u8(0);
     int32_t bit = 0;
+    // Unrolled whole, as the AVX2 kernel: the bit count and the plane stores are constants.
+#pragma GCC unroll 5
     for (int32_t dy = 0; dy < 5; ++dy) {
+#pragma GCC unroll 5
       for (int32_t dx = -2; dx <= 2; ++dx) {
         if (dy == 2 && dx == 0) continue;
         // Shift in one bit per neighbour: the compare mask is all ones where it is darker.
@@ -57,12 +60,25 @@ inline uint8x16_t Lerp(uint8x16_t a, uint8x16_t b, uint8x8_t g, uint8x8_t f) {
                      vrshrn_n_u16(Mix(vget_high_u8(a), vget_high_u8(b), g, f), 8));
 }
 
+// The sample's fraction, as in the AVX2 kernel: none (f = 0), any, a half (f = 128), a quarter or
+// three quarters (f = 64, 192), the last three by byte averages: (a + b + 1) >> 1 is vrhadd, and
+// (3 a + b + 2) >> 2 = vrhadd(a, vhadd(a, b)) (data_term_avx2.cc: QuarterLerp).
+constexpr int32_t kWhole = 0, kFraction = 1, kHalf = 2, kQuarter = 3, kThreeQuarters = 4;
+
+template <int32_t kFrac>
+inline uint8x16_t MixBytes(uint8x16_t a, uint8x16_t b, uint8x8_t g, uint8x8_t f) {
+  if constexpr (kFrac == kHalf) return vrhaddq_u8(a, b);
+  if constexpr (kFrac == kQuarter) return vrhaddq_u8(a, vhaddq_u8(a, b));
+  if constexpr (kFrac == kThreeQuarters) return vrhaddq_u8(b, vhaddq_u8(a, b));
+  return Lerp(a, b, g, f);
+}
+
 // vld3 de-interleaves the colours; channel sums saturate at 255 as in the AVX2 kernel.
-template <bool kFrac>
+template <int32_t kFrac>
 void CostRowNeonT(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, const uint8_t* cimg,
                   ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc, int32_t cw, uint8_t* out) {
   if (n < 16) return CostRowC(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
-  const uint8x8_t g8 = vdup_n_u8(static_cast<uint8_t>(kFrac ? 256 - f : 0));
+  const uint8x8_t g8 = vdup_n_u8(static_cast<uint8_t>(kFrac != kWhole ? 256 - f : 0));
   const uint8x8_t f8 = vdup_n_u8(static_cast<uint8_t>(f));
   const uint16_t cw16 = static_cast<uint16_t>(cw);
   const uint8x16_t trunc8 = vdupq_n_u8(static_cast<uint8_t>(trunc < 255 ? trunc : 255));
@@ -72,7 +88,7 @@ void CostRowNeonT(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, c
     const uint8x16x3_t a = vld3q_u8(img + 3 * x);
     const uint8x16_t h0 = Hamming(cref + x, cimg + x, plane);
     uint8x16_t sum = vdupq_n_u8(0), ham;
-    if (kFrac) {
+    if constexpr (kFrac == kFraction) {
       const uint8x16x3_t b = vld3q_u8(img + 3 * x + 3);
       for (int32_t c = 0; c < 3; ++c) {
         sum = vqaddq_u8(sum, vabdq_u8(r.val[c], Lerp(a.val[c], b.val[c], g8, f8)));
@@ -82,6 +98,15 @@ void CostRowNeonT(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, c
       const uint16x8_t lo = vmulq_n_u16(Mix(vget_low_u8(h0), vget_low_u8(h1), g8, f8), cw16);
       const uint16x8_t hi = vmulq_n_u16(Mix(vget_high_u8(h0), vget_high_u8(h1), g8, f8), cw16);
       ham = vcombine_u8(vrshrn_n_u16(lo, 8), vrshrn_n_u16(hi, 8));
+    } else if constexpr (kFrac != kWhole) {
+      const uint8x16x3_t b = vld3q_u8(img + 3 * x + 3);
+      for (int32_t c = 0; c < 3; ++c) {
+        sum = vqaddq_u8(sum, vabdq_u8(r.val[c], MixBytes<kFrac>(a.val[c], b.val[c], g8, f8)));
+      }
+      // (cw h0) g + (cw h1) f = (h0 g + h1 f) cw, and cw * h <= 240 fits a byte.
+      const uint8x16_t cw8 = vdupq_n_u8(static_cast<uint8_t>(cw));
+      const uint8x16_t h1 = Hamming(cref + x, cimg + x + 1, plane);
+      ham = MixBytes<kFrac>(vmulq_u8(h0, cw8), vmulq_u8(h1, cw8), g8, f8);
     } else {
       for (int32_t c = 0; c < 3; ++c) sum = vqaddq_u8(sum, vabdq_u8(r.val[c], a.val[c]));
       ham = vmulq_u8(h0, vdupq_n_u8(static_cast<uint8_t>(cw)));  // <= 240
@@ -92,10 +117,17 @@ void CostRowNeonT(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, c
 
 void CostRowNeon(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, const uint8_t* cimg,
                  ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc, int32_t cw, uint8_t* out) {
-  if (f == 0) {
-    CostRowNeonT<false>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
-  } else {
-    CostRowNeonT<true>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+  switch (f) {
+    case 0:
+      return CostRowNeonT<kWhole>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+    case 128:
+      return CostRowNeonT<kHalf>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+    case 64:
+      return CostRowNeonT<kQuarter>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+    case 192:
+      return CostRowNeonT<kThreeQuarters>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
+    default:
+      return CostRowNeonT<kFraction>(ref, img, cref, cimg, plane, n, f, trunc, cw, out);
   }
 }
 
@@ -109,43 +141,59 @@ void HSumRowNeon(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum) {
   }
 }
 
-inline int16x8_t Window(const uint16_t* const* rows, int32_t j, int32_t x) {
-  return vreinterpretq_s16_u16(
-      vaddq_u16(vaddq_u16(vld1q_u16(rows[3 * j] + x), vld1q_u16(rows[3 * j + 1] + x)),
-                vld1q_u16(rows[3 * j + 2] + x)));
+inline int16x8_t Window(const uint16_t* ring, ptrdiff_t stride, int32_t j, int32_t x) {
+  const uint16_t* view = ring + 3 * j * stride + x;
+  return vreinterpretq_s16_u16(vaddq_u16(vaddq_u16(vld1q_u16(view), vld1q_u16(view + stride)),
+                                         vld1q_u16(view + 2 * stride)));
 }
 
-// As the AVX2 kernel; vqrdmulh is (2 * sum * recip + 2^15) >> 16 = (sum * recip + 2^14) >> 15.
-template <int32_t kKeep>
-void SelectRowNeonT(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
-                    uint16_t* out) {
-  if (x1 - x0 < 8) return SelectRowC(rows, others, x0, x1, out);
+inline void Exchange(int16x8_t* v, int32_t i, int32_t j) {
+  const int16x8_t lo = vminq_s16(v[i], v[j]);
+  v[j] = vmaxq_s16(v[i], v[j]);
+  v[i] = lo;
+}
+
+// Ascending sort of kN vectors lane by lane: the optimal 5 exchanges for 4, else insertion.
+template <int32_t kN>
+inline void SortNetwork(int16x8_t* v) {
+  if constexpr (kN == 4) {
+    Exchange(v, 0, 1);
+    Exchange(v, 2, 3);
+    Exchange(v, 0, 2);
+    Exchange(v, 1, 3);
+    Exchange(v, 1, 2);
+  } else {
+    for (int32_t i = 1; i < kN; ++i)
+      for (int32_t j = i; j > 0; --j) Exchange(v, j - 1, j);
+  }
+}
+
+// As the AVX2 kernel: the first kKeep windows and the other kB sorted apart, the kept sum that
+// of min(A_i, B_(kKeep-1-i)); vqrdmulh is (2 * sum * recip + 2^15) >> 16 =
+// (sum * recip + 2^14) >> 15.
+template <int32_t kKeep, int32_t kB>
+void SelectRowNeonT(const uint16_t* ring, ptrdiff_t stride, int32_t x0, int32_t x1, uint16_t* out) {
   const int16x8_t recip = vdupq_n_s16(static_cast<int16_t>(kKeep == 1 ? 0 : RecipQ15(kKeep)));
   for (int32_t step = x0; step < x1; step += 8) {
     const int32_t x = step + 8 <= x1 ? step : x1 - 8;
-    int16x8_t best[kKeep];
-    for (int32_t j = 0; j < kKeep; ++j) {
-      int16x8_t a = Window(rows, j, x);
-      for (int32_t i = 0; i < j; ++i) {
-        const int16x8_t lo = vminq_s16(best[i], a);
-        a = vmaxq_s16(best[i], a);
-        best[i] = lo;
-      }
-      best[j] = a;
-    }
-    for (int32_t j = kKeep; j < others; ++j) {
-      int16x8_t a = Window(rows, j, x);
-      for (int32_t i = 0; i < kKeep - 1; ++i) {
-        const int16x8_t lo = vminq_s16(best[i], a);
-        a = vmaxq_s16(best[i], a);
-        best[i] = lo;
-      }
-      best[kKeep - 1] = vminq_s16(best[kKeep - 1], a);
-    }
-    int16x8_t sum = best[0];
-    for (int32_t i = 1; i < kKeep; ++i) sum = vaddq_s16(sum, best[i]);
+    int16x8_t a[kKeep], b[kB + (kB == 0 ? 1 : 0)];  // no empty array when kKeep is 1
+    for (int32_t j = 0; j < kKeep; ++j) a[j] = Window(ring, stride, j, x);
+    for (int32_t j = 0; j < kB; ++j) b[j] = Window(ring, stride, kKeep + j, x);
+    SortNetwork<kKeep>(a);
+    SortNetwork<kB>(b);
+    int16x8_t sum = a[0];
+    if constexpr (kB == kKeep) sum = vminq_s16(a[0], b[kKeep - 1]);
+    for (int32_t i = 1; i < kKeep; ++i) sum = vaddq_s16(sum, vminq_s16(a[i], b[kKeep - 1 - i]));
     vst1q_u16(out + x, vreinterpretq_u16_s16(kKeep == 1 ? sum : vqrdmulhq_s16(sum, recip)));
   }
+}
+
+template <int32_t kKeep>
+void SelectRowNeonT(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t x0, int32_t x1,
+                    uint16_t* out) {
+  if (x1 - x0 < 8) return SelectRowC(ring, stride, others, x0, x1, out);
+  if (others == 2 * kKeep) return SelectRowNeonT<kKeep, kKeep>(ring, stride, x0, x1, out);
+  SelectRowNeonT<kKeep, kKeep - 1>(ring, stride, x0, x1, out);
 }
 
 // The instance for each kept count (others + 1) / 2 = 1 .. kMaxBest.
@@ -156,8 +204,13 @@ constexpr SelectRowFn kNeonByKeep[kMaxBest] = {
 }  // namespace
 
 const DataTerm::Kernels* NeonKernels() {
-  static constexpr DataTerm::Kernels kNeon = {
-      CensusRowNeon, CostRowNeon, HSumRowNeon, SelectByKeep<kNeonByKeep>, PlaneSpansNeon, nullptr};
+  static constexpr DataTerm::Kernels kNeon = {CensusRowNeon,
+                                              CostRowNeon,
+                                              HSumRowNeon,
+                                              SelectByKeep<kNeonByKeep>,
+                                              RectRowWith<CostRowNeon, HSumRowNeon>,
+                                              PlaneSpansNeon,
+                                              nullptr};
   return &kNeon;
 }
 

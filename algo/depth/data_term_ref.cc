@@ -126,7 +126,7 @@ void HSumRowC(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum) {
 // Per pixel: window sums (3 ring rows per other view, <= 2295), the mean of the smallest
 // (others + 1) / 2 of them. The kept sum is <= 8 * 2295, so 32-bit products are exact.
 // Chunks of 16 pixels so that the sorted-list insertion (a min/max chain) vectorises.
-void SelectRowC(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t x1,
+void SelectRowC(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t x0, int32_t x1,
                 uint16_t* out) {
   constexpr int32_t kChunk = 16;
   const int32_t keep = (others + 1) / 2;
@@ -138,7 +138,8 @@ void SelectRowC(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t
       for (int32_t l = 0; l < kChunk; ++l) best[i][l] = UINT16_MAX;
     for (int32_t j = 0; j < others; ++j) {
       uint16_t a[kChunk] = {};
-      const uint16_t *r0 = rows[3 * j] + xs, *r1 = rows[3 * j + 1] + xs, *r2 = rows[3 * j + 2] + xs;
+      const uint16_t* r0 = ring + 3 * j * stride + xs;
+      const uint16_t *r1 = r0 + stride, *r2 = r0 + 2 * stride;
       for (int32_t l = 0; l < n; ++l) a[l] = static_cast<uint16_t>(r0[l] + r1[l] + r2[l]);
       for (int32_t i = 0; i < keep; ++i) {
         for (int32_t l = 0; l < kChunk; ++l) {
@@ -156,13 +157,15 @@ void SelectRowC(const uint16_t* const* rows, int32_t others, int32_t x0, int32_t
   }
 }
 
-const DataTerm::Kernels kReference = {CensusRowC, CostRowC,    HSumRowC,
-                                      SelectRowC, PlaneSpansC, nullptr};
+const DataTerm::Kernels kReference = {
+    CensusRowC,  CostRowC, HSumRowC, SelectRowC, RectRowWith<CostRowC, HSumRowC>,
+    PlaneSpansC, nullptr};
 
 const DataTerm::Kernels* Ssse3Kernels() {
 #if defined(__x86_64__)
-  static constexpr DataTerm::Kernels kSsse3 = {CensusRowC, CostRowCSsse3, HSumRowC,
-                                               SelectRowC, PlaneSpansC,   nullptr};
+  static constexpr DataTerm::Kernels kSsse3 = {
+      CensusRowC,  CostRowCSsse3, HSumRowC, SelectRowC, RectRowWith<CostRowCSsse3, HSumRowC>,
+      PlaneSpansC, nullptr};
   return __builtin_cpu_supports("ssse3") ? &kSsse3 : nullptr;
 #else
   return nullptr;

@@ -53,7 +53,7 @@ TEST(DataTermKernels, CensusVariantsEqualTheReference) {
 TEST(DataTermKernels, CostVariantsEqualTheReference) {
   LB_SKIP_WITHOUT_VARIANTS();
   std::mt19937 rng(12);
-  const int32_t fracs[] = {0, 1, 2, 127, 128, 129, 254, 255};
+  const int32_t fracs[] = {0, 1, 2, 63, 64, 65, 127, 128, 129, 191, 192, 193, 254, 255};
   const int32_t truncs[] = {0, 1, 45, 254, 255, 256, 765};
   for (int32_t n : kWidths) {
     for (int32_t kind = 0; kind < 3; ++kind) {
@@ -112,6 +112,63 @@ TEST(DataTermKernels, HSumVariantsEqualTheReference) {
   }
 }
 
+TEST(DataTermKernels, RectRowVariantsEqualTheReference) {
+  LB_SKIP_WITHOUT_VARIANTS();
+  std::mt19937 rng(15);
+  for (int32_t w : kWidths) {
+    for (int32_t kind = 0; kind < 3; ++kind) {
+      const int32_t others = 1 + static_cast<int32_t>(rng() % dtk::kMaxOthers);
+      const std::vector<uint8_t> ref = Bytes(rng, 3 * w, kind);
+      const std::vector<uint8_t> cref = Bytes(rng, 3 * w, kind == 2 ? 2 : 0);
+      std::vector<std::vector<uint8_t>> img, cimg;
+      dtk::RectRow row;
+      row.ref = ref.data();
+      row.cref = cref.data();
+      row.others = others;
+      row.width = w;
+      row.trunc = kind == 2 ? 765 : static_cast<int32_t>(rng() % 100);
+      row.cw = kind == 2 ? 10 : static_cast<int32_t>(rng() % 11);
+      row.invalid = static_cast<int32_t>(rng() % 256);
+      for (int32_t j = 0; j < others; ++j) {
+        img.push_back(Bytes(rng, 3 * w, kind));
+        cimg.push_back(Bytes(rng, 3 * w, kind == 2 ? 2 : 0));
+        row.img[j] = img.back().data();
+        row.cimg[j] = cimg.back().data();
+        // Shifts inside the row, partly or wholly outside it, whole pixels and fractions.
+        const int32_t px = static_cast<int32_t>(rng() % (2 * w + 8)) - w - 4;
+        // Quarter-pixel labels' fractions (0, 64, 128, 192) half the time, any other else.
+        const int32_t f = rng() % 2 == 0 ? static_cast<int32_t>(rng() % 4) * 64
+                                         : static_cast<int32_t>(rng() % 256);
+        row.shift_q8[j] = px * 256 + f;
+      }
+      std::vector<uint8_t> pixel(w + 2 + 2 * dtk::kPixelSlack);
+      row.pixel = pixel.data();
+      // Columns: any, and a few at the row's start, middle and end (runs shorter than a
+      // vector step, which the SIMD kernels take at either end of their run).
+      const int32_t x0 = static_cast<int32_t>(rng() % w);
+      const int32_t narrow = w < 5 ? w : 5;
+      const int32_t windows[4][2] = {{x0, x0 + 1 + static_cast<int32_t>(rng() % (w - x0))},
+                                     {0, narrow},
+                                     {(w - narrow) / 2, (w - narrow) / 2 + narrow},
+                                     {w - narrow, w}};
+      for (const auto& cols : windows) {
+        row.x0 = cols[0];
+        row.x1 = cols[1];
+        std::vector<std::vector<uint16_t>> want(others, std::vector<uint16_t>(w, 0xbeef));
+        for (int32_t j = 0; j < others; ++j) row.hsum[j] = want[j].data();
+        dtk::kReference.rect_row(row);
+        for (const dtk::Variant& v : Others()) {
+          std::vector<std::vector<uint16_t>> got(others, std::vector<uint16_t>(w, 0xbeef));
+          for (int32_t j = 0; j < others; ++j) row.hsum[j] = got[j].data();
+          v.kernels->rect_row(row);
+          ASSERT_EQ(got, want) << v.name << " w " << w << " kind " << kind << " x0 " << row.x0
+                               << " x1 " << row.x1;
+        }
+      }
+    }
+  }
+}
+
 TEST(DataTermKernels, SelectVariantsEqualTheReference) {
   LB_SKIP_WITHOUT_VARIANTS();
   std::mt19937 rng(14);
@@ -119,21 +176,19 @@ TEST(DataTermKernels, SelectVariantsEqualTheReference) {
     for (int32_t others = 1; others <= 15; ++others) {
       const int32_t kind = static_cast<int32_t>(rng() % 3);
       // Horizontal 3-sums 0..765: random, or all at the cap (window sums of 2295), or 0 / 765.
-      std::vector<std::vector<uint16_t>> sums(3 * others, std::vector<uint16_t>(w));
-      std::vector<const uint16_t*> rows;
-      for (auto& r : sums) {
-        for (uint16_t& s : r) {
-          const uint32_t v = rng();
-          s = static_cast<uint16_t>(kind == 0 ? v % 766 : kind == 1 ? 765 : (v & 1) * 765);
-        }
-        rows.push_back(r.data());
+      // The ring: 3 rows per view, `stride` apart (a little more than the row).
+      const ptrdiff_t stride = w + 3;
+      std::vector<uint16_t> ring(static_cast<size_t>(3 * others * stride));
+      for (uint16_t& s : ring) {
+        const uint32_t v = rng();
+        s = static_cast<uint16_t>(kind == 0 ? v % 766 : kind == 1 ? 765 : (v & 1) * 765);
       }
       const int32_t x0 = static_cast<int32_t>(rng() % w);
       std::vector<uint16_t> want(w, 0xbeef);
-      dtk::kReference.select(rows.data(), others, x0, w, want.data());
+      dtk::kReference.select(ring.data(), stride, others, x0, w, want.data());
       for (const dtk::Variant& v : Others()) {
         std::vector<uint16_t> got(w, 0xbeef);
-        v.kernels->select(rows.data(), others, x0, w, got.data());
+        v.kernels->select(ring.data(), stride, others, x0, w, got.data());
         ASSERT_EQ(got, want) << v.name << " w " << w << " others " << others << " kind " << kind;
       }
     }
