@@ -1,16 +1,9 @@
 #include "algo/depth/data_term.h"
 
+#include "algo/core/clones.h"
 #include "algo/core/int_math.h"
 #include "algo/depth/data_term_kernels.h"
 #include "algo/depth/warp_cost.h"
-
-// Plain C++ written to vectorize: on x86-64 also compiled for AVX2 (twice the lanes), chosen at
-// load time by the CPU; the same source, so the same bits.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define LB_CLONES_AVX2 __attribute__((target_clones("avx2", "default")))
-#else
-#define LB_CLONES_AVX2
-#endif
 
 namespace lb {
 namespace {
