@@ -341,6 +341,7 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
   data_.Prepare(views);
   EdgeWeights(views[c.reference]);
   for (int32_t x = 0; x < w; ++x) keep_row_[x] = kKeep;
+  for (int32_t x = 0; x < w; ++x) move_rows_[9 * w + x] = 0;  // ZeroRow
   prev_label_ = -1;
   stats_.cycles = 0;
   stats_.moves = 0;

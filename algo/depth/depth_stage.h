@@ -205,6 +205,11 @@ class DepthStage {
   }
   void CutRect(int32_t alpha, const Rect& r);
   int32_t ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1, int32_t e0, int32_t e1);
+  static uint8_t StatesRow(const uint8_t* f, const uint16_t* wr, const uint16_t* wd,
+                           const uint16_t* wu, const int32_t* er, const int32_t* ed,
+                           const int32_t* eu, const uint16_t* ca, const uint16_t* cc,
+                           const uint8_t* near, int32_t alpha, int32_t k, uint8_t full, int32_t x0,
+                           int32_t x1, int32_t* hi, uint8_t* state);
   void NearColumns(const Rect& r, int32_t y, int32_t* x0, int32_t* x1) const;
   void PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1);
   int32_t BuildRow(const Rect& r, int32_t y, int32_t node_row);
@@ -223,6 +228,8 @@ class DepthStage {
     if (count[to]++ == 0) m[to >> 6] |= uint64_t{1} << (to & 63);
   }
   enum : int32_t { kPairRight = 0, kPairDown = 1, kHigh = 2, kRowFree = 1, kRowTake = 2 };
+  // A row of zeros (width int32, or 2 * width uint16) where the first row's pairs up would be.
+  const int32_t* ZeroRow() const { return move_rows_ + 9 * config_.width; }
   int32_t* Ring(int32_t y, int32_t kind) {
     return move_rows_ + ((y % 3) * 3 + kind) * config_.width;
   }

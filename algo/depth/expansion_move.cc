@@ -40,7 +40,6 @@ LB_CLONES_AVX2 int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t
   int32_t* er = Ring(y, kPairRight);
   int32_t* ed = Ring(y, kPairDown);
   int32_t* hi = Ring(y, kHigh);
-  int32_t* sw = move_rows_ + 9 * config_.width;  // each node's pair weights summed
   auto v = [k](int32_t a, int32_t b) {
     const int32_t d = a > b ? a - b : b - a;
     return d < k ? d : k;
@@ -54,18 +53,9 @@ LB_CLONES_AVX2 int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t
   for (int32_t x = e0; x < e1; ++x) {
     ed[x] = wd[x] * (v(f[x], alpha) + v(fd[x], alpha) - v(f[x], fd[x]));
   }
-  for (int32_t x = x0; x < x1; ++x) {
-    sw[x] = wr[x] + wd[x] + (x > 0 ? wr[x - 1] : 0);
-    hi[x] = er[x] + ed[x] + (x > 0 ? er[x - 1] : 0);
-  }
-  if (y > 0) {
-    const uint16_t* wu = wd - w;
-    const int32_t* eu = Ring(y - 1, kPairDown);
-    for (int32_t x = x0; x < x1; ++x) {
-      sw[x] += wu[x];
-      hi[x] += eu[x];
-    }
-  }
+  // The first row's pairs up are a row of zeros (ZeroRow).
+  const uint16_t* wu = y > 0 ? wd - w : reinterpret_cast<const uint16_t*>(ZeroRow());
+  const int32_t* eu = y > 0 ? Ring(y - 1, kPairDown) : ZeroRow();
   // Restricted moves: which columns hold a label near alpha in rows y - 1..y + 1.
   uint8_t* near = reinterpret_cast<uint8_t*>(move_rows_ + 10 * config_.width) + 1;
   const bool restricted = window_ < config_.labels - 1;
@@ -87,15 +77,32 @@ LB_CLONES_AVX2 int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t
   const uint16_t* ca = g.cost_alpha + row;
   const uint16_t* cc = g.cost + row;
   uint8_t* state = g.state + row;
-  // Without branches, so that the loop vectorizes.
   const uint8_t full = restricted ? 0 : 1;
+  static_assert(kRowFree == 1 && kRowTake == 2);
+  return StatesRow(f, wr, wd, wu, er, ed, eu, ca, cc, near, alpha, k, full, x0, x1, hi, state);
+}
+
+// Pass 1's states of pixels x0..x1-1 of a row (ClassifyRow), without branches so that the loop
+// vectorizes (its own function: the pointers it is handed do not overlap); returns kRowFree |
+// kRowTake for the states present.
+LB_CLONES_AVX2 uint8_t DepthStage::StatesRow(
+    const uint8_t* __restrict f, const uint16_t* __restrict wr, const uint16_t* __restrict wd,
+    const uint16_t* __restrict wu, const int32_t* __restrict er, const int32_t* __restrict ed,
+    const int32_t* __restrict eu, const uint16_t* __restrict ca, const uint16_t* __restrict cc,
+    const uint8_t* __restrict near, int32_t alpha, int32_t k, uint8_t full, int32_t x0, int32_t x1,
+    int32_t* __restrict hi, uint8_t* __restrict state) {
+  auto v = [k](int32_t a, int32_t b) {
+    const int32_t d = a > b ? a - b : b - a;
+    return d < k ? d : k;
+  };
   uint8_t any_free = 0, any_take = 0;
   for (int32_t x = x0; x < x1; ++x) {
+    const int32_t sw = wr[x] + wd[x] + wu[x] + (x > 0 ? wr[x - 1] : 0);  // the pair weights
     const int32_t u = ca[x] - cc[x];
-    int32_t limit = sw[x] * k;
+    int32_t limit = sw * k;
     limit = limit < 0xffff ? limit : 0xffff;
-    const int32_t lo = u - v(f[x], alpha) * sw[x];
-    const int32_t high = hi[x] + lo;
+    const int32_t lo = u - v(f[x], alpha) * sw;
+    const int32_t high = er[x] + ed[x] + eu[x] + (x > 0 ? er[x - 1] : 0) + lo;
     hi[x] = high;
     const uint8_t far = (near[x - 1] | near[x] | near[x + 1] | full) == 0;
     const uint8_t keep = static_cast<uint8_t>(u > limit) | static_cast<uint8_t>(f[x] == alpha) |
@@ -105,7 +112,7 @@ LB_CLONES_AVX2 int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t
     any_free |= static_cast<uint8_t>((keep | take) == 0);
     any_take |= take;
   }
-  return (any_free != 0 ? kRowFree : 0) | (any_take != 0 ? kRowTake : 0);
+  return static_cast<uint8_t>((any_free != 0 ? kRowFree : 0) | (any_take != 0 ? kRowTake : 0));
 }
 
 // The pairs from row y (fixed: above a rectangle) down into the rectangle's first row.
