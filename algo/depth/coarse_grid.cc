@@ -43,14 +43,24 @@ void DepthStage::BlockCosts(int32_t label, const Rect& b, uint16_t* out) {
   UseLabelPlanes(label);
   uint16_t* d = fine_.cost_alpha;
   data_.ComputeRect(LabelDispQ8(label), x0, x1, y0, y1, d + y0 * w, w);
+  // Whole blocks in a loop that vectorizes; a last odd column or row holds half blocks.
+  const int32_t whole = Min(b.x1, w / 2);
   for (int32_t by = b.y0; by < b.y1; ++by) {
     const uint16_t* r0 = d + 2 * by * w;
-    const uint16_t* r1 = 2 * by + 1 < h ? r0 + w : nullptr;
-    for (int32_t bx = b.x0; bx < b.x1; ++bx) {
-      const int32_t x = 2 * bx;
-      int32_t sum = r0[x] + (r1 ? r1[x] : 0);
-      if (x + 1 < w) sum += r0[x + 1] + (r1 ? r1[x + 1] : 0);
-      out[by * bw + bx] = static_cast<uint16_t>(sum);
+    const uint16_t* r1 = 2 * by + 1 < h ? r0 + w : r0;
+    const int32_t second = 2 * by + 1 < h ? 1 : 0;
+    uint16_t* o = out + by * bw;
+    if (second != 0) {
+      for (int32_t bx = b.x0; bx < whole; ++bx) {
+        o[bx] = static_cast<uint16_t>(r0[2 * bx] + r0[2 * bx + 1] + r1[2 * bx] + r1[2 * bx + 1]);
+      }
+    } else {
+      for (int32_t bx = b.x0; bx < whole; ++bx) {
+        o[bx] = static_cast<uint16_t>(r0[2 * bx] + r0[2 * bx + 1]);
+      }
+    }
+    for (int32_t bx = whole > b.x0 ? whole : b.x0; bx < b.x1; ++bx) {  // the odd last column
+      o[bx] = static_cast<uint16_t>(r0[2 * bx] + second * r1[2 * bx]);
     }
   }
 }
