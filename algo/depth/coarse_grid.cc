@@ -5,6 +5,8 @@
 // pass minimises the real energy over block-constant labels, on a quarter of the nodes.
 #include "algo/depth/depth_stage.h"
 
+#include <cstring>
+
 #include "algo/core/int_math.h"
 
 namespace lb {
@@ -121,8 +123,8 @@ void DepthStage::CoarsePass() {
   FineFromBlocks();
 }
 
-// Every pixel takes its block's label; its D comes from one pass per label present, over the
-// rectangles holding that label.
+// Every pixel takes its block's label; its D comes from one pass of the data term per label
+// present, each row over its own columns from the label's first pixel to its last.
 void DepthStage::FineFromBlocks() {
   const int32_t w = config_.width, h = config_.height, bw = coarse_.width;
   uint64_t present[4] = {};
@@ -133,18 +135,32 @@ void DepthStage::FineFromBlocks() {
     RowLabels(fine_, y);
     for (int32_t i = 0; i < 4; ++i) present[i] |= fine_.row_labels[4 * y + i];
   }
-  window_ = 0;
+  // Each row over its own columns from the first pixel of the label to the last.
+  int32_t* spans = data_.span_buffer();
   for (int32_t l = 0; l < config_.labels; ++l) {
     if (((present[l >> 6] >> (l & 63)) & 1) == 0) continue;
+    const uint8_t label = static_cast<uint8_t>(l);
+    for (int32_t y = 0; y < h; ++y) {
+      const uint8_t* f = fine_.labels + y * w;
+      int32_t x0 = 0, x1 = 0;
+      if (((fine_.row_labels[4 * y + (l >> 6)] >> (l & 63)) & 1) != 0) {
+        x0 = static_cast<int32_t>(
+            static_cast<const uint8_t*>(memchr(f, label, static_cast<size_t>(w))) - f);
+        x1 = static_cast<int32_t>(
+                 static_cast<const uint8_t*>(memrchr(f, label, static_cast<size_t>(w))) - f) +
+             1;
+      }
+      spans[2 * y] = x0;
+      spans[2 * y + 1] = x1;
+    }
     UseLabelPlanes(l);
-    const int32_t count = MoveRects(l);
-    for (int32_t i = 0; i < count; ++i) {
-      const Rect& r = fine_.rects[i];
-      data_.ComputeRect(LabelDispQ8(l), r.x0, r.x1, r.y0, r.y1, fine_.cost_alpha + r.y0 * w, w);
-      for (int32_t y = r.y0; y < r.y1; ++y) {
-        for (int32_t p = y * w + r.x0; p < y * w + r.x1; ++p) {
-          if (fine_.labels[p] == l) fine_.cost[p] = fine_.cost_alpha[p];
-        }
+    data_.ComputeSpans(LabelDispQ8(l), spans, 0, h, fine_.cost_alpha, w);
+    for (int32_t y = 0; y < h; ++y) {
+      const uint8_t* f = fine_.labels + y * w;
+      uint16_t* cost = fine_.cost + y * w;
+      const uint16_t* d = fine_.cost_alpha + y * w;
+      for (int32_t x = spans[2 * y]; x < spans[2 * y + 1]; ++x) {
+        if (f[x] == label) cost[x] = d[x];
       }
     }
   }

@@ -140,10 +140,8 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
     }
   }
   // Each run's rectangle, split until no split is left (or the list is full): the cuts and the
-  // data term then cover far fewer fixed pixels. Not for the hand-over from the blocks (window
-  // 0, no cut: only D of the pixels), where the many small pieces cost the data term more in
-  // their first rows than they save.
-  for (int32_t i = 0; i < count && window_ > 0;) {
+  // data term then cover far fewer fixed pixels.
+  for (int32_t i = 0; i < count;) {
     const int32_t after = SplitRect(i, count, lo, hi);
     if (after < 0) {
       ++i;
