@@ -105,7 +105,7 @@ Status DepthStage::Carve(Arena& arena) {
   data_.Carve(arena, w, h, config_.views, config_.workers);
   maxflow_.Carve(arena, w, h);
   CarveGrid(arena, fine_, w, h, true);
-  move_rows_ = arena.Allocate<int32_t>(14 * static_cast<size_t>(w));
+  move_rows_ = arena.Allocate<int32_t>(11 * static_cast<size_t>(w));
   keep_row_ = arena.Allocate<uint8_t>(static_cast<size_t>(w));
   free_span_ = arena.Allocate<int32_t>(2 * static_cast<size_t>(h));
   split_ = arena.Allocate<uint8_t>(static_cast<size_t>(w > h ? w : h) + 2);

@@ -181,31 +181,30 @@ int32_t DepthStage::BuildRow(const Rect& r, int32_t y, int32_t node_row) {
   const int32_t* ed = Ring(y, kPairDown);
   const int32_t* eu = y > r.y0 ? Ring(y - 1, kPairDown) : ed;  // unread when up is keep_row_
   const int32_t* hi = Ring(y, kHigh);
-  int32_t* balance = move_rows_ + 11 * config_.width;
-  int32_t* cap_right = move_rows_ + 12 * config_.width;
-  int32_t* cap_down = move_rows_ + 13 * config_.width;
   // Only the nodes a free node can reach are set (Reach); the others are never read. The terms
-  // are needed only from the row's first free pixel to its last.
+  // are needed only from the row's first free pixel to its last, and go straight to the
+  // solver's staging rows; the other reachable nodes are idle.
   int32_t x0 = r.x0, x1 = r.x1;
   Reach(r, y, &x0, &x1);
   const int32_t* span = free_span_ + 2 * y;
   const int32_t f0 = span[0], f1 = span[1];
-  if (f0 < f1)
-    BuildTerms(st, up, down, er, ed, eu, hi, f0, f1, r.x0, r.x1, balance, cap_right, cap_down);
   const int32_t base = node_row * (r.x1 - r.x0) - r.x0;
+  ptrdiff_t stride = 0;
+  int32_t* const balance = maxflow_.Staged(base, &stride);
   if (x0 > r.x0) maxflow_.SetIdle(base + r.x0);
   if (x1 < r.x1) maxflow_.SetIdle(base + r.x1 - 1);
-  for (int32_t x = x0; x < f0; ++x) maxflow_.SetIdle(base + x);
   int32_t free_pixels = 0;
-  for (int32_t x = f0; x < f1; ++x) {
-    if (st[x] != kFree) {
-      maxflow_.SetIdle(base + x);
-      continue;
-    }
-    maxflow_.SetNode(base + x, balance[x], cap_right[x], cap_down[x]);
-    ++free_pixels;
+  if (f0 < f1) {
+    BuildTerms(st, up, down, er, ed, eu, hi, f0, f1, r.x0, r.x1, balance, balance + stride,
+               balance + 2 * stride);
+    for (int32_t x = f0; x < f1; ++x) free_pixels += st[x] == kFree ? 1 : 0;
   }
-  for (int32_t x = f1 > x0 ? f1 : x0; x < x1; ++x) maxflow_.SetIdle(base + x);
+  const int32_t idle_end = f0 < f1 ? f0 : x1;
+  for (int32_t k = 0; k < 3; ++k) {
+    int32_t* const row = balance + k * stride;
+    if (idle_end > x0) memset(row + x0, 0, sizeof(int32_t) * static_cast<size_t>(idle_end - x0));
+    if (f0 < f1 && x1 > f1) memset(row + f1, 0, sizeof(int32_t) * static_cast<size_t>(x1 - f1));
+  }
   // The solver's row passes look only from the first free pixel to the last.
   if (free_pixels > 0) {
     maxflow_.RowDone(node_row, f0 - r.x0, f1 - r.x0);

@@ -42,6 +42,13 @@ class GridMaxflow {
     s[stage_width_] = cap_right;
     s[2 * stage_width_] = cap_down;
   }
+  // SetNode's three values of nodes p, p + 1, ... written by the caller straight into the
+  // staging rows: node p + i's balance at [i], cap right at [i + *stride], cap down at
+  // [i + 2 * *stride], within the row after the last RowDone.
+  int32_t* Staged(int32_t p, ptrdiff_t* stride) const {
+    *stride = stage_width_;
+    return stage_ + p;
+  }
   // A node with no balance and no arcs: what SetNode(p, 0, 0, 0) gives. Outside the columns
   // RowDone names, the passes before the search write it as the search's free node without
   // reading what was set.
