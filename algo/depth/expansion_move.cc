@@ -349,10 +349,11 @@ bool DepthStage::Expand(int32_t alpha) {
   UseLabelPlanes(alpha);
   const int32_t disp_q8 = LabelDispQ8(alpha);
   const bool near = !on_coarse_ && window_ < config_.labels - 1;
-  if (near && count > 0) ComputeNear(disp_q8);
   for (int32_t i = 0; i < count; ++i) {
     const Rect& r = g.rects[i];
-    if (on_coarse_ && block_costs_ != nullptr) {
+    if (near) {
+      ComputeNear(disp_q8, r);
+    } else if (on_coarse_ && block_costs_ != nullptr) {
       g.cost_alpha = CoarseCosts(alpha);  // the whole grid, from the winner-take-all
     } else if (on_coarse_) {
       BlockCosts(alpha, r, g.cost_alpha);
@@ -367,28 +368,21 @@ bool DepthStage::Expand(int32_t alpha) {
   return delta < 0;
 }
 
-// A restricted move needs D only at the pixels it may free (a label near alpha in their 3x3
-// neighbourhood) and, for the sub-label fit, at those that may take alpha + 1 next (near_span,
-// MoveRects): per row, over the columns next to such a label in the row and the rows either
-// side, each row its own columns (the data term's ring then covers them all, and the image pays
-// its 2 starting rows once). The others keep kNotComputed, which pass 1 never reads (they are
-// fixed as far from alpha whatever their D). Written records a rectangle per run of rows with the
-// same columns, exactly where D was computed.
-void DepthStage::ComputeNear(int32_t disp_q8) {
+// A restricted move needs D only at the pixels of a rectangle that pass 1 may free or leave for
+// the cut: per row, the columns NearColumns gives (next to a label within the window of alpha,
+// or, for the sub-label fit, one above it, in the row and the rows either side), each row its own
+// columns (the data term's ring then covers them all, and the rectangle pays its 2 starting
+// rows once). The others keep kNotComputed, which pass 1 never reads (they are fixed as far from
+// alpha whatever their D), and a pixel that takes alpha + 1 next lies next to such a label, so the
+// sub-label fit mostly finds its D(alpha) at hand (Record computes the rest). Written records a
+// rectangle per run of rows with the same columns, exactly where D was computed.
+void DepthStage::ComputeNear(int32_t disp_q8, const Rect& r) {
   constexpr int32_t kMinWidth = 34;
-  const Grid& g = fine_;
-  const int32_t w = g.width, h = g.height;
+  const int32_t w = fine_.width;
   int32_t* spans = data_.span_buffer();
-  for (int32_t y = 0; y < h; ++y) {
-    int32_t lo = w, hi = 0;
-    for (int32_t r = y > 0 ? y - 1 : 0; r <= y + 1 && r < h; ++r) {
-      const int32_t a = g.near_span[2 * r], b = g.near_span[2 * r + 1];
-      if (a >= b) continue;
-      lo = a - 1 < lo ? a - 1 : lo;
-      hi = b + 1 > hi ? b + 1 : hi;
-    }
-    lo = lo > 0 ? lo : 0;
-    hi = hi < w ? hi : w;
+  for (int32_t y = r.y0; y < r.y1; ++y) {
+    int32_t lo = 0, hi = 0;
+    NearColumns(r, y, &lo, &hi);
     // At least kMinWidth columns: the SIMD kernels' step, where narrow rows take the C ones.
     if (lo < hi && hi - lo < kMinWidth && w >= kMinWidth) {
       lo = (lo + hi - kMinWidth) / 2;
@@ -398,10 +392,12 @@ void DepthStage::ComputeNear(int32_t disp_q8) {
     spans[2 * y] = lo < hi ? lo : 0;
     spans[2 * y + 1] = lo < hi ? hi : 0;
   }
-  data_.ComputeSpans(disp_q8, spans, 0, h, g.cost_alpha, w);
-  for (int32_t y0 = 0; y0 < h;) {
+  data_.ComputeSpans(disp_q8, spans, r.y0, r.y1, fine_.cost_alpha + r.y0 * w, w);
+  for (int32_t y0 = r.y0; y0 < r.y1;) {
     int32_t y1 = y0 + 1;
-    while (y1 < h && spans[2 * y1] == spans[2 * y0] && spans[2 * y1 + 1] == spans[2 * y0 + 1]) ++y1;
+    while (y1 < r.y1 && spans[2 * y1] == spans[2 * y0] && spans[2 * y1 + 1] == spans[2 * y0 + 1]) {
+      ++y1;
+    }
     if (spans[2 * y0] < spans[2 * y0 + 1]) {
       Written(Rect{spans[2 * y0], spans[2 * y0 + 1], y0, y1});
     }
