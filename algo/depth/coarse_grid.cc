@@ -124,7 +124,7 @@ void DepthStage::CoarsePass() {
 }
 
 // Every pixel takes its block's label; its D comes from one pass of the data term per label
-// present, each row over its own columns from the label's first pixel to its last.
+// present, each row over the runs of its pixels of the label.
 void DepthStage::FineFromBlocks() {
   const int32_t w = config_.width, h = config_.height, bw = coarse_.width;
   uint64_t present[4] = {};
@@ -135,32 +135,34 @@ void DepthStage::FineFromBlocks() {
     RowLabels(fine_, y);
     for (int32_t i = 0; i < 4; ++i) present[i] |= fine_.row_labels[4 * y + i];
   }
-  // Each row over its own columns from the first pixel of the label to the last.
-  int32_t* spans = data_.span_buffer();
+  // Each row over the runs of its own pixels of the label.
+  uint8_t* const mark = run_marks_;
   for (int32_t l = 0; l < config_.labels; ++l) {
     if (((present[l >> 6] >> (l & 63)) & 1) == 0) continue;
     const uint8_t label = static_cast<uint8_t>(l);
-    for (int32_t y = 0; y < h; ++y) {
-      const uint8_t* f = fine_.labels + y * w;
-      int32_t x0 = 0, x1 = 0;
-      if (((fine_.row_labels[4 * y + (l >> 6)] >> (l & 63)) & 1) != 0) {
-        x0 = static_cast<int32_t>(
-            static_cast<const uint8_t*>(memchr(f, label, static_cast<size_t>(w))) - f);
-        x1 = static_cast<int32_t>(
-                 static_cast<const uint8_t*>(memrchr(f, label, static_cast<size_t>(w))) - f) +
-             1;
-      }
-      spans[2 * y] = x0;
-      spans[2 * y + 1] = x1;
-    }
     UseLabelPlanes(l);
-    data_.ComputeSpans(LabelDispQ8(l), spans, 0, h, fine_.cost_alpha, w);
+    for (int32_t y = 0; y < h; ++y) {
+      runs_[y].count = 0;
+      if (((fine_.row_labels[4 * y + (l >> 6)] >> (l & 63)) & 1) == 0) continue;
+      const uint8_t* f = fine_.labels + y * w;
+      const int32_t x0 = static_cast<int32_t>(
+          static_cast<const uint8_t*>(memchr(f, label, static_cast<size_t>(w))) - f);
+      const int32_t x1 = static_cast<int32_t>(static_cast<const uint8_t*>(memrchr(
+                                                  f + x0, label, static_cast<size_t>(w - x0))) -
+                                              f) +
+                         1;
+      for (int32_t x = x0; x < x1; ++x) mark[x] = f[x] == label ? 1 : 0;
+      runs_[y].FromMarks(mark, x0, x1, w, data_.RunJoin());
+    }
+    data_.ComputeRuns(LabelDispQ8(l), runs_, 0, h, fine_.cost_alpha, w);
     for (int32_t y = 0; y < h; ++y) {
       const uint8_t* f = fine_.labels + y * w;
       uint16_t* cost = fine_.cost + y * w;
       const uint16_t* d = fine_.cost_alpha + y * w;
-      for (int32_t x = spans[2 * y]; x < spans[2 * y + 1]; ++x) {
-        if (f[x] == label) cost[x] = d[x];
+      for (int32_t k = 0; k < runs_[y].count; ++k) {
+        for (int32_t x = runs_[y].x[2 * k]; x < runs_[y].x[2 * k + 1]; ++x) {
+          if (f[x] == label) cost[x] = d[x];
+        }
       }
     }
   }

@@ -1,5 +1,7 @@
 #include "algo/depth/data_term.h"
 
+#include <cstring>
+
 #include "algo/core/clones.h"
 #include "algo/core/int_math.h"
 #include "algo/depth/data_term_kernels.h"
@@ -57,7 +59,6 @@ void DataTerm::Carve(Arena& arena, int32_t width, int32_t height, int32_t views,
     s.hsum = arena.Allocate<uint16_t>(static_cast<size_t>(width) * 3 * (views - 1));
     s.ref_lanes = arena.Allocate<int32_t>(static_cast<size_t>(width) * 4);
   }
-  spans_ = arena.Allocate<int32_t>(static_cast<size_t>(height) * 2);
   runner_ = &inline_;
   UseSimd(true);
 }
@@ -184,70 +185,140 @@ void DataTerm::ComputeRect(int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0, 
   });
 }
 
-void DataTerm::ComputeSpans(int32_t disp_q8, const int32_t* spans, int32_t y0, int32_t y1,
-                            uint16_t* out, ptrdiff_t stride) {
-  const int32_t rows = y1 - y0;
-  int64_t pixels = 0;
-  for (int32_t y = y0; y < y1; ++y) pixels += Max(spans[2 * y + 1] - spans[2 * y], 0);
-  const int32_t bands = Bands(rows, pixels);
-  if (bands <= 1) {
-    ComputeSpanBand(scratch_[0], disp_q8, spans, y0, y1, out, stride);
+void RowRuns::Add(int32_t lo, int32_t hi, int32_t width, int32_t join) {
+  if (hi - lo < kMinWidth && width >= kMinWidth) {
+    lo = Clamp((lo + hi - kMinWidth) / 2, 0, width - kMinWidth);
+    hi = lo + kMinWidth;
+  }
+  // Joined to the run before when it is near (widening may even overlap it), or when full.
+  if (count > 0 && (lo - x[2 * count - 1] < join || count == kMax)) {
+    x[2 * count - 1] = Max(x[2 * count - 1], hi);
     return;
   }
-  // Bands of equal rows: the spans of a restricted move are spread over the image.
+  x[2 * count] = lo;
+  x[2 * count + 1] = hi;
+  ++count;
+}
+
+void RowRuns::FromMarks(const uint8_t* mark, int32_t lo, int32_t hi, int32_t width, int32_t join) {
+  // Marks are 0 or 1: eight at a time while a word is all 0 (a gap) or all 1 (a run).
+  constexpr uint64_t kOnes = 0x0101010101010101u;
+  auto word = [&](int32_t x) {
+    uint64_t v;
+    memcpy(&v, mark + x, sizeof(v));
+    return v;
+  };
+  count = 0;
+  int32_t start = -1, end = -1;  // the run being gathered: [start, end)
+  for (int32_t x = lo; x < hi;) {
+    while (x + 8 <= hi && word(x) == 0) x += 8;
+    while (x < hi && mark[x] == 0) ++x;
+    if (x >= hi) break;
+    int32_t e = x + 1;
+    while (e + 8 <= hi && word(e) == kOnes) e += 8;
+    while (e < hi && mark[e] != 0) ++e;
+    if (start >= 0 && x - end >= join) {
+      Add(start, end, width, join);
+      start = -1;
+    }
+    if (start < 0) start = x;
+    end = e;
+    x = e;
+  }
+  if (start >= 0) Add(start, end, width, join);
+}
+
+void DataTerm::ComputeRuns(int32_t disp_q8, const RowRuns* runs, int32_t y0, int32_t y1,
+                           uint16_t* out, ptrdiff_t stride) {
+  const int32_t rows = y1 - y0;
+  int64_t pixels = 0;
+  for (int32_t y = y0; y < y1; ++y) {
+    for (int32_t k = 0; k < runs[y].count; ++k) pixels += runs[y].x[2 * k + 1] - runs[y].x[2 * k];
+  }
+  const int32_t bands = Bands(rows, pixels);
+  if (bands <= 1) {
+    ComputeRunBand(scratch_[0], disp_q8, runs, y0, y1, out, stride);
+    return;
+  }
+  // Bands of equal rows: the runs of a restricted move are spread over the image.
   ParallelFor(*runner_, bands, [&](int32_t band, int32_t worker) {
     const int32_t b0 = y0 + static_cast<int32_t>(int64_t{rows} * band / bands);
     const int32_t b1 = y0 + static_cast<int32_t>(int64_t{rows} * (band + 1) / bands);
-    ComputeSpanBand(scratch_[worker], disp_q8, spans, b0, b1, out + (b0 - y0) * stride, stride);
+    ComputeRunBand(scratch_[worker], disp_q8, runs, b0, b1, out + (b0 - y0) * stride, stride);
   });
 }
 
-void DataTerm::ComputeSpanBand(const Scratch& s, int32_t disp_q8, const int32_t* spans, int32_t y0,
-                               int32_t y1, uint16_t* out, ptrdiff_t stride) const {
+namespace {
+
+// The columns of ring row r's 3-sums that rows r - 1 .. r + 1 of the band y0..y1-1 read: the
+// union of their runs, ascending, joined where closer than `join`. Returns the count (at most
+// 3 * RowRuns::kMax) of [iv[2k], iv[2k + 1]).
+int32_t NeededColumns(const RowRuns* runs, int32_t r, int32_t y0, int32_t y1, int32_t join,
+                      int32_t* iv) {
+  int32_t n = 0;
+  for (int32_t y = Max(r - 1, y0); y <= r + 1 && y < y1; ++y) {
+    for (int32_t k = 0; k < runs[y].count; ++k) {
+      const int32_t a = runs[y].x[2 * k], b = runs[y].x[2 * k + 1];
+      if (a >= b) continue;
+      int32_t i = n++;  // insertion by start
+      for (; i > 0 && iv[2 * i - 2] > a; --i) {
+        iv[2 * i] = iv[2 * i - 2];
+        iv[2 * i + 1] = iv[2 * i - 1];
+      }
+      iv[2 * i] = a;
+      iv[2 * i + 1] = b;
+    }
+  }
+  int32_t m = 0;
+  for (int32_t i = 0; i < n; ++i) {
+    if (m > 0 && iv[2 * i] - iv[2 * m - 1] < join) {
+      iv[2 * m - 1] = Max(iv[2 * m - 1], iv[2 * i + 1]);
+    } else {
+      iv[2 * m] = iv[2 * i];
+      iv[2 * m + 1] = iv[2 * i + 1];
+      ++m;
+    }
+  }
+  return m;
+}
+
+}  // namespace
+
+void DataTerm::ComputeRunBand(const Scratch& s, int32_t disp_q8, const RowRuns* runs, int32_t y0,
+                              int32_t y1, uint16_t* out, ptrdiff_t stride) const {
   const int32_t w = width_;
   const int32_t others = views_ - 1;
   auto ring = [&](int32_t j, int32_t row) {
     return s.hsum + (static_cast<size_t>(j) * 3 + static_cast<size_t>((row - y0 + 1) % 3)) * w;
   };
-  // The 3-sums of row r are read by rows r - 1 .. r + 1 of the band: the hull of their spans.
-  auto hull = [&](int32_t r, int32_t* a, int32_t* b) {
-    *a = w;
-    *b = 0;
-    for (int32_t y = Max(r - 1, y0); y <= r + 1 && y < y1; ++y) {
-      if (spans[2 * y] >= spans[2 * y + 1]) continue;
-      *a = Min(*a, spans[2 * y]);
-      *b = Max(*b, spans[2 * y + 1]);
-    }
-    return *a < *b;
-  };
   dtk::RectRow row;
   StartRows(disp_q8, &row);
-  auto window_rows = [&](int32_t r, int32_t c0, int32_t c1) {
+  int32_t iv[2 * 3 * RowRuns::kMax];
+  const int32_t join = RunJoin();
+  auto window_rows = [&](int32_t r, int32_t n) {
     for (int32_t j = 0; j < others; ++j) row.hsum[j] = ring(j, r);
-    WindowRows(s, r, c0, c1, &row);
+    for (int32_t i = 0; i < n; ++i) WindowRows(s, r, iv[2 * i], iv[2 * i + 1], &row);
   };
-  int32_t a, b;
-  for (int32_t r = y0 - 1; r <= y0; ++r) {
-    if (hull(r, &a, &b)) window_rows(r, a, b);
-  }
-  // The hull of row y + 1, found one row earlier for its prefetch.
-  bool any = hull(y0 + 1, &a, &b);
+  for (int32_t r = y0 - 1; r <= y0; ++r) window_rows(r, NeededColumns(runs, r, y0, y1, join, iv));
+  // The columns of row y + 1, found one row earlier for their prefetch.
+  int32_t n = NeededColumns(runs, y0 + 1, y0, y1, join, iv);
   for (int32_t y = y0; y < y1; ++y) {
-    if (any) window_rows(y + 1, a, b);
+    window_rows(y + 1, n);
     // As ComputeBand: ask early for the views' next rows, which the prefetcher misses.
-    any = hull(y + 2, &a, &b);
-    if (any) {
-      const int32_t next = Clamp(y + 2, 0, height_ - 1);
-      const size_t bytes = static_cast<size_t>(3) * (b - a);
+    n = NeededColumns(runs, y + 2, y0, y1, join, iv);
+    const int32_t next = Clamp(y + 2, 0, height_ - 1);
+    for (int32_t i = 0; i < n; ++i) {
+      const size_t bytes = static_cast<size_t>(3) * (iv[2 * i + 1] - iv[2 * i]);
       for (int32_t j = 0; j < others; ++j) {
-        Prefetch(images_[OtherView(j)].Row(next) + 3 * a, bytes);
-        Prefetch(census_[OtherView(j)] + static_cast<ptrdiff_t>(next) * 3 * w + a, bytes);
+        Prefetch(images_[OtherView(j)].Row(next) + 3 * iv[2 * i], bytes);
+        Prefetch(census_[OtherView(j)] + static_cast<ptrdiff_t>(next) * 3 * w + iv[2 * i], bytes);
       }
     }
-    const int32_t x0 = spans[2 * y], x1 = spans[2 * y + 1];
-    if (x0 >= x1) continue;
     // The ring's three rows of each view are y - 1 .. y + 1.
-    kernels_->select(s.hsum, w, others, x0, x1, out + (y - y0) * stride);
+    for (int32_t k = 0; k < runs[y].count; ++k) {
+      const int32_t x0 = runs[y].x[2 * k], x1 = runs[y].x[2 * k + 1];
+      if (x0 < x1) kernels_->select(s.hsum, w, others, x0, x1, out + (y - y0) * stride);
+    }
   }
 }
 

@@ -35,6 +35,24 @@ namespace dtk {
 struct RectRow;
 }  // namespace dtk
 
+// Runs of columns of one row, ascending and disjoint: [x[2k], x[2k + 1]) for k < count.
+struct RowRuns {
+  static constexpr int32_t kMax = 4;
+  // Narrower runs are widened to this (within the row): the SIMD kernels' step, where narrow
+  // rows take the C ones.
+  static constexpr int32_t kMinWidth = 34;
+  int32_t count = 0;
+  int32_t x[2 * kMax] = {};
+
+  // The columns of lo..hi-1 whose mark is 0 or 1 (mark indexed by x), as runs joined across
+  // gaps under `join` columns (DataTerm::RunJoin) and widened to kMinWidth within 0..width-1;
+  // past kMax runs, the last takes in the rest. The runs cover every marked column.
+  void FromMarks(const uint8_t* mark, int32_t lo, int32_t hi, int32_t width, int32_t join);
+
+ private:
+  void Add(int32_t lo, int32_t hi, int32_t width, int32_t join);
+};
+
 struct DataTermParams {
   int32_t color_trunc = 45;   // truncation of the summed |dR|+|dG|+|dB|, 0..765
   int32_t census_weight = 4;  // cost per differing census bit (24 bits), 0..10
@@ -66,16 +84,16 @@ class DataTerm {
   // ComputeRows, bit for bit.
   void ComputeRect(int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0, int32_t y1, uint16_t* out,
                    ptrdiff_t stride);
-  // Rows y0..y1-1, each over its own columns: row y over spans[2 * y] .. spans[2 * y + 1] - 1
-  // (none when not less), out still pointing at (0, y0); the values of ComputeRows, bit for bit.
-  // For callers whose rows need different columns (a restricted move): the ring's 3-sums of a row
-  // cover only the hull of the spans of the rows that read them, and a band pays its 2 starting
-  // rows once rather than per rectangle.
-  void ComputeSpans(int32_t disp_q8, const int32_t* spans, int32_t y0, int32_t y1, uint16_t* out,
-                    ptrdiff_t stride);
-  // A buffer of 2 * height entries for the caller to fill with ComputeSpans' spans (carved here
-  // so that the caller needs no memory of its own).
-  int32_t* span_buffer() { return spans_; }
+  // Rows y0..y1-1, each over its own runs of columns (runs[y], indexed by absolute row), out
+  // still pointing at (0, y0); the values of ComputeRows, bit for bit, and nothing written
+  // outside the runs. For callers whose rows need different columns (a restricted move): the
+  // ring's 3-sums of a row cover only the runs of the rows that read them, and a band pays its 2
+  // starting rows once rather than per run.
+  void ComputeRuns(int32_t disp_q8, const RowRuns* runs, int32_t y0, int32_t y1, uint16_t* out,
+                   ptrdiff_t stride);
+  // Runs of a row closer than this are best joined: a run costs every view's kernel set-up on
+  // each of its rows, about what this many columns cost (the plane sweep's columns cost more).
+  int32_t RunJoin() const { return planes_ != nullptr ? 16 : 64; }
 
   // Plane sweep (warp_cost.h): the homography of each view for the label of the next ComputeRows
   // calls (borrowed; disp_q8 is then ignored), or nullptr for the rectified shifts.
@@ -117,8 +135,8 @@ class DataTerm {
   void CensusOfView(const Scratch& s, int32_t view);
   void ComputeBand(const Scratch& s, int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0,
                    int32_t y1, uint16_t* out, ptrdiff_t stride) const;
-  void ComputeSpanBand(const Scratch& s, int32_t disp_q8, const int32_t* spans, int32_t y0,
-                       int32_t y1, uint16_t* out, ptrdiff_t stride) const;
+  void ComputeRunBand(const Scratch& s, int32_t disp_q8, const RowRuns* runs, int32_t y0,
+                      int32_t y1, uint16_t* out, ptrdiff_t stride) const;
   // How many bands a request of `rows` rows and `pixels` pixels is cut into.
   int32_t Bands(int32_t rows, int64_t pixels) const;
 
@@ -129,7 +147,6 @@ class DataTerm {
   const Kernels* kernels_ = nullptr;
   const PlaneHomography* planes_ = nullptr;
   uint8_t* census_[16] = {};
-  int32_t* spans_ = nullptr;
   Scratch scratch_[kMaxWorkers];
   int32_t workers_ = 1;
   InlineRunner inline_;

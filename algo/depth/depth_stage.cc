@@ -109,6 +109,8 @@ Status DepthStage::Carve(Arena& arena) {
   keep_row_ = arena.Allocate<uint8_t>(static_cast<size_t>(w));
   free_span_ = arena.Allocate<int32_t>(2 * static_cast<size_t>(h));
   split_ = arena.Allocate<uint8_t>(static_cast<size_t>(w > h ? w : h) + 2);
+  runs_ = arena.Allocate<RowRuns>(static_cast<size_t>(h));
+  run_marks_ = arena.Allocate<uint8_t>(2 * (static_cast<size_t>(w) + 2));
   // The coarse grid is done with before the fine moves record anything in below_ and above_,
   // so it lives in their memory (enlarged for the smallest images, where alignment dominates).
   Arena plan;

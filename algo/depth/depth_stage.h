@@ -258,6 +258,11 @@ class DepthStage {
   uint8_t* keep_row_ = nullptr;   // width x kKeep: the state of the rows around a rectangle
   int32_t* free_span_ = nullptr;  // per row, the free pixels of the rectangle being cut (FreeSpan)
   uint8_t* split_ = nullptr;      // max(width, height) + 2 bytes: SplitRect's column or row marks
+  // Per row, the runs of columns whose D a restricted move or the hand-over computes.
+  RowRuns* runs_ = nullptr;
+  uint8_t* run_marks_ = nullptr;  // 2 * (width + 2) bytes: the columns those runs hold
+  // The labels near alpha that a restricted move computes D next to (MoveRects).
+  int32_t near_lo_ = 0, near_top_ = 0;
   int32_t smooth_[DepthConfig::kMaxLabels] = {};  // min(d, smooth_trunc) for a label distance d
   int32_t prev_label_ = -1;
   uint16_t* below_ = nullptr;  // D_p(f_p - 1), 0xffff when not seen

@@ -369,38 +369,55 @@ bool DepthStage::Expand(int32_t alpha) {
 }
 
 // A restricted move needs D only at the pixels of a rectangle that pass 1 may free or leave for
-// the cut: per row, the columns NearColumns gives (next to a label within the window of alpha,
-// or, for the sub-label fit, one above it, in the row and the rows either side), each row its own
-// columns (the data term's ring then covers them all, and the rectangle pays its 2 starting
-// rows once). The others keep kNotComputed, which pass 1 never reads (they are fixed as far from
-// alpha whatever their D), and a pixel that takes alpha + 1 next lies next to such a label, so the
-// sub-label fit mostly finds its D(alpha) at hand (Record computes the rest). Written records a
-// rectangle per run of rows with the same columns, exactly where D was computed.
-void DepthStage::ComputeNear(int32_t disp_q8, const Rect& r) {
-  constexpr int32_t kMinWidth = 34;
-  const int32_t w = fine_.width;
-  int32_t* spans = data_.span_buffer();
+// the cut: next to a label within the window of alpha or, for the sub-label fit, one above it
+// (near_lo_..near_top_), in the row or the rows either side. Per row, the runs of such columns
+// (RowRuns: joined where close, at most a few) within the columns pass 1 looks at (NearColumns);
+// the data term's ring covers them all, and the rectangle pays its 2 starting rows once. The
+// others keep kNotComputed, which pass 1 never reads (they are fixed as far from alpha whatever
+// their D), and a pixel that takes alpha + 1 next lies next to such a label, so the sub-label fit
+// mostly finds its D(alpha) at hand (Record computes the rest). Written records a rectangle per
+// run of rows with the same single run, or each run, exactly where D was computed.
+LB_CLONES_AVX2 void DepthStage::ComputeNear(int32_t disp_q8, const Rect& r) {
+  const Grid& g = fine_;
+  const int32_t w = g.width, h = g.height;
+  // One unsigned compare per label (a label below the base wraps above the window's width).
+  const uint8_t base = static_cast<uint8_t>(near_lo_);
+  const uint8_t width = static_cast<uint8_t>(near_top_ - near_lo_);
+  uint8_t* const near = run_marks_ + 1;      // near[-1 .. w]: a label near in the column
+  uint8_t* const mark = run_marks_ + w + 3;  // mark[x]: one next to column x
   for (int32_t y = r.y0; y < r.y1; ++y) {
     int32_t lo = 0, hi = 0;
     NearColumns(r, y, &lo, &hi);
-    // At least kMinWidth columns: the SIMD kernels' step, where narrow rows take the C ones.
-    if (lo < hi && hi - lo < kMinWidth && w >= kMinWidth) {
-      lo = (lo + hi - kMinWidth) / 2;
-      lo = lo < 0 ? 0 : (lo + kMinWidth > w ? w - kMinWidth : lo);
-      hi = lo + kMinWidth;
+    if (lo >= hi) {
+      runs_[y].count = 0;
+      continue;
     }
-    spans[2 * y] = lo < hi ? lo : 0;
-    spans[2 * y + 1] = lo < hi ? hi : 0;
+    const uint8_t* f = g.labels + y * w;
+    const uint8_t* fu = y > 0 ? f - w : f;
+    const uint8_t* fd = y + 1 < h ? f + w : f;
+    const int32_t a = lo > 0 ? lo - 1 : 0, b = hi < w ? hi + 1 : w;
+    for (int32_t x = a; x < b; ++x) {
+      near[x] = static_cast<uint8_t>(static_cast<uint8_t>(fu[x] - base) <= width) |
+                static_cast<uint8_t>(static_cast<uint8_t>(f[x] - base) <= width) |
+                static_cast<uint8_t>(static_cast<uint8_t>(fd[x] - base) <= width);
+    }
+    near[a - 1] = near[b] = 0;
+    for (int32_t x = lo; x < hi; ++x) {
+      mark[x] = static_cast<uint8_t>(near[x - 1] | near[x] | near[x + 1]);
+    }
+    runs_[y].FromMarks(mark, lo, hi, w, data_.RunJoin());
   }
-  data_.ComputeSpans(disp_q8, spans, r.y0, r.y1, fine_.cost_alpha + r.y0 * w, w);
+  data_.ComputeRuns(disp_q8, runs_, r.y0, r.y1, fine_.cost_alpha + r.y0 * w, w);
   for (int32_t y0 = r.y0; y0 < r.y1;) {
+    const RowRuns& a = runs_[y0];
     int32_t y1 = y0 + 1;
-    while (y1 < r.y1 && spans[2 * y1] == spans[2 * y0] && spans[2 * y1 + 1] == spans[2 * y0 + 1]) {
-      ++y1;
+    if (a.count == 1) {
+      while (y1 < r.y1 && runs_[y1].count == 1 && runs_[y1].x[0] == a.x[0] &&
+             runs_[y1].x[1] == a.x[1]) {
+        ++y1;
+      }
     }
-    if (spans[2 * y0] < spans[2 * y0 + 1]) {
-      Written(Rect{spans[2 * y0], spans[2 * y0 + 1], y0, y1});
-    }
+    for (int32_t k = 0; k < a.count; ++k) Written(Rect{a.x[2 * k], a.x[2 * k + 1], y0, y1});
     y0 = y1;
   }
 }

@@ -93,6 +93,8 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
   // now; either way its D(alpha) for the sub-label fit is then mostly at hand (Record).
   {
     const int32_t top = config_.subpixel && hi + 1 < config_.labels ? hi + 1 : hi;
+    near_lo_ = lo;
+    near_top_ = top;
     uint64_t more[4] = {want[0], want[1], want[2], want[3]};
     more[top >> 6] |= uint64_t{1} << (top & 63);
     for (int32_t y = 0; y < h; ++y) {

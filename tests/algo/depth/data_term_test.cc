@@ -188,36 +188,86 @@ TEST(DataTermTest, RectanglesEqualTheWholeImage) {
   }
 }
 
-// A restricted move computes each row over its own columns (ComputeSpans): rows of different
-// widths, empty rows between them and rows at the image's borders must give the whole image's
-// values bit for bit, and write nothing outside their spans.
-TEST(DataTermTest, RowSpansEqualTheWholeImage) {
+// A restricted move computes each row over its own runs of columns (ComputeRuns): rows of one
+// run or several, of different widths, empty rows between them and runs at the image's borders
+// must give the whole image's values bit for bit, and write nothing outside their runs.
+TEST(DataTermTest, RowRunsEqualTheWholeImage) {
   const int32_t w = 70, h = 20;
   const synth::Burst b = synth::MakeBurst(w, h, 5, 2, 1, 4, 10, 50, 5, 16, 9u);
   Fixed f;
   PrepareTerm(f, b, DataTermParams{});
-  int32_t* spans = f.term.span_buffer();
-  ASSERT_NE(spans, nullptr);
-  // Per row: wide, narrow, empty, at either border; the first and last rows included.
-  const std::pair<int32_t, int32_t> pick[] = {{0, 70}, {5, 40},  {0, 0},  {69, 70}, {17, 70},
-                                              {0, 1},  {30, 31}, {0, 33}, {40, 40}, {1, 2}};
+  // Per row: wide, narrow, empty, at either border, two or four runs; the first and last rows
+  // included.
+  const std::vector<std::vector<int32_t>> pick = {
+      {0, 70},        {5, 40},      {},       {69, 70},
+      {0, 3, 60, 70}, {0, 1},       {30, 31}, {2, 9, 20, 24, 40, 41, 50, 66},
+      {40, 40},       {1, 2, 5, 33}};
+  std::vector<RowRuns> runs(h);
   for (int32_t y = 0; y < h; ++y) {
-    spans[2 * y] = pick[(y * 3) % 10].first;
-    spans[2 * y + 1] = pick[(y * 3) % 10].second;
+    const std::vector<int32_t>& p = pick[(y * 3) % pick.size()];
+    runs[y].count = static_cast<int32_t>(p.size() / 2);
+    for (size_t i = 0; i < p.size(); ++i) runs[y].x[i] = p[i];
   }
+  auto inside = [&](int32_t x, int32_t y) {
+    for (int32_t k = 0; k < runs[y].count; ++k) {
+      if (x >= runs[y].x[2 * k] && x < runs[y].x[2 * k + 1]) return true;
+    }
+    return false;
+  };
   for (int32_t disp_q8 : {0, 300, 1000}) {
     std::vector<uint16_t> whole(static_cast<size_t>(w) * h);
     f.term.ComputeRows(disp_q8, 0, h, whole.data(), w);
     for (const auto& [y0, y1] : {std::pair{0, h}, {3, 11}, {19, 20}}) {
       std::vector<uint16_t> out(whole.size(), 0xabcd);
-      f.term.ComputeSpans(disp_q8, spans, y0, y1, out.data() + y0 * w, w);
+      f.term.ComputeRuns(disp_q8, runs.data(), y0, y1, out.data() + y0 * w, w);
       for (int32_t y = 0; y < h; ++y) {
         for (int32_t x = 0; x < w; ++x) {
-          const bool inside = y >= y0 && y < y1 && x >= spans[2 * y] && x < spans[2 * y + 1];
-          ASSERT_EQ(out[y * w + x], inside ? whole[y * w + x] : 0xabcd)
+          const bool in = y >= y0 && y < y1 && inside(x, y);
+          ASSERT_EQ(out[y * w + x], in ? whole[y * w + x] : 0xabcd)
               << "x " << x << " y " << y << " rows [" << y0 << ", " << y1 << ")";
         }
       }
+    }
+  }
+}
+
+// The runs a caller makes from its marked columns cover every one of them, in order and apart,
+// at most RowRuns::kMax, none narrower than the kernels' step, and split only where the gap is
+// worth a run's set-up.
+TEST(DataTermTest, RunsFromMarksCoverEveryMark) {
+  const int32_t w = 300;
+  uint32_t seed = 7;
+  auto next = [&]() { return seed = seed * 1664525u + 1013904223u; };
+  for (int32_t trial = 0; trial < 400; ++trial) {
+    std::vector<uint8_t> mark(w, 0);
+    const int32_t blobs = static_cast<int32_t>(next() % 9);
+    for (int32_t i = 0; i < blobs; ++i) {
+      const int32_t a = static_cast<int32_t>(next() % w);
+      const int32_t n = 1 + static_cast<int32_t>(next() % 40);
+      for (int32_t x = a; x < a + n && x < w; ++x) mark[x] = 1;
+    }
+    const int32_t lo = static_cast<int32_t>(next() % 50),
+                  hi = w - static_cast<int32_t>(next() % 50);
+    const int32_t join = trial % 2 == 0 ? 16 : 64;
+    RowRuns runs;
+    runs.FromMarks(mark.data(), lo, hi, w, join);
+    ASSERT_LE(runs.count, RowRuns::kMax);
+    for (int32_t k = 0; k < runs.count; ++k) {
+      const int32_t a = runs.x[2 * k], b = runs.x[2 * k + 1];
+      ASSERT_GE(a, 0);
+      ASSERT_LE(b, w);
+      ASSERT_GE(b - a, RowRuns::kMinWidth) << "trial " << trial;
+      if (k > 0) {
+        ASSERT_GE(a - runs.x[2 * k - 1], join) << "trial " << trial << ": runs this close join";
+      }
+    }
+    for (int32_t x = lo; x < hi; ++x) {
+      if (mark[x] == 0) continue;
+      bool covered = false;
+      for (int32_t k = 0; k < runs.count; ++k) {
+        covered |= x >= runs.x[2 * k] && x < runs.x[2 * k + 1];
+      }
+      ASSERT_TRUE(covered) << "trial " << trial << ": column " << x;
     }
   }
 }
