@@ -193,7 +193,7 @@ class DepthStage {
   bool Expand(int32_t alpha);
   int32_t MoveRects(int32_t alpha);
   int32_t SplitRect(int32_t i, int32_t count, int32_t lo, int32_t hi);
-  void ComputeNear(int32_t disp_q8, const Rect& r);
+  void ComputeNear(int32_t disp_q8);
   // Notes that the fine grid's cost_alpha holds D over r (MoveRects clears it two moves on).
   void Written(const Rect& r) {
     Grid& g = fine_;

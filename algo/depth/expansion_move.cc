@@ -349,10 +349,11 @@ bool DepthStage::Expand(int32_t alpha) {
   UseLabelPlanes(alpha);
   const int32_t disp_q8 = LabelDispQ8(alpha);
   const bool near = !on_coarse_ && window_ < config_.labels - 1;
+  if (near && count > 0) ComputeNear(disp_q8);
   for (int32_t i = 0; i < count; ++i) {
     const Rect& r = g.rects[i];
     if (near) {
-      ComputeNear(disp_q8, r);
+      // D is at hand (ComputeNear).
     } else if (on_coarse_ && block_costs_ != nullptr) {
       g.cost_alpha = CoarseCosts(alpha);  // the whole grid, from the winner-take-all
     } else if (on_coarse_) {
@@ -368,24 +369,25 @@ bool DepthStage::Expand(int32_t alpha) {
   return delta < 0;
 }
 
-// A restricted move needs D only at the pixels of a rectangle that pass 1 may free or leave for
-// the cut: next to a label within the window of alpha or, for the sub-label fit, one above it
-// (near_lo_..near_top_), in the row or the rows either side. Per row, the runs of such columns
-// (RowRuns: joined where close, at most a few) within the columns pass 1 looks at (NearColumns);
-// the data term's ring covers them all, and the rectangle pays its 2 starting rows once. The
-// others keep kNotComputed, which pass 1 never reads (they are fixed as far from alpha whatever
-// their D), and a pixel that takes alpha + 1 next lies next to such a label, so the sub-label fit
-// mostly finds its D(alpha) at hand (Record computes the rest). Written records a rectangle per
-// run of rows with the same single run, or each run, exactly where D was computed.
-LB_CLONES_AVX2 void DepthStage::ComputeNear(int32_t disp_q8, const Rect& r) {
+// A restricted move needs D only at the pixels it may free: next to a label within the window of
+// alpha or, for the sub-label fit, one above it (near_lo_..near_top_), in the row or the rows
+// either side. Per row, the runs of such columns (RowRuns: joined where close, at most a few),
+// over the whole image in one pass of the data term (its ring covers every row's runs, the image
+// pays its 2 starting rows once, and each view row is read once: the move's rectangles may share
+// rows). The others keep kNotComputed, which pass 1 never reads (they are fixed as far from alpha
+// whatever their D), and a pixel that takes alpha + 1 next lies next to such a label, so the
+// sub-label fit mostly finds its D(alpha) at hand (Record computes the rest). Written records a
+// rectangle per run of rows with the same single run, or each run, exactly where D was computed.
+LB_CLONES_AVX2 void DepthStage::ComputeNear(int32_t disp_q8) {
   const Grid& g = fine_;
   const int32_t w = g.width, h = g.height;
+  const Rect r{0, w, 0, h};
   // One unsigned compare per label (a label below the base wraps above the window's width).
   const uint8_t base = static_cast<uint8_t>(near_lo_);
   const uint8_t width = static_cast<uint8_t>(near_top_ - near_lo_);
   uint8_t* const near = run_marks_ + 1;      // near[-1 .. w]: a label near in the column
   uint8_t* const mark = run_marks_ + w + 3;  // mark[x]: one next to column x
-  for (int32_t y = r.y0; y < r.y1; ++y) {
+  for (int32_t y = 0; y < h; ++y) {
     int32_t lo = 0, hi = 0;
     NearColumns(r, y, &lo, &hi);
     if (lo >= hi) {

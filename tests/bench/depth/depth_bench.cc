@@ -4,7 +4,7 @@
 // And the plane sweep against the rectified shifts on a synthetic handheld burst (the case
 // depth_planes_accuracy_test prints), in CPU time.
 //   build/host/tests/bench/depth/depth_bench --benchmark_counters_tabular=true
-// BM_TeddyOverSgbm gives the ratio of the two, alternated call by call.
+// BM_TeddyOverSgbm and BM_HandheldPlanesOverRectified give the ratios, alternated call by call.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -24,6 +24,11 @@
 
 namespace lb {
 namespace {
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0.0 : v[v.size() / 2];
+}
 
 const middlebury::Set* Teddy() {
   static middlebury::Set set;
@@ -153,6 +158,40 @@ BENCHMARK(BM_HandheldDepth640x480)
     ->Unit(benchmark::kMillisecond)
     ->MinTime(2.0);
 
+// The plane sweep's ratio to the rectified shifts on that burst, taken so that a busy machine
+// slows both alike: one compute of each by turns, each timed on its own; the counters are each
+// side's median and the median of the per-turn ratios.
+void BM_HandheldPlanesOverRectified(benchmark::State& state) {
+  static motiontest::Burst burst;
+  static const bool made = motiontest::MakeBurst(motiontest::Handheld(1), 640, 480, 7, &burst);
+  if (!made) return state.SkipWithError("no synthetic burst");
+  const handheld::Labels l = handheld::HandheldLabels(burst, 0.1);
+  DepthConfig c = l.config;
+  handheld::Stage sweep, shifts;
+  c.geometry = ViewGeometry::kKnownPoses;
+  if (!sweep.Configure(c).ok()) return state.SkipWithError("configure failed");
+  c.geometry = ViewGeometry::kRectified;
+  if (!shifts.Configure(c).ok()) return state.SkipWithError("configure failed");
+  const std::vector<PlaneHomography> homographies = handheld::Planes(burst, l);
+  std::vector<double> planes_ms, rect_ms, ratios;
+  using Clock = std::chrono::steady_clock;
+  for (auto _ : state) {
+    const Clock::time_point t0 = Clock::now();
+    if (!sweep.depth.SetPlanes(homographies.data()).ok()) state.SkipWithError("planes");
+    if (!sweep.Compute(burst.views.data()).ok()) state.SkipWithError("compute failed");
+    const Clock::time_point t1 = Clock::now();
+    if (!shifts.Compute(burst.views.data()).ok()) state.SkipWithError("compute failed");
+    const Clock::time_point t2 = Clock::now();
+    planes_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    rect_ms.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
+    ratios.push_back(planes_ms.back() / rect_ms.back());
+  }
+  state.counters["planes_ms"] = Median(planes_ms);
+  state.counters["rectified_ms"] = Median(rect_ms);
+  state.counters["ratio"] = Median(ratios);
+}
+BENCHMARK(BM_HandheldPlanesOverRectified)->Unit(benchmark::kMillisecond)->MinTime(6.0);
+
 #ifdef LB_HAVE_OPENCV
 // Two-view SGBM on im2/im6 (disparities 0..63 px over 4 view steps, the same depth range as the
 // 64 quarter-pixel labels above), single thread.
@@ -237,13 +276,9 @@ void BM_TeddyOverSgbm(benchmark::State& state) {
     theirs.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
     ratios.push_back(ours.back() / theirs.back());
   }
-  auto median = [](std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.empty() ? 0.0 : v[v.size() / 2];
-  };
-  state.counters["depth_ms"] = median(ours);
-  state.counters["sgbm_ms"] = median(theirs);
-  state.counters["ratio"] = median(ratios);
+  state.counters["depth_ms"] = Median(ours);
+  state.counters["sgbm_ms"] = Median(theirs);
+  state.counters["ratio"] = Median(ratios);
 }
 BENCHMARK(BM_TeddyOverSgbm)->Unit(benchmark::kMillisecond)->MinTime(6.0);
 #endif
