@@ -27,6 +27,22 @@ namespace lb {
 //
 // Columns x0..x1-1 are classified (the caller fixed the others as far from alpha), and the pairs
 // down are kept over e0..e1-1, which also covers the next row's x0..x1-1 (its sums read them).
+namespace {
+
+// out[x] = 1 where column x of the rows up, f and down holds a label in base..base + width, for
+// x in a..b-1: one unsigned compare per label (a label below base wraps above the width).
+LB_CLONES_AVX2 void MarkNearLabels(const uint8_t* __restrict up, const uint8_t* __restrict f,
+                                   const uint8_t* __restrict down, uint8_t base, uint8_t width,
+                                   int32_t a, int32_t b, uint8_t* __restrict out) {
+  for (int32_t x = a; x < b; ++x) {
+    out[x] = static_cast<uint8_t>(static_cast<uint8_t>(up[x] - base) <= width) |
+             static_cast<uint8_t>(static_cast<uint8_t>(f[x] - base) <= width) |
+             static_cast<uint8_t>(static_cast<uint8_t>(down[x] - base) <= width);
+  }
+}
+
+}  // namespace
+
 LB_CLONES_AVX2 int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1,
                                                int32_t e0, int32_t e1) {
   Grid& g = grid();
@@ -62,15 +78,10 @@ LB_CLONES_AVX2 int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t
   if (restricted) {
     const int32_t lo = alpha - window_, top = alpha + window_;
     const uint8_t* fu = y > 0 ? f - w : f;
-    // One unsigned compare per label (a label below lo wraps above the window's width).
     const uint8_t base = static_cast<uint8_t>(lo > 0 ? lo : 0);
     const uint8_t width = static_cast<uint8_t>((top < 255 ? top : 255) - base);
     const int32_t xe1 = x1 + 1 < w ? x1 + 1 : w;
-    for (int32_t x = x0 > 0 ? x0 - 1 : 0; x < xe1; ++x) {
-      near[x] = static_cast<uint8_t>(static_cast<uint8_t>(fu[x] - base) <= width) |
-                static_cast<uint8_t>(static_cast<uint8_t>(f[x] - base) <= width) |
-                static_cast<uint8_t>(static_cast<uint8_t>(fd[x] - base) <= width);
-    }
+    MarkNearLabels(fu, f, fd, base, width, x0 > 0 ? x0 - 1 : 0, xe1, near);
     if (x0 == 0) near[-1] = 0;
     if (x1 == w) near[w] = 0;
   }
@@ -352,9 +363,7 @@ bool DepthStage::Expand(int32_t alpha) {
   if (near && count > 0) ComputeNear(disp_q8);
   for (int32_t i = 0; i < count; ++i) {
     const Rect& r = g.rects[i];
-    if (near) {
-      // D is at hand (ComputeNear).
-    } else if (on_coarse_ && block_costs_ != nullptr) {
+    if (on_coarse_ && block_costs_ != nullptr) {
       g.cost_alpha = CoarseCosts(alpha);  // the whole grid, from the winner-take-all
     } else if (on_coarse_) {
       BlockCosts(alpha, r, g.cost_alpha);
@@ -381,40 +390,33 @@ bool DepthStage::Expand(int32_t alpha) {
 LB_CLONES_AVX2 void DepthStage::ComputeNear(int32_t disp_q8) {
   const Grid& g = fine_;
   const int32_t w = g.width, h = g.height;
-  const Rect r{0, w, 0, h};
-  // One unsigned compare per label (a label below the base wraps above the window's width).
+  const Rect whole{0, w, 0, h};
   const uint8_t base = static_cast<uint8_t>(near_lo_);
   const uint8_t width = static_cast<uint8_t>(near_top_ - near_lo_);
   uint8_t* const near = run_marks_ + 1;      // near[-1 .. w]: a label near in the column
   uint8_t* const mark = run_marks_ + w + 3;  // mark[x]: one next to column x
   for (int32_t y = 0; y < h; ++y) {
     int32_t lo = 0, hi = 0;
-    NearColumns(r, y, &lo, &hi);
+    NearColumns(whole, y, &lo, &hi);
     if (lo >= hi) {
       runs_[y].count = 0;
       continue;
     }
     const uint8_t* f = g.labels + y * w;
-    const uint8_t* fu = y > 0 ? f - w : f;
-    const uint8_t* fd = y + 1 < h ? f + w : f;
     const int32_t a = lo > 0 ? lo - 1 : 0, b = hi < w ? hi + 1 : w;
-    for (int32_t x = a; x < b; ++x) {
-      near[x] = static_cast<uint8_t>(static_cast<uint8_t>(fu[x] - base) <= width) |
-                static_cast<uint8_t>(static_cast<uint8_t>(f[x] - base) <= width) |
-                static_cast<uint8_t>(static_cast<uint8_t>(fd[x] - base) <= width);
-    }
+    MarkNearLabels(y > 0 ? f - w : f, f, y + 1 < h ? f + w : f, base, width, a, b, near);
     near[a - 1] = near[b] = 0;
     for (int32_t x = lo; x < hi; ++x) {
       mark[x] = static_cast<uint8_t>(near[x - 1] | near[x] | near[x + 1]);
     }
     runs_[y].FromMarks(mark, lo, hi, w, data_.RunJoin());
   }
-  data_.ComputeRuns(disp_q8, runs_, r.y0, r.y1, fine_.cost_alpha + r.y0 * w, w);
-  for (int32_t y0 = r.y0; y0 < r.y1;) {
+  data_.ComputeRuns(disp_q8, runs_, 0, h, g.cost_alpha, w);
+  for (int32_t y0 = 0; y0 < h;) {
     const RowRuns& a = runs_[y0];
     int32_t y1 = y0 + 1;
     if (a.count == 1) {
-      while (y1 < r.y1 && runs_[y1].count == 1 && runs_[y1].x[0] == a.x[0] &&
+      while (y1 < h && runs_[y1].count == 1 && runs_[y1].x[0] == a.x[0] &&
              runs_[y1].x[1] == a.x[1]) {
         ++y1;
       }
