@@ -41,19 +41,25 @@ const middlebury::Set* Teddy() {
   return &set;
 }
 
+// Teddy's 64 quarter-pixel labels (0..63 px over its 4 view steps between im2 and im6).
+DepthConfig TeddyConfig(const middlebury::Set& set) {
+  DepthConfig c;
+  c.width = set.width;
+  c.height = set.height;
+  c.views = static_cast<int32_t>(set.views.size());
+  c.reference = set.reference;
+  c.labels = 64;
+  c.disp_max_q8 = 63 * 64;
+  return c;
+}
+
 void BM_DepthStageTeddy(benchmark::State& state) {
   const middlebury::Set* set = Teddy();
   if (!set) {
     state.SkipWithError("../shared/data/middlebury/teddy is absent");
     return;
   }
-  DepthConfig c;
-  c.width = set->width;
-  c.height = set->height;
-  c.views = static_cast<int32_t>(set->views.size());
-  c.reference = set->reference;
-  c.labels = 64;
-  c.disp_max_q8 = 63 * 64;
+  DepthConfig c = TeddyConfig(*set);
   c.subpixel = state.range(0) != 0;  // the refinement costs one more pass of the data term
   const size_t bytes = DepthStage::RequiredBytes(c);
   std::vector<uint8_t> memory(bytes + Arena::kAlign);
@@ -131,13 +137,20 @@ void BM_DepthStage640x480(benchmark::State& state) {
 }
 BENCHMARK(BM_DepthStage640x480)->Unit(benchmark::kMillisecond)->MinTime(3.0);
 
+// The synthetic handheld burst below, made once (nullptr when it cannot be).
+const motiontest::Burst* HandheldBurst() {
+  static motiontest::Burst burst;
+  static const bool made = motiontest::MakeBurst(motiontest::Handheld(1), 640, 480, 7, &burst);
+  return made ? &burst : nullptr;
+}
+
 // A synthetic handheld burst at 640x480, 7 views, with its true poses and 33 labels (as
 // depth_planes_accuracy_test's speed case): range(0) 1 for the plane sweep, 0 for the rectified
 // shifts over the same labels.
 void BM_HandheldDepth640x480(benchmark::State& state) {
-  static motiontest::Burst burst;
-  static const bool made = motiontest::MakeBurst(motiontest::Handheld(1), 640, 480, 7, &burst);
-  if (!made) return state.SkipWithError("no synthetic burst");
+  const motiontest::Burst* made = HandheldBurst();
+  if (made == nullptr) return state.SkipWithError("no synthetic burst");
+  const motiontest::Burst& burst = *made;
   const handheld::Labels l = handheld::HandheldLabels(burst, 0.1);
   DepthConfig c = l.config;
   const bool planes = state.range(0) != 0;
@@ -162,9 +175,9 @@ BENCHMARK(BM_HandheldDepth640x480)
 // slows both alike: one compute of each by turns, each timed on its own; the counters are each
 // side's median and the median of the per-turn ratios.
 void BM_HandheldPlanesOverRectified(benchmark::State& state) {
-  static motiontest::Burst burst;
-  static const bool made = motiontest::MakeBurst(motiontest::Handheld(1), 640, 480, 7, &burst);
-  if (!made) return state.SkipWithError("no synthetic burst");
+  const motiontest::Burst* made = HandheldBurst();
+  if (made == nullptr) return state.SkipWithError("no synthetic burst");
+  const motiontest::Burst& burst = *made;
   const handheld::Labels l = handheld::HandheldLabels(burst, 0.1);
   DepthConfig c = l.config;
   handheld::Stage sweep, shifts;
@@ -193,6 +206,14 @@ void BM_HandheldPlanesOverRectified(benchmark::State& state) {
 BENCHMARK(BM_HandheldPlanesOverRectified)->Unit(benchmark::kMillisecond)->MinTime(6.0);
 
 #ifdef LB_HAVE_OPENCV
+// Dense output (no uniqueness, left-right or speckle rejection), so bad_pct scores every pixel
+// as ours does; P1/P2 are OpenCV's usual 8/32 x channels x block area.
+cv::Ptr<cv::StereoSGBM> TeddySgbm() {
+  const int block = 5;
+  return cv::StereoSGBM::create(0, 64, block, 8 * 3 * block * block, 32 * 3 * block * block, -1, 63,
+                                0, 0, 0, cv::StereoSGBM::MODE_SGBM);
+}
+
 // Two-view SGBM on im2/im6 (disparities 0..63 px over 4 view steps, the same depth range as the
 // 64 quarter-pixel labels above), single thread.
 void BM_OpenCvSgbmTeddy(benchmark::State& state) {
@@ -205,11 +226,7 @@ void BM_OpenCvSgbmTeddy(benchmark::State& state) {
   // OpenCV wants BGR; the cost is colour-order independent, so the RGB bytes are used as they are.
   const cv::Mat left(set->height, set->width, CV_8UC3, const_cast<uint8_t*>(set->views[2].data()));
   const cv::Mat right(set->height, set->width, CV_8UC3, const_cast<uint8_t*>(set->views[6].data()));
-  const int block = 5;
-  // Dense output (no uniqueness, left-right or speckle rejection), so bad_pct scores every
-  // pixel as ours does; P1/P2 are OpenCV's usual 8/32 x channels x block area.
-  auto sgbm = cv::StereoSGBM::create(0, 64, block, 8 * 3 * block * block, 32 * 3 * block * block,
-                                     -1, 63, 0, 0, 0, cv::StereoSGBM::MODE_SGBM);
+  const cv::Ptr<cv::StereoSGBM> sgbm = TeddySgbm();
   cv::Mat disp;
   for (auto _ : state) {
     sgbm->compute(left, right, disp);
@@ -237,13 +254,7 @@ void BM_TeddyOverSgbm(benchmark::State& state) {
     state.SkipWithError("../shared/data/middlebury/teddy is absent");
     return;
   }
-  DepthConfig c;
-  c.width = set->width;
-  c.height = set->height;
-  c.views = static_cast<int32_t>(set->views.size());
-  c.reference = set->reference;
-  c.labels = 64;
-  c.disp_max_q8 = 63 * 64;
+  const DepthConfig c = TeddyConfig(*set);
   const size_t bytes = DepthStage::RequiredBytes(c);
   std::vector<uint8_t> memory(bytes + Arena::kAlign);
   Arena arena(Arena::AlignUp(memory.data()), bytes);
@@ -258,9 +269,7 @@ void BM_TeddyOverSgbm(benchmark::State& state) {
   cv::setNumThreads(1);
   const cv::Mat left(set->height, set->width, CV_8UC3, const_cast<uint8_t*>(set->views[2].data()));
   const cv::Mat right(set->height, set->width, CV_8UC3, const_cast<uint8_t*>(set->views[6].data()));
-  const int block = 5;  // as BM_OpenCvSgbmTeddy
-  auto sgbm = cv::StereoSGBM::create(0, 64, block, 8 * 3 * block * block, 32 * 3 * block * block,
-                                     -1, 63, 0, 0, 0, cv::StereoSGBM::MODE_SGBM);
+  const cv::Ptr<cv::StereoSGBM> sgbm = TeddySgbm();
   cv::Mat sgbm_disp;
   std::vector<double> ours, theirs, ratios;
   using Clock = std::chrono::steady_clock;
