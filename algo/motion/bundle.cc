@@ -255,11 +255,20 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
       }
       for (int32_t k = 0; k < nr; ++k) s(k, k) = s(k, k) * (1 + lambda) + eps;
       g2 = g;
+      // Only S's lower triangle: the Cholesky reads nothing else. Each entry as the full
+      // outer product s -= (hcw / hd) hcw^T computes it, in the same order over the points.
+      double scaled[kMaxReduced];
       for (int32_t j = 0; j < in.points; ++j) {
         if (!in.point_ok[j]) continue;
         const double hd = hww_[j] * (1 + lambda) + eps;
-        Eigen::Map<const Eigen::VectorXd> hcw(hcw_ + static_cast<size_t>(nr) * j, nr);
-        s.noalias() -= (hcw / hd) * hcw.transpose();
+        const double* h = hcw_ + static_cast<size_t>(nr) * j;
+        for (int32_t a = 0; a < nr; ++a) scaled[a] = h[a] / hd;
+        for (int32_t b = 0; b < nr; ++b) {
+          double* col = s_ + static_cast<size_t>(nr) * b;
+          const double hb = h[b];
+          for (int32_t a = b; a < nr; ++a) col[a] -= hb * scaled[a];
+        }
+        Eigen::Map<const Eigen::VectorXd> hcw(h, nr);
         g2 -= hcw * (gw_[j] / hd);
       }
       Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(s);

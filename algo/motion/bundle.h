@@ -64,6 +64,8 @@ struct BundleReport {
 class Bundle {
  public:
   static constexpr int32_t kMaxViews = 16;
+  // Unknowns of the reduced system: 6 per view but the reference's, k1 and k0.
+  static constexpr int32_t kMaxReduced = 6 * (kMaxViews - 1) + 2;
 
   Status Carve(int32_t max_views, int32_t max_points, Arena& arena);
 

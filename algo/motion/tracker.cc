@@ -3,18 +3,6 @@
 namespace lb {
 namespace {
 
-// Bilinear sample at Q16 index coordinates, Q4 result; the caller keeps (x, y) and (x+1, y+1)
-// inside the image.
-inline int32_t SampleQ4(const ImageU8& img, int32_t x_q16, int32_t y_q16) {
-  const int32_t ix = x_q16 >> 16, iy = y_q16 >> 16;
-  const int32_t fx = (x_q16 >> 8) & 255, fy = (y_q16 >> 8) & 255;
-  const uint8_t* a = img.Row(iy) + ix;
-  const uint8_t* b = a + img.stride;
-  const int32_t top = a[0] * (256 - fx) + a[1] * fx;
-  const int32_t bot = b[0] * (256 - fx) + b[1] * fx;
-  return (top * (256 - fy) + bot * fy + 2048) >> 12;
-}
-
 // True when the window of half size `half` around (x, y) can be sampled bilinearly.
 inline bool Inside(const ImageU8& img, int32_t x_q16, int32_t y_q16, int32_t half) {
   const int32_t x0 = (x_q16 >> 16) - half, y0 = (y_q16 >> 16) - half;
@@ -39,10 +27,13 @@ Status Tracker::Carve(const TrackerParams& params, Arena& arena, int32_t workers
   }
   params_ = params;
   workers_ = workers;
+  const tk::Kernels* simd = tk::SimdKernels();
+  kernels_ = simd != nullptr ? simd : &tk::kReference;
   const size_t t = 2 * static_cast<size_t>(params.radius) + 3;
   const size_t w = 2 * static_cast<size_t>(params.radius) + 1;
   for (int32_t i = 0; i < workers; ++i) {
     windows_[i].tmpl = arena.Allocate<int32_t>(t * t);
+    windows_[i].inner = arena.Allocate<int32_t>(w * w);
     windows_[i].gx = arena.Allocate<int32_t>(w * w);
     windows_[i].gy = arena.Allocate<int32_t>(w * w);
   }
@@ -120,17 +111,16 @@ bool Tracker::TrackOne(const Window& w, const GreyPyramid& ref, const GreyPyrami
       px = px < lo ? lo : (px > hx ? hx : px);
       py = py < lo ? lo : (py > hy ? hy : py);
     }
-    for (int32_t j = 0; j < tw; ++j) {
-      for (int32_t i = 0; i < tw; ++i) {
-        w.tmpl[j * tw + i] = SampleQ4(ti, px + ((i - r - 1) << 16), py + ((j - r - 1) << 16));
-      }
-    }
+    // The window's samples lie whole pixels apart: one fraction for all (tracker_kernels.h).
+    kernels_->sample(ti.Row((py >> 16) - r - 1) + (px >> 16) - r - 1, ti.stride, (px >> 8) & 255,
+                     (py >> 8) & 255, tw, w.tmpl);
     int64_t gxx = 0, gyy = 0, gxy = 0;
     for (int32_t j = 0; j < ww; ++j) {
       for (int32_t i = 0; i < ww; ++i) {
         const int32_t* t = w.tmpl + (j + 1) * tw + (i + 1);
         const int32_t gx = t[1] - t[-1];
         const int32_t gy = t[tw] - t[-tw];
+        w.inner[j * ww + i] = t[0];
         w.gx[j * ww + i] = gx;
         w.gy[j * ww + i] = gy;
         gxx += int64_t{gx} * gx;
@@ -150,16 +140,10 @@ bool Tracker::TrackOne(const Window& w, const GreyPyramid& ref, const GreyPyrami
         if (!coarse) return false;
         break;
       }
-      int64_t bx = 0, by = 0, abs_err = 0;
-      for (int32_t j = 0; j < ww; ++j) {
-        for (int32_t i = 0; i < ww; ++i) {
-          const int32_t e = SampleQ4(vi, qx + ((i - r) << 16), qy + ((j - r) << 16)) -
-                            w.tmpl[(j + 1) * tw + (i + 1)];
-          bx += int64_t{w.gx[j * ww + i]} * e;
-          by += int64_t{w.gy[j * ww + i]} * e;
-          abs_err += e < 0 ? -e : e;
-        }
-      }
+      const tk::WindowSums sums =
+          kernels_->sums(vi.Row((qy >> 16) - r) + (qx >> 16) - r, vi.stride, (qx >> 8) & 255,
+                         (qy >> 8) & 255, ww, w.inner, w.gx, w.gy);
+      const int64_t bx = sums.bx, by = sums.by, abs_err = sums.abs_err;
       mean_error = static_cast<int32_t>(abs_err / (ww * ww));
       const double sx = 2.0 * (c * static_cast<double>(bx) - b * static_cast<double>(by)) / det;
       const double sy = 2.0 * (a * static_cast<double>(by) - b * static_cast<double>(bx)) / det;

@@ -16,6 +16,7 @@
 #include "algo/core/status.h"
 #include "algo/core/task_runner.h"
 #include "algo/motion/pyramid.h"
+#include "algo/motion/tracker_kernels.h"
 
 namespace lb {
 
@@ -46,8 +47,9 @@ class Tracker {
  private:
   // One worker's window.
   struct Window {
-    int32_t* tmpl = nullptr;  // (2r+3)^2 reference samples, Q4
-    int32_t* gx = nullptr;    // (2r+1)^2
+    int32_t* tmpl = nullptr;   // (2r+3)^2 reference samples, Q4
+    int32_t* inner = nullptr;  // (2r+1)^2: its inner window, row after row
+    int32_t* gx = nullptr;     // (2r+1)^2
     int32_t* gy = nullptr;
   };
   void TrackRange(const Window& w, const GreyPyramid& ref, const GreyPyramid& view,
@@ -60,6 +62,7 @@ class Tracker {
                 int32_t* error_q4) const;
 
   TrackerParams params_;
+  const tk::Kernels* kernels_ = &tk::kReference;  // picked at Carve (tracker_kernels.h)
   Window windows_[kMaxWorkers];
   int32_t workers_ = 1;
 };
