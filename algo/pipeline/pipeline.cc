@@ -138,7 +138,7 @@ Status Pipeline::Carve(Arena& arena) {
   disp_q8_ = arena.AllocateImage<uint16_t>(work_w_, work_h_);
   rgb_rows_[0] = arena.Allocate<uint8_t>(static_cast<size_t>(c.width) * 3);
   rgb_rows_[1] = arena.Allocate<uint8_t>(static_cast<size_t>(c.width) * 3);
-  acc_ = arena.Allocate<uint32_t>(static_cast<size_t>(work_w_) * 3);
+  cols_ = arena.Allocate<uint32_t>(static_cast<size_t>(work_w_) * scale_ * 3);
   if (UsesMotion(c, work_w_, work_h_)) {
     planes_ = arena.Allocate<PlaneHomography>(static_cast<size_t>(c.frames) * c.labels);
     order_scratch_ = arena.Allocate<uint8_t>(DepthOrderScratchBytes(work_w_, work_h_));
@@ -227,7 +227,7 @@ Status Pipeline::BeginFrame(const FrameInfo& info) {
   in_frame_ = true;
   next_row_ = 0;
   depth_ready_ = false;
-  memset(acc_, 0, static_cast<size_t>(work_w_) * 3 * sizeof(uint32_t));
+  memset(cols_, 0, static_cast<size_t>(work_w_) * scale_ * 3 * sizeof(uint32_t));
   return Status::Ok();
 }
 
@@ -270,13 +270,13 @@ void Pipeline::IngestRow(const uint8_t* src, const uint8_t* uv, int32_t y, const
     RowRgb8ToY(rgb, n, ref_.planes[0].Row(y) + c.x0);
     if ((y & 1) || y == config_.height - 1) FlushChroma(y, c);
   }
-  // Integer box downscale: accumulate `scale_` rows, then write their mean (rounded).
+  // Integer box downscale: `scale_` rows into the column sums, then each box's mean (rounded).
   const int32_t s = scale_;
   if (y >= work_h_ * s || c.wx1 <= c.wx0) return;
-  uint32_t* acc = acc_ + 3 * c.wx0;
-  ingest::BoxAccumulateRowC(rgb, c.wx1 - c.wx0, s, acc);
+  uint32_t* cols = cols_ + 3 * static_cast<ptrdiff_t>(c.wx0) * s;
+  ingest::ColumnAccumulateRowC(rgb, 3 * (c.wx1 - c.wx0) * s, cols);
   if ((y + 1) % s == 0) {
-    ingest::BoxEmitRowC(acc, (c.wx1 - c.wx0) * 3, s, working_[frame_.index].Row(y / s) + 3 * c.wx0);
+    ingest::BoxEmitColumnsC(cols, c.wx1 - c.wx0, s, working_[frame_.index].Row(y / s) + 3 * c.wx0);
   }
 }
 

@@ -125,7 +125,7 @@ class Pipeline : public FrameSink {
   ImageU8 working_[PipelineConfig::kMaxFrames];  // working-resolution views, RGB8
   ImageU16 disp_q8_;                             // working-resolution disparity, Q8.8
   uint8_t* rgb_rows_[2] = {nullptr, nullptr};    // full-width RGB8 rows (even, odd)
-  uint32_t* acc_ = nullptr;                      // box-downscale accumulator, working row x 3
+  uint32_t* cols_ = nullptr;  // box downscale: column sums, working row x scale x 3 (ingest.h)
   DepthStage depth_;
   RenderStage render_;
   MotionStage motion_;  // kAuto only

@@ -15,14 +15,14 @@ namespace {
 std::vector<uint8_t> Downscale(const std::vector<std::vector<uint8_t>>& rows, int32_t w,
                                int32_t scale) {
   const int32_t ow = w / scale, oh = static_cast<int32_t>(rows.size()) / scale;
-  std::vector<uint32_t> acc(3 * ow, 0);
+  std::vector<uint32_t> cols(3 * static_cast<size_t>(ow) * scale, 0);
   std::vector<uint8_t> out(3 * static_cast<size_t>(ow) * oh, 0);
   for (int32_t y = 0; y < oh * scale; ++y) {
-    ingest::BoxAccumulateRowC(rows[y].data(), ow, scale, acc.data());
+    ingest::ColumnAccumulateRowC(rows[y].data(), 3 * ow * scale, cols.data());
     if ((y + 1) % scale == 0)
-      ingest::BoxEmitRowC(acc.data(), 3 * ow, scale, &out[3 * ow * (y / scale)]);
+      ingest::BoxEmitColumnsC(cols.data(), ow, scale, &out[3 * ow * (y / scale)]);
   }
-  for (uint32_t a : acc) EXPECT_EQ(a, 0u);  // every emit clears its accumulator
+  for (uint32_t a : cols) EXPECT_EQ(a, 0u);  // every emit clears the column sums
   return out;
 }
 
@@ -76,11 +76,11 @@ TEST(Ingest, TheLargestBoxOfWhiteDoesNotOverflow) {
                     uint64_t{ingest::kMaxBoxScale} * ingest::kMaxBoxScale / 2 <
                 uint64_t{1} << 32);
   const std::vector<uint8_t> white(3 * static_cast<size_t>(s), 255);
-  std::vector<uint32_t> acc(3, 0);
-  for (int32_t y = 0; y < s; ++y) ingest::BoxAccumulateRowC(white.data(), 1, s, acc.data());
-  EXPECT_EQ(acc[0], static_cast<uint32_t>(uint64_t{255} * s * s));
+  std::vector<uint32_t> cols(3 * static_cast<size_t>(s), 0);
+  for (int32_t y = 0; y < s; ++y) ingest::ColumnAccumulateRowC(white.data(), 3 * s, cols.data());
+  EXPECT_EQ(cols[0], static_cast<uint32_t>(255 * s));
   uint8_t out[3] = {};
-  ingest::BoxEmitRowC(acc.data(), 3, s, out);
+  ingest::BoxEmitColumnsC(cols.data(), 1, s, out);
   EXPECT_EQ(out[0], 255);
   EXPECT_EQ(out[1], 255);
   EXPECT_EQ(out[2], 255);
