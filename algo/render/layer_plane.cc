@@ -205,7 +205,7 @@ void LayerPlane::BuildPrefixT(Scratch& sc, int32_t k, int32_t level, int32_t h, 
         } else if (pure & bit) {  // wholly in the layer: weight 256 everywhere
           layer_rows::PurePrefixRowC<C>(v, shift, t0, t1, p);
         } else {
-          layer_rows::WeightedPrefixRowC<C>(v, s, layer_of, offset, k, shift, t0, t1, p);
+          rows_->weighted_prefix[C - 1](v, s, layer_of, offset, k, shift, t0, t1, p);
         }
       }
     } else {

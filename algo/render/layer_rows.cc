@@ -246,7 +246,8 @@ const Kernels kReference = {GatherRowC,
                             NormaliseColourRowC,
                             BlendRowsC,
                             BoxPrefixRowC,
-                            ResolveRowC};
+                            ResolveRowC,
+                            {WeightedPrefixRowC<1>, WeightedPrefixRowC<2>}};
 
 #if defined(LB_ROW_AVX2)
 LB_ROW_AVX2 void GatherRowCAvx2(const uint32_t* p, const KernelRow& k, uint32_t* acc, int32_t x0,

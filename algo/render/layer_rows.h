@@ -153,6 +153,11 @@ struct Kernels {
   void (*box_prefix)(const int32_t* box, int32_t level, int32_t q0, int32_t q1, uint32_t* p);
   void (*resolve)(const int32_t* out, const int32_t* alpha, const int16_t* v, int32_t width,
                   int32_t bias, uint8_t* dst);
+  // WeightedPrefixRowC<1> and <2>: the running sums eight (AVX2) or four (NEON) columns a step,
+  // each step's own prefix in-register (wrapping uint32, as the reference), then its carry.
+  void (*weighted_prefix[2])(const int16_t* const* v, const int16_t* s, const uint16_t* layer_of,
+                             int32_t offset, int32_t k, int32_t shift, int32_t x0, int32_t x1,
+                             uint32_t* const* p);
 };
 
 extern const Kernels kReference;

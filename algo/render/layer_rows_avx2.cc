@@ -153,6 +153,36 @@ LB_AVX2 void WeightedBoxAvx2T(const int16_t* const* v, const int16_t* s, const u
   WeightedBoxRowC<C>(v, s, layer_of, offset, k, shift, L, x, x1, box);
 }
 
+// As WeightedPrefixRowC: the same increments as WeightedBoxAvx2T's, their running sums over
+// 8 columns in-register (each 128-bit half's own by two shifts, then the low half's total into
+// the high one), plus the prefix before the step; wrapping uint32 adds, so the same bits.
+template <int C>
+LB_AVX2 void WeightedPrefixRowAvx2(const int16_t* const* v, const int16_t* s,
+                                   const uint16_t* layer_of, int32_t offset, int32_t k,
+                                   int32_t shift, int32_t x0, int32_t x1, uint32_t* const* p) {
+  const __m128i count = _mm_cvtsi32_si128(shift);
+  const __m256i layer = _mm256_set1_epi32(k), last = _mm256_set1_epi32(7);
+  const __m256i third = _mm256_set1_epi32(3);
+  __m256i before[C + 1];
+  for (int32_t c = 0; c <= C; ++c) before[c] = _mm256_set1_epi32(static_cast<int32_t>(p[c][x0]));
+  int32_t x = x0;
+  for (; x + 7 <= x1; x += 8) {
+    const __m256i a = Weights(s + x, layer_of + offset, layer);
+    for (int32_t c = 0; c <= C; ++c) {
+      const __m256i t =
+          c == C ? a : _mm256_sra_epi32(_mm256_mullo_epi32(Widen(v[c] + x), a), count);
+      __m256i u = _mm256_add_epi32(t, _mm256_slli_si256(t, 4));
+      u = _mm256_add_epi32(u, _mm256_slli_si256(u, 8));
+      const __m256i low = _mm256_permutevar8x32_epi32(u, third);
+      u = _mm256_add_epi32(u, _mm256_blend_epi32(_mm256_setzero_si256(), low, 0xf0));
+      const __m256i out = _mm256_add_epi32(u, before[c]);
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(p[c] + x + 1), out);
+      before[c] = _mm256_permutevar8x32_epi32(out, last);
+    }
+  }
+  WeightedPrefixRowC<C>(v, s, layer_of, offset, k, shift, x, x1, p);
+}
+
 // As PureBoxRowC: v << (8 - shift) summed per box (the sum of the shifted values equals the
 // shifted sum, modulo 2^32 as the reference's int32), and the weight 256 per pixel.
 template <int C, int L>
@@ -322,7 +352,8 @@ const Kernels* Avx2Kernels() {
                                     NormaliseColourRowAvx2,
                                     BlendRowsAvx2,
                                     BoxPrefixRowAvx2,
-                                    ResolveRowAvx2};
+                                    ResolveRowAvx2,
+                                    {WeightedPrefixRowAvx2<1>, WeightedPrefixRowAvx2<2>}};
   return __builtin_cpu_supports("avx2") ? &kAvx2 : nullptr;
 }
 

@@ -124,6 +124,33 @@ inline int32x4_t Weights(const int16_t* s, const uint16_t* table, int32x4_t k) {
   return vorrq_s32(in_first, in_next);
 }
 
+// As WeightedPrefixRowC: the same increments as WeightedBoxNeonT's, their running sums over 4
+// columns in-register (two shifts), plus the prefix before the step; wrapping uint32 adds, so
+// the same bits.
+template <int C>
+void WeightedPrefixRowNeon(const int16_t* const* v, const int16_t* s, const uint16_t* layer_of,
+                           int32_t offset, int32_t k, int32_t shift, int32_t x0, int32_t x1,
+                           uint32_t* const* p) {
+  const int32x4_t down = vdupq_n_s32(-shift), layer = vdupq_n_s32(k);
+  const uint32x4_t zero = vdupq_n_u32(0);
+  uint32x4_t before[C + 1];
+  for (int32_t c = 0; c <= C; ++c) before[c] = vdupq_n_u32(p[c][x0]);
+  int32_t x = x0;
+  for (; x + 3 <= x1; x += 4) {
+    const int32x4_t a = Weights(s + x, layer_of + offset, layer);
+    for (int32_t c = 0; c <= C; ++c) {
+      const uint32x4_t t = vreinterpretq_u32_s32(
+          c == C ? a : vshlq_s32(vmulq_s32(vmovl_s16(vld1_s16(v[c] + x)), a), down));
+      uint32x4_t u = vaddq_u32(t, vextq_u32(zero, t, 3));
+      u = vaddq_u32(u, vextq_u32(zero, u, 2));
+      const uint32x4_t out = vaddq_u32(u, before[c]);
+      vst1q_u32(p[c] + x + 1, out);
+      before[c] = vdupq_n_u32(vgetq_lane_u32(out, 3));
+    }
+  }
+  WeightedPrefixRowC<C>(v, s, layer_of, offset, k, shift, x, x1, p);
+}
+
 // As WeightedBoxRowC: c = (v x a) >> shift per pixel (|v x a| <= 2^15 x 2^8, int32), the weight
 // a itself in the last plane, each box's columns summed in-register. A step is a whole number
 // of boxes (4 columns, 2^L from level 2), from x0 (a multiple of 2^L); the rest in C.
@@ -296,7 +323,8 @@ const Kernels* NeonKernels() {
                                     NormaliseColourRowNeon,
                                     BlendRowsNeon,
                                     BoxPrefixRowNeon,
-                                    ResolveRowNeon};
+                                    ResolveRowNeon,
+                                    {WeightedPrefixRowNeon<1>, WeightedPrefixRowNeon<2>}};
   return &kNeon;
 }
 

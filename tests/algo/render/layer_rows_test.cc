@@ -429,6 +429,41 @@ TEST(LayerRows, PrefixRowsAddEachPixelsWeightedValue) {
   }
 }
 
+// The weighted prefix rows' twins against the reference, from any start, over lengths that
+// leave every remainder of a step and with the largest values.
+template <int C>
+void CheckPrefixRowVariants(std::mt19937& rng, int32_t trial) {
+  const int32_t n = 1 + trial % 90, k = trial % 4, shift = trial % 9;
+  const LayerInput<C> in(rng, n, trial % 3 == 0);
+  const int32_t x0 = static_cast<int32_t>(rng() % n);
+  std::vector<uint32_t> start(C + 1);
+  for (uint32_t& v : start) v = rng();
+  const auto run = [&](const Kernels* kernels) {
+    std::vector<std::vector<uint32_t>> prefix(C + 1, std::vector<uint32_t>(n + 1, 0));
+    uint32_t* p[C + 1];
+    for (int32_t c = 0; c <= C; ++c) {
+      prefix[c][x0] = start[c];
+      p[c] = prefix[c].data();
+    }
+    kernels->weighted_prefix[C - 1](in.rows, in.s.data(), in.layer_of.data(),
+                                    LayerInput<C>::kOffset, k, shift, x0, n - 1, p);
+    return prefix;
+  };
+  const auto want = run(&layer_rows::kReference);
+  for (const auto& [name, kernels] : Variants()) {
+    ASSERT_EQ(run(kernels), want) << name << " C " << C << " trial " << trial;
+  }
+}
+
+TEST(LayerRows, PrefixRowVariantsEqualTheReference) {
+  SkipWithoutVariants();
+  std::mt19937 rng(36);
+  for (int32_t trial = 0; trial < 300; ++trial) {
+    CheckPrefixRowVariants<1>(rng, trial);
+    CheckPrefixRowVariants<2>(rng, trial);
+  }
+}
+
 // A box row's case: a level, a layer, a shift, columns [x0, x1] from a box edge, and the rows
 // of a pixel mix and of a tile wholly in the layer.
 template <int C>
