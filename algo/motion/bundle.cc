@@ -73,8 +73,14 @@ double PriorCost(const BundleInput& in, const ViewMotion* motion, double k1, dou
 // s -= scaled h^T on and below the diagonal of the nr x nr column-major s. Each entry is one
 // product and one difference whatever the lanes (no contraction: -ffp-contract=off), so the
 // AVX2 copy and the optimisation this file's -O2 leaves out give the same bits.
-LB_CLONES_AVX2 __attribute__((optimize("tree-vectorize"))) void LowerUpdate(
-    const double* __restrict h, const double* __restrict scaled, int32_t nr, double* __restrict s) {
+#if defined(__GNUC__) && !defined(__clang__)
+#define LB_VECTORIZE __attribute__((optimize("tree-vectorize")))  // this file is built -O2
+#else
+#define LB_VECTORIZE
+#endif
+LB_CLONES_AVX2 LB_VECTORIZE void LowerUpdate(const double* __restrict h,
+                                             const double* __restrict scaled, int32_t nr,
+                                             double* __restrict s) {
   for (int32_t b = 0; b < nr; ++b) {
     double* col = s + static_cast<size_t>(nr) * b;
     const double hb = h[b];
