@@ -81,10 +81,7 @@ LB_AVX2 WindowSums SumsAvx2(const uint8_t* p, ptrdiff_t stride, int32_t fx, int3
     }
     for (; i < n; ++i) {
       const int32_t k = k0 + i;
-      const int32_t e = SampleQ4(a + i, stride, fx, fy) - tmpl[k];
-      s.bx += int64_t{gx[k]} * e;
-      s.by += int64_t{gy[k]} * e;
-      s.abs_err += e < 0 ? -e : e;
+      AddError(SampleQ4(a + i, stride, fx, fy) - tmpl[k], gx[k], gy[k], &s);
     }
   }
   s.bx += LaneSum(bx);

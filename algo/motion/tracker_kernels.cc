@@ -17,10 +17,7 @@ WindowSums SumsC(const uint8_t* p, ptrdiff_t stride, int32_t fx, int32_t fy, int
   for (int32_t j = 0; j < n; ++j) {
     for (int32_t i = 0; i < n; ++i) {
       const int32_t k = j * n + i;
-      const int32_t e = SampleQ4(p + j * stride + i, stride, fx, fy) - tmpl[k];
-      s.bx += int64_t{gx[k]} * e;
-      s.by += int64_t{gy[k]} * e;
-      s.abs_err += e < 0 ? -e : e;
+      AddError(SampleQ4(p + j * stride + i, stride, fx, fy) - tmpl[k], gx[k], gy[k], &s);
     }
   }
   return s;

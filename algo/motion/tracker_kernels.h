@@ -45,4 +45,11 @@ inline int32_t SampleQ4(const uint8_t* a, ptrdiff_t stride, int32_t fx, int32_t 
   return (top * (256 - fy) + bot * fy + 2048) >> 12;
 }
 
+// One sample's error e against the template, into the sums, as every kernel adds it.
+inline void AddError(int32_t e, int32_t gx, int32_t gy, WindowSums* s) {
+  s->bx += int64_t{gx} * e;
+  s->by += int64_t{gy} * e;
+  s->abs_err += e < 0 ? -e : e;
+}
+
 }  // namespace lb::tk
