@@ -8,6 +8,7 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
 #include <deque>
@@ -37,6 +38,7 @@ class TestButton : public Button {
     cv_.notify_all();
   }
   Status Wait(int32_t timeout_ms, ButtonEvent* event) override {
+    ++waits;
     std::unique_lock<std::mutex> lock(mutex_);
     cv_.wait_for(lock, milliseconds(timeout_ms), [this] { return broken_ || !events_.empty(); });
     *event = ButtonEvent::kNone;
@@ -47,6 +49,9 @@ class TestButton : public Button {
     }
     return Status::Ok();
   }
+
+  // Calls of Wait begun: the daemon enters one after each of its checks.
+  std::atomic<int> waits{0};
 
  private:
   std::mutex mutex_;
@@ -563,11 +568,17 @@ TEST_F(CameraDaemonTest, ChangedProblemIsLoggedAndLookedAtSoonAgain) {
   StartDaemon();
   EXPECT_EQ(sink_.Count("error: camera test0: no such device"), 1) << sink_.All();
   EXPECT_EQ(sink_.Count("error: output folder"), 1) << sink_.All();
+  // Until the n-th check has been made and the daemon waits again: the clock is moved, or the
+  // camera brought, only then, or the check would see them (as a slow machine once showed).
   auto wait_probes = [this](int n) {
     for (int i = 0; i < 1000 && sensor_.probes.load() < n; ++i) {
       std::this_thread::sleep_for(milliseconds(10));
     }
-    return sensor_.probes.load() == n;
+    const int waits = button_.waits.load();
+    for (int i = 0; i < 1000 && button_.waits.load() == waits; ++i) {
+      std::this_thread::sleep_for(milliseconds(10));
+    }
+    return sensor_.probes.load() == n && button_.waits.load() > waits;
   };
   // Checks at 1 and 3 s find the same; the camera appears before the one at 7 s.
   clock_.Advance(1000000000);
