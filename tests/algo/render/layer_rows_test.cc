@@ -15,11 +15,6 @@
 #include <random>
 #include <vector>
 
-#if defined(__arm__)
-#include <asm/hwcap.h>
-#include <sys/auxv.h>
-#endif
-
 namespace lb {
 namespace {
 
@@ -33,14 +28,10 @@ constexpr int32_t kMaxC = 2147483647 / (kCells * 256);  // |c| that keeps a kern
 std::vector<std::pair<const char*, const Kernels*>> Variants() {
   std::vector<std::pair<const char*, const Kernels*>> v = {{"C", &layer_rows::kReference}};
   if (const Kernels* k = layer_rows::Avx2Kernels()) v.emplace_back("AVX2", k);
-  if (const Kernels* k = layer_rows::NeonKernels()) {
-#if defined(__arm__)
-    // armhf builds the NEON twins whatever its baseline: run them only where the CPU has NEON.
-    if (getauxval(AT_HWCAP) & HWCAP_NEON) v.emplace_back("NEON", k);
-#else
-    v.emplace_back("NEON", k);
-#endif
-  }
+  // armhf builds the NEON twins whatever its baseline: run them only where the CPU has NEON (as
+  // the tests' main read it, tests/support/test_main.cc).
+  const Kernels* neon = layer_rows::NeonKernels();
+  if (neon != nullptr && CurrentCpu().neon) v.emplace_back("NEON", neon);
   return v;
 }
 
