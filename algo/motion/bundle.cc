@@ -13,17 +13,22 @@ using Mat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
 
 Mat3 Rot(const ViewMotion& m) { return Eigen::Map<const Mat3>(&m.rotation[0][0]); }
 
+// a . b over three terms as Eigen's unrolled sum adds them (a0 b0 + (a1 b1 + a2 b2)), so that
+// the products written out here give the bits the Eigen expressions gave.
+inline double Dot3(double a0, double a1, double a2, double b0, double b1, double b2) {
+  return a0 * b0 + (a1 * b1 + a2 * b2);
+}
+
 // Undistorted normalised coordinates of a distorted observation p: p (1 + k0 + k1 |p|^2).
 Eigen::Vector2d Undistort(const double* p, double k1, double k0) {
   return Eigen::Vector2d(p[0], p[1]) * UndistortScale(k1, p[0], p[1], k0);
 }
 
-// Point on the reference ray of `point` at inverse depth w, in view coordinates (up to scale);
-// rr receives R r.
-Vec3 Ray(const BundleInput& in, const ViewMotion& m, double w, double k1, double k0, int32_t point,
-         Vec3* rr) {
-  const Eigen::Vector2d u = Undistort(in.ref_xy + 2 * point, k1, k0);
-  *rr = Rot(m) * Vec3(u[0], u[1], 1.0);
+// Point on the reference ray through u (the point's undistorted reference observation) at
+// inverse depth w, in view coordinates (up to scale); rr receives R r.
+inline Vec3 Ray(const ViewMotion& m, double w, const Eigen::Vector2d& u, Vec3* rr) {
+  const double(*r)[3] = m.rotation;
+  for (int32_t i = 0; i < 3; ++i) (*rr)[i] = Dot3(r[i][0], r[i][1], r[i][2], u[0], u[1], 1.0);
   return *rr + w * Eigen::Map<const Vec3>(m.translation);
 }
 
@@ -88,6 +93,42 @@ LB_CLONES_AVX2 LB_VECTORIZE void LowerUpdate(const double* __restrict h,
   }
 }
 
+// One observation's share of the normal equations: H += rw Jc^T Jc (camera block b, the
+// column-major nc x 6 hcc at h), g -= rw Jc^T e, hcw += rw Jc^T jw. Written out so it inlines,
+// in the order Eigen's products gave (each entry of rw Jc^T times a column summed over the two
+// rows, then added): the same bits.
+inline void AddObservation(const Eigen::Matrix<double, 2, 6>& jc, double rw,
+                           const Eigen::Vector2d& e, const Eigen::Vector2d& jw, double* h,
+                           int32_t nc, double* g, double* hcw) {
+  double l0[6], l1[6];
+  for (int32_t i = 0; i < 6; ++i) {
+    l0[i] = rw * jc(0, i);
+    l1[i] = rw * jc(1, i);
+  }
+  for (int32_t j = 0; j < 6; ++j) {
+    double* col = h + static_cast<ptrdiff_t>(nc) * j;
+    const double c0 = jc(0, j), c1 = jc(1, j);
+    for (int32_t i = 0; i < 6; ++i) col[i] += l0[i] * c0 + l1[i] * c1;
+  }
+  for (int32_t i = 0; i < 6; ++i) g[i] -= l0[i] * e[0] + l1[i] * e[1];
+  for (int32_t i = 0; i < 6; ++i) hcw[i] += l0[i] * jw[0] + l1[i] * jw[1];
+}
+
+// ErrorPx with the point's undistorted reference observation u given (the same in every view).
+double Error(const BundleInput& in, const ViewMotion& m, double w, const Eigen::Vector2d& u,
+             double k1, int32_t view, int32_t point, double k0) {
+  Vec3 rr;
+  const Vec3 a = Ray(m, w, u, &rr);
+  // A point behind the view's camera (or at its centre) is no fit of the observation, however
+  // its projection happens to fall: with signed inverse depths a step could otherwise flip
+  // points through the camera into a fit that wanders off.
+  if (!(a[2] > 1e-6 * rr.norm())) return Bundle::kBehindPx;
+  const Eigen::Vector2d o = Undistort(Obs(in, view, point), k1, k0);
+  const double ex = in.fx * (a[0] / a[2] - o[0]), ey = in.fy * (a[1] / a[2] - o[1]);
+  // In px of the focal length the fit holds, fx / (1 + k0): the frames' own pixels.
+  return __builtin_sqrt(ex * ex + ey * ey) / (1 + k0);
+}
+
 }  // namespace
 
 Status Bundle::Carve(int32_t max_views, int32_t max_points, Arena& arena) {
@@ -112,16 +153,7 @@ Status Bundle::Carve(int32_t max_views, int32_t max_points, Arena& arena) {
 
 double Bundle::ErrorPx(const BundleInput& in, const ViewMotion& m, double w, double k1,
                        int32_t view, int32_t point, double k0) {
-  Vec3 rr;
-  const Vec3 a = Ray(in, m, w, k1, k0, point, &rr);
-  // A point behind the view's camera (or at its centre) is no fit of the observation, however
-  // its projection happens to fall: with signed inverse depths a step could otherwise flip
-  // points through the camera into a fit that wanders off.
-  if (!(a[2] > 1e-6 * rr.norm())) return kBehindPx;
-  const Eigen::Vector2d o = Undistort(Obs(in, view, point), k1, k0);
-  const double ex = in.fx * (a[0] / a[2] - o[0]), ey = in.fy * (a[1] / a[2] - o[1]);
-  // In px of the focal length the fit holds, fx / (1 + k0): the frames' own pixels.
-  return __builtin_sqrt(ex * ex + ey * ey) / (1 + k0);
+  return Error(in, m, w, Undistort(in.ref_xy + 2 * point, k1, k0), k1, view, point, k0);
 }
 
 double Bundle::Cost(const BundleInput& in, const ViewMotion* motion, const double* w, double k1,
@@ -130,9 +162,10 @@ double Bundle::Cost(const BundleInput& in, const ViewMotion* motion, const doubl
   int32_t n = 0;
   for (int32_t j = 0; j < in.points; ++j) {
     if (!in.point_ok[j]) continue;
+    const Eigen::Vector2d u = Undistort(in.ref_xy + 2 * j, k1, k0);  // the same in every view
     for (int32_t v = 0; v < in.views; ++v) {
       if (v == in.reference || !ObsOk(in, v, j)) continue;
-      const double e = ErrorPx(in, motion[v], w[j], k1, v, j, k0);
+      const double e = Error(in, motion[v], w[j], u, k1, v, j, k0);
       cost += Huber(e * e, huber);
       ++n;
     }
@@ -186,10 +219,11 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
       if (!in.point_ok[j]) continue;
       const double* rd = in.ref_xy + 2 * j;
       const double rd2 = rd[0] * rd[0] + rd[1] * rd[1];
+      const Eigen::Vector2d u = Undistort(rd, kd, kz);
       for (int32_t v = 0; v < in.views; ++v) {
         if (v == in.reference || !ObsOk(in, v, j)) continue;
         Vec3 rr;
-        const Vec3 a = Ray(in, motion[v], w[j], kd, kz, j, &rr);
+        const Vec3 a = Ray(motion[v], w[j], u, &rr);
         const double* od = Obs(in, v, j);
         const Eigen::Vector2d o = Undistort(od, kd, kz);
         const double iz = 1.0 / a[2];
@@ -205,13 +239,17 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
         Mat3 skew;  // d(R r)/dd = -[R r]x
         skew << 0, rr[2], -rr[1], -rr[2], 0, rr[0], rr[1], -rr[0], 0;
         Eigen::Matrix<double, 2, 6> jc;
-        jc.leftCols<3>() = ja * skew;
-        jc.rightCols<3>() = ja * w[j];
-        const Eigen::Vector2d jw = ja * Eigen::Map<const Vec3>(motion[v].translation);
+        const double* t = motion[v].translation;
+        Eigen::Vector2d jw;
+        for (int32_t r = 0; r < 2; ++r) {
+          for (int32_t k = 0; k < 3; ++k) {
+            jc(r, k) = Dot3(ja(r, 0), ja(r, 1), ja(r, 2), skew(0, k), skew(1, k), skew(2, k));
+            jc(r, 3 + k) = ja(r, k) * w[j];
+          }
+          jw[r] = Dot3(ja(r, 0), ja(r, 1), ja(r, 2), t[0], t[1], t[2]);
+        }
         const int32_t b = block(v);
-        hcc.block<6, 6>(b, 0) += rw * jc.transpose() * jc;
-        g.segment<6>(b) -= rw * jc.transpose() * e;
-        hcw.segment<6>(b) += rw * jc.transpose() * jw;
+        AddObservation(jc, rw, e, jw, hcc_ + b, nc, g_ + b, hcw.data() + b);
         hww_[j] += rw * jw.squaredNorm();
         gw_[j] -= rw * jw.dot(e);
         if (k1 || k0) {
