@@ -131,16 +131,21 @@ class XmpBuild final : public PendingSegments {
   double build_s_ = 0, wait_s_ = 0;
 };
 
-// The labeling's moves as the progress line's percentage.
+// The labeling's moves as the progress line's percentage (when there is a line), and when the
+// labeling began: the motion's estimate comes before it.
 class DepthProgress final : public ProgressSink {
  public:
   explicit DepthProgress(Progress* progress) : progress_(progress) {}
   void Report(int32_t done, int32_t total) override {
+    if (labeling_began_ < 0) labeling_began_ = Now();
+    if (progress_ == nullptr) return;
     progress_->Update("depth", static_cast<int32_t>(100 * int64_t{done} / (total > 0 ? total : 1)));
   }
+  double labeling_began() const { return labeling_began_; }
 
  private:
   Progress* progress_;
+  double labeling_began_ = -1;
 };
 
 }  // namespace
@@ -214,10 +219,8 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
   double t1 = Now();
   r.capture_s = t1 - t0;
   DepthProgress depth_progress(progress_);
-  if (progress_ != nullptr) {
-    progress_->Update("depth", 0);
-    p.SetProgress(&depth_progress);
-  }
+  if (progress_ != nullptr) progress_->Update("depth", 0);
+  p.SetProgress(&depth_progress);
   const Status depth = p.ComputeDepth();
   p.SetProgress(nullptr);
   LB_RETURN_IF_ERROR(depth);
@@ -225,6 +228,8 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
   if (progress_ != nullptr) progress_->Update("depth", 100);
   double t2 = Now();
   r.depth_s = t2 - t1;
+  r.motion_s =
+      depth_progress.labeling_began() >= 0 ? depth_progress.labeling_began() - t1 : r.depth_s;
   r.warning = p.depth_warning();
 
   LB_RETURN_IF_ERROR(p.BeginRender(options_.render));

@@ -42,6 +42,9 @@ struct JobOptions {
 
 struct JobReport {
   double capture_s = 0, depth_s = 0, render_s = 0;  // wall time of each stage
+  // Within depth_s: the camera motion's estimate (auto geometry) before the labeling began; all
+  // of depth_s when a burst gave no depth.
+  double motion_s = 0;
   // Within render_s: building the refocusable XMP (the original's JPEG, the depth PNG, base64,
   // MD5), beside the render when there are workers to spare, and how long the writer then waited
   // for it after the last strip.

@@ -186,11 +186,11 @@ int RunCommand(int argc, char** argv) {
             report.warning.message());
   }
   printf(
-      "wrote %s: %dx%d, %d frames, focus disparity %.2f px; capture %.2f s, depth %.2f s, "
-      "render+encode %.2f s, arena %.1f MiB, %d thread%s\n",
+      "wrote %s: %dx%d, %d frames, focus disparity %.2f px; capture %.2f s, depth %.2f s (motion "
+      "%.2f s), render+encode %.2f s, arena %.1f MiB, %d thread%s\n",
       out_path.c_str(), report.width, report.height, runner.mode().frames,
-      report.focus_disp_q8 / 256.0, report.capture_s, report.depth_s, report.render_s,
-      static_cast<double>(report.arena_bytes) / (1024.0 * 1024.0),
+      report.focus_disp_q8 / 256.0, report.capture_s, report.depth_s, report.motion_s,
+      report.render_s, static_cast<double>(report.arena_bytes) / (1024.0 * 1024.0),
       runner.pipeline().config().workers, runner.pipeline().config().workers == 1 ? "" : "s");
   const Pipeline& p = runner.pipeline();
   if (job.pipeline.geometry == ViewGeometry::kAuto && report.warning.ok()) {

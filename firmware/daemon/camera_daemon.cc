@@ -352,9 +352,10 @@ void CameraDaemon::TakePhoto(int32_t number) {
                  report.warning.message());
   }
   log_->Printf(LogLevel::kInfo,
-               "photo %d: saved %s (%dx%d; capture %.2f s, depth %.2f s, render and save %.2f s)",
+               "photo %d: saved %s (%dx%d; capture %.2f s, depth %.2f s of which motion %.2f s, "
+               "render and save %.2f s)",
                number, path, report.width, report.height, report.capture_s, report.depth_s,
-               report.render_s);
+               report.motion_s, report.render_s);
   std::lock_guard<std::mutex> lock(mutex_);
   ++counts_.saved;
 }

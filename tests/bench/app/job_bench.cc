@@ -122,7 +122,7 @@ void BM_Photo(benchmark::State& state) {
   const char* dir = getenv("TMPDIR");
   const std::string out = std::string(dir != nullptr ? dir : "/tmp") + "/job_bench_" +
                           std::to_string(getpid()) + ".jpg";
-  double capture = 0, depth = 0, render = 0, metadata = 0, wait = 0;
+  double capture = 0, motion = 0, depth = 0, render = 0, metadata = 0, wait = 0;
   for (auto _ : state) {
     JobReport report;
     s = job.Run(out.c_str(), &report);
@@ -131,6 +131,7 @@ void BM_Photo(benchmark::State& state) {
       break;
     }
     capture += report.capture_s;
+    motion += report.motion_s;
     depth += report.depth_s;
     render += report.render_s;
     metadata += report.metadata_s;
@@ -140,6 +141,7 @@ void BM_Photo(benchmark::State& state) {
   const double n = static_cast<double>(state.iterations());
   state.counters["capture_ms"] = 1000 * capture / n;
   state.counters["depth_ms"] = 1000 * depth / n;
+  state.counters["motion_ms"] = 1000 * motion / n;  // within depth_ms: before the labeling
   state.counters["render_jpeg_ms"] = 1000 * render / n;
   // Within render_jpeg_ms: the XMP's build (beside the render with 2 threads) and the wait for it.
   state.counters["xmp_ms"] = 1000 * metadata / n;
