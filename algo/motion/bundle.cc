@@ -92,6 +92,19 @@ LB_CLONES_AVX2 LB_VECTORIZE void LowerUpdate(const double* __restrict h,
     for (int32_t a = b; a < nr; ++a) col[a] -= hb * scaled[a];
   }
 }
+// LowerUpdate of two points at once, the first's difference before the second's: each entry is
+// loaded and stored once for both.
+LB_CLONES_AVX2 LB_VECTORIZE void LowerUpdate2(const double* __restrict h,
+                                              const double* __restrict scaled,
+                                              const double* __restrict h2,
+                                              const double* __restrict scaled2, int32_t nr,
+                                              double* __restrict s) {
+  for (int32_t b = 0; b < nr; ++b) {
+    double* col = s + static_cast<size_t>(nr) * b;
+    const double hb = h[b], hb2 = h2[b];
+    for (int32_t a = b; a < nr; ++a) col[a] = (col[a] - hb * scaled[a]) - hb2 * scaled2[a];
+  }
+}
 
 // One observation's share of the normal equations: H += rw Jc^T Jc (camera block b, the
 // column-major nc x 6 hcc at h), g -= rw Jc^T e, hcw += rw Jc^T jw. Written out so it inlines,
@@ -315,16 +328,25 @@ Status Bundle::Solve(const BundleInput& in, int32_t max_iterations, double huber
       g2 = g;
       // Only S's lower triangle: the Cholesky reads nothing else. Each entry as the full
       // outer product s -= (hcw / hd) hcw^T computes it, in the same order over the points.
-      double scaled[kMaxReduced];
+      // Points in pairs (LowerUpdate2), the one left over alone.
+      double scaled[2][kMaxReduced];
+      const double* pending = nullptr;
       for (int32_t j = 0; j < in.points; ++j) {
         if (!in.point_ok[j]) continue;
         const double hd = hww_[j] * (1 + lambda) + eps;
         const double* h = hcw_ + static_cast<size_t>(nr) * j;
-        for (int32_t a = 0; a < nr; ++a) scaled[a] = h[a] / hd;
-        LowerUpdate(h, scaled, nr, s_);
+        double* sc = scaled[pending != nullptr ? 1 : 0];
+        for (int32_t a = 0; a < nr; ++a) sc[a] = h[a] / hd;
+        if (pending != nullptr) {
+          LowerUpdate2(pending, scaled[0], h, sc, nr, s_);
+          pending = nullptr;
+        } else {
+          pending = h;
+        }
         Eigen::Map<const Eigen::VectorXd> hcw(h, nr);
         g2 -= hcw * (gw_[j] / hd);
       }
+      if (pending != nullptr) LowerUpdate(pending, scaled[0], nr, s_);
       Eigen::LLT<Eigen::Ref<Eigen::MatrixXd>> llt(s);
       if (llt.info() != Eigen::Success) {
         lambda *= 10;
