@@ -1,5 +1,7 @@
 #include "firmware/app/side_task.h"
 
+#include <signal.h>
+
 #include <cstring>
 
 namespace lb {
@@ -11,7 +13,12 @@ Status SideTask::Start() {
   stopping_ = false;
   // Default attributes inherit the caller's policy: under a real-time caller the task competes
   // with the workers as an equal.
+  // With every signal blocked, as the worker pool's threads (worker_pool.cc).
+  sigset_t all, old;
+  sigfillset(&all);
+  pthread_sigmask(SIG_SETMASK, &all, &old);
   const int err = pthread_create(&thread_, nullptr, &SideTask::Entry, this);
+  pthread_sigmask(SIG_SETMASK, &old, nullptr);
   if (err != 0) {
     return Status(Code::kUnsupported, "threads: cannot start the side thread: %s", strerror(err));
   }

@@ -1,6 +1,8 @@
 #include "firmware/storage/atomic_file.h"
 
 #include <fcntl.h>
+#include <pthread.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -134,9 +136,19 @@ Status AtomicFile::Commit(Replace replace) {
     Forget();
     return kind;
   }
+  // A signal between the rename and MarkCommitted would end the process after the file was
+  // replaced: they wait until the file is in place and marked (temp_registry.h).
+  sigset_t stops, old;
+  sigemptyset(&stops);
+  sigaddset(&stops, SIGINT);
+  sigaddset(&stops, SIGTERM);
+  sigaddset(&stops, SIGHUP);
+  pthread_sigmask(SIG_BLOCK, &stops, &old);
   const int err = replace == Replace::kNever             ? RenameNoReplace()
                   : rename(temp_path_, final_path_) == 0 ? 0
                                                          : errno;
+  if (err == 0) temp_registry::MarkCommitted();
+  pthread_sigmask(SIG_SETMASK, &old, nullptr);
   if (err != 0) {
     Forget();
     if (err == EEXIST) {

@@ -15,7 +15,9 @@ struct Slot {
   char path[kMaxPath] = {};
 };
 Slot g_slots[kSlots];
+std::atomic<bool> g_committed{false};
 static_assert(std::atomic<int>::is_always_lock_free, "the signal handler reads these");
+static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler reads this");
 
 }  // namespace
 
@@ -40,6 +42,12 @@ void Remove(const char* path) {
   }
 }
 
+void MarkCommitted() { g_committed.store(true); }
+
+bool Committed() { return g_committed.load(); }
+
+void ResetCommitted() { g_committed.store(false); }
+
 void UnlinkAll() {
   for (Slot& s : g_slots) {
     if (s.state.load() == 2) unlink(s.path);
@@ -52,6 +60,7 @@ namespace lb {
 namespace {
 
 extern "C" void OnFatalSignal(int sig) {
+  if (temp_registry::Committed()) return;  // SA_RESTART: a call it interrupted goes on
   temp_registry::UnlinkAll();
   signal(sig, SIG_DFL);
   raise(sig);
@@ -60,9 +69,11 @@ extern "C" void OnFatalSignal(int sig) {
 }  // namespace
 
 void RemoveTemporariesOnSignals() {
+  temp_registry::ResetCommitted();
   struct sigaction sa;
   memset(&sa, 0, sizeof(sa));
   sa.sa_handler = OnFatalSignal;
+  sa.sa_flags = SA_RESTART;
   sigemptyset(&sa.sa_mask);
   for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr);
 }

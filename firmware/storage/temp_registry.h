@@ -14,13 +14,22 @@ bool Add(const char* path);
 void Remove(const char* path);
 // Unlinks every registered temporary. Async-signal-safe.
 void UnlinkAll();
+// A file of the command is in place: from now on the signals below no longer end the process,
+// which finishes what little is left (a photo's command commits its output last), so an
+// interrupted command has left the old file or ends as if not interrupted, never both.
+// AtomicFile calls it with the signals blocked from before its rename, so none falls between.
+void MarkCommitted();
+bool Committed();
+void ResetCommitted();  // RemoveTemporariesOnSignals starts each command unmarked
 
 }  // namespace lb::temp_registry
 
 namespace lb {
 
 // For the command-line programs: SIGINT, SIGTERM and SIGHUP remove every registered temporary,
-// then end the process by the same signal, as it would have ended without the handler.
+// then end the process by the same signal, as it would have ended without the handler; once a
+// file is committed after this call (MarkCommitted) they are ignored. Threads the program starts
+// block them (WorkerPool, SideTask), so the handler runs on the thread that commits.
 void RemoveTemporariesOnSignals();
 
 }  // namespace lb

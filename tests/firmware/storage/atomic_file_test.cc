@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "firmware/storage/temp_registry.h"
+
 namespace lb {
 namespace {
 
@@ -211,6 +213,33 @@ TEST_F(AtomicFileTest, FullDiskLeavesNoFile) {
   ASSERT_TRUE(WIFEXITED(wstatus));
   EXPECT_EQ(WEXITSTATUS(wstatus), 0);
   EXPECT_TRUE(Entries().empty());
+}
+
+// A command's SIGINT or SIGTERM (temp_registry.h) ends it, its temporary removed, until its
+// file is committed; after that it finishes as if not interrupted, so an interrupted command
+// never leaves a new file behind, nor dies once it has.
+TEST_F(AtomicFileTest, ASignalEndsTheCommandUntilItsFileIsInPlaceNotAfter) {
+  for (const bool commit_first : {false, true}) {
+    const std::string path = Path(commit_first ? "kept.jpg" : "dropped.jpg");
+    const pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      RemoveTemporariesOnSignals();
+      AtomicFile file;
+      if (!file.Open(path.c_str()).ok() || !file.Write("jpeg", 4).ok()) _exit(11);
+      if (commit_first && !file.Commit().ok()) _exit(12);
+      raise(SIGTERM);
+      _exit(0);
+    }
+    int wstatus = 0;
+    ASSERT_EQ(waitpid(pid, &wstatus, 0), pid);
+    if (commit_first) {
+      EXPECT_TRUE(WIFEXITED(wstatus) && WEXITSTATUS(wstatus) == 0) << wstatus;
+    } else {
+      EXPECT_TRUE(WIFSIGNALED(wstatus) && WTERMSIG(wstatus) == SIGTERM) << wstatus;
+    }
+  }
+  EXPECT_EQ(Entries(), std::vector<std::string>{"kept.jpg"});
 }
 
 }  // namespace
