@@ -11,12 +11,12 @@ SideTask::~SideTask() { Stop(); }
 Status SideTask::Start() {
   if (started_) return Status::Ok();
   stopping_ = false;
-  // Default attributes inherit the caller's policy: under a real-time caller the task competes
-  // with the workers as an equal.
   // With every signal blocked, as the worker pool's threads (worker_pool.cc).
   sigset_t all, old;
   sigfillset(&all);
   pthread_sigmask(SIG_SETMASK, &all, &old);
+  // Default attributes inherit the caller's policy: under a real-time caller the task competes
+  // with the workers as an equal.
   const int err = pthread_create(&thread_, nullptr, &SideTask::Entry, this);
   pthread_sigmask(SIG_SETMASK, &old, nullptr);
   if (err != 0) {
