@@ -1,8 +1,8 @@
 #include "firmware/app/side_task.h"
 
-#include <signal.h>
-
 #include <cstring>
+
+#include "firmware/platform/signals_blocked.h"
 
 namespace lb {
 
@@ -11,14 +11,13 @@ SideTask::~SideTask() { Stop(); }
 Status SideTask::Start() {
   if (started_) return Status::Ok();
   stopping_ = false;
-  // With every signal blocked, as the worker pool's threads (worker_pool.cc).
-  sigset_t all, old;
-  sigfillset(&all);
-  pthread_sigmask(SIG_SETMASK, &all, &old);
-  // Default attributes inherit the caller's policy: under a real-time caller the task competes
-  // with the workers as an equal.
-  const int err = pthread_create(&thread_, nullptr, &SideTask::Entry, this);
-  pthread_sigmask(SIG_SETMASK, &old, nullptr);
+  int err = 0;
+  {
+    const SignalsBlocked blocked;
+    // Default attributes inherit the caller's policy: under a real-time caller the task competes
+    // with the workers as an equal.
+    err = pthread_create(&thread_, nullptr, &SideTask::Entry, this);
+  }
   if (err != 0) {
     return Status(Code::kUnsupported, "threads: cannot start the side thread: %s", strerror(err));
   }

@@ -1,13 +1,12 @@
 #include "firmware/daemon/camera_daemon.h"
 
-#include <signal.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
 
 #include "firmware/daemon/startup_checks.h"
+#include "firmware/platform/signals_blocked.h"
 
 namespace lb {
 
@@ -76,12 +75,11 @@ double CameraDaemon::SecondsSince(int64_t start_ns) const {
 }
 
 Status CameraDaemon::Start() {
-  // The worker never takes signals: they belong to the thread that waits on the button.
-  sigset_t all, old;
-  sigfillset(&all);
-  pthread_sigmask(SIG_SETMASK, &all, &old);
-  worker_ = std::thread(&CameraDaemon::Worker, this);
-  pthread_sigmask(SIG_SETMASK, &old, nullptr);
+  {
+    // The worker never takes signals: they belong to the thread that waits on the button.
+    const SignalsBlocked blocked;
+    worker_ = std::thread(&CameraDaemon::Worker, this);
+  }
   (void)CheckReady(true);
   return Status::Ok();
 }

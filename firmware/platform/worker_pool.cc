@@ -1,10 +1,11 @@
 #include "firmware/platform/worker_pool.h"
 
 #include <sched.h>
-#include <signal.h>
 
 #include <chrono>
 #include <cstring>
+
+#include "firmware/platform/signals_blocked.h"
 
 namespace lb {
 
@@ -16,25 +17,22 @@ Status WorkerPool::Start(int32_t workers) {
   }
   Stop();
   stopping_ = false;
-  // The workers start with every signal blocked, so a process's signal runs its handler on
-  // the thread that set it (temp_registry.h: the handler and the commit must not race).
-  sigset_t all, old;
-  sigfillset(&all);
-  pthread_sigmask(SIG_SETMASK, &all, &old);
   for (int32_t i = 0; i + 1 < workers; ++i) {
     Thread& t = threads_[i];
     t.pool = this;
     t.worker = i + 1;
-    const int err = pthread_create(&t.id, nullptr, &WorkerPool::Entry, &t);
+    int err = 0;
+    {
+      const SignalsBlocked blocked;
+      err = pthread_create(&t.id, nullptr, &WorkerPool::Entry, &t);
+    }
     if (err != 0) {
-      pthread_sigmask(SIG_SETMASK, &old, nullptr);
       Stop();
       return Status(Code::kUnsupported, "threads: cannot start worker %d of %d: %s", i + 2, workers,
                     strerror(err));
     }
     ++started_;
   }
-  pthread_sigmask(SIG_SETMASK, &old, nullptr);
   workers_ = workers;
   return Status::Ok();
 }

@@ -44,10 +44,6 @@ void Remove(const char* path) {
 
 void MarkCommitted() { g_committed.store(true); }
 
-bool Committed() { return g_committed.load(); }
-
-void ResetCommitted() { g_committed.store(false); }
-
 void UnlinkAll() {
   for (Slot& s : g_slots) {
     if (s.state.load() == 2) unlink(s.path);
@@ -60,7 +56,7 @@ namespace lb {
 namespace {
 
 extern "C" void OnFatalSignal(int sig) {
-  if (temp_registry::Committed()) return;  // SA_RESTART: a call it interrupted goes on
+  if (temp_registry::g_committed.load()) return;  // SA_RESTART: a call it interrupted goes on
   temp_registry::UnlinkAll();
   signal(sig, SIG_DFL);
   raise(sig);
@@ -69,7 +65,7 @@ extern "C" void OnFatalSignal(int sig) {
 }  // namespace
 
 void RemoveTemporariesOnSignals() {
-  temp_registry::ResetCommitted();
+  temp_registry::g_committed.store(false);  // each command starts unmarked
   struct sigaction sa;
   memset(&sa, 0, sizeof(sa));
   sa.sa_handler = OnFatalSignal;

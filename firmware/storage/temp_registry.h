@@ -19,8 +19,6 @@ void UnlinkAll();
 // interrupted command has left the old file or ends as if not interrupted, never both.
 // AtomicFile calls it with the signals blocked from before its rename, so none falls between.
 void MarkCommitted();
-bool Committed();
-void ResetCommitted();  // RemoveTemporariesOnSignals starts each command unmarked
 
 }  // namespace lb::temp_registry
 
@@ -29,7 +27,8 @@ namespace lb {
 // For the command-line programs: SIGINT, SIGTERM and SIGHUP remove every registered temporary,
 // then end the process by the same signal, as it would have ended without the handler; once a
 // file is committed after this call (MarkCommitted) they are ignored. Threads the program starts
-// block them (WorkerPool, SideTask), so the handler runs on the thread that commits.
+// start with them blocked (firmware/platform/signals_blocked.h), so the handler runs on the thread
+// that commits.
 void RemoveTemporariesOnSignals();
 
 }  // namespace lb

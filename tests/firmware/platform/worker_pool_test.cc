@@ -5,9 +5,11 @@
 
 #include <dirent.h>
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <cstring>
 #include <vector>
@@ -128,6 +130,35 @@ TEST(WorkerPool, StartsTheThreadsItIsAskedForAndStopsThem) {
   int32_t ran = 0;
   ParallelFor(pool, 3, [&](int32_t, int32_t worker) { ran += worker == 0; });
   EXPECT_EQ(ran, 3);
+}
+
+TEST(WorkerPool, WorkersTakeNoSignalAndTheCallerKeepsItsMask) {
+  // A signal's handler must run on the thread that commits the command's file
+  // (temp_registry.h), so the workers hold every signal blocked; starting them leaves the
+  // caller's mask as it was.
+  WorkerPool pool;
+  ASSERT_TRUE(pool.Start(3).ok());
+  sigset_t mask;
+  pthread_sigmask(SIG_SETMASK, nullptr, &mask);
+  EXPECT_EQ(sigismember(&mask, SIGTERM), 0);
+  std::atomic<int32_t> open_workers{0}, worker_tasks{0};
+  for (int32_t round = 0; round < 20; ++round) {
+    ParallelFor(pool, 64, [&](int32_t, int32_t worker) {
+      if (worker == 0) {  // leaves tasks to the workers, however late they wake
+        const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(50);
+        while (worker_tasks.load() == 0 && std::chrono::steady_clock::now() < end) {
+        }
+        return;
+      }
+      worker_tasks.fetch_add(1);
+      sigset_t now;
+      pthread_sigmask(SIG_SETMASK, nullptr, &now);
+      if (sigismember(&now, SIGTERM) != 1 || sigismember(&now, SIGINT) != 1)
+        open_workers.fetch_add(1);
+    });
+  }
+  EXPECT_GT(worker_tasks.load(), 0);
+  EXPECT_EQ(open_workers.load(), 0);
 }
 
 TEST(WorkerPool, ACountOutsideTheRangeIsRefused) {
