@@ -1,121 +1,25 @@
 #include "firmware/web/web_server.h"
 
 #include <arpa/inet.h>
-#include <fcntl.h>
 #include <microhttpd.h>
 #include <netinet/in.h>
 #include <strings.h>
 #include <sys/random.h>
 #include <sys/resource.h>
 #include <sys/socket.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
-#include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <new>
 #include <thread>
-#include <vector>
 
 #include "firmware/storage/errno_text.h"
-#include "firmware/web/photo_folder.h"
-#include "firmware/web/thumbnail.h"
+#include "firmware/web/web_request.h"
 
 namespace lb {
-
-// The decoded fields of a form body (application/x-www-form-urlencoded), as libmicrohttpd's
-// post processor hands them over: a value may come in pieces.
-struct Fields {
-  static constexpr int kMax = 12;
-  std::string key[kMax], value[kMax];
-  int count = 0;
-  const char* Get(const char* name) const {
-    for (int i = 0; i < count; ++i) {
-      if (key[i] == name) return value[i].c_str();
-    }
-    return nullptr;
-  }
-  // Adds `key` when `offset` is 0, else continues its value.
-  bool Add(const char* k, const char* data, uint64_t offset, size_t size) {
-    // A decoded NUL would cut the text the checks see short of what was sent.
-    if (memchr(data, '\0', size) != nullptr) return false;
-    if (offset == 0) {
-      if (count == kMax) return false;
-      key[count] = k;
-      value[count].clear();
-      ++count;
-    } else if (count == 0 || key[count - 1] != k || value[count - 1].size() != offset) {
-      return false;
-    }
-    value[count - 1].append(data, size);
-    return true;
-  }
-};
-
-// One request's state between libmicrohttpd's calls: the form fields so far (its post processor
-// decodes the body; at most max_body bytes) and whether an answer was queued.
-struct WebServer::Request {
-  ~Request() {
-    if (post != nullptr) MHD_destroy_post_processor(post);
-  }
-  char method[8] = "";
-  char path[168] = "";  // as logged
-  MHD_PostProcessor* post = nullptr;
-  Fields fields;
-  size_t body_bytes = 0;
-  bool too_large = false;
-  bool bad_body = false;
-  bool replied = false;
-};
-
-// The render outputs: a fixed number of sinks whose capacity stays between requests (so steady
-// use does not grow memory), each lent to one render and returned when libmicrohttpd has sent
-// and freed its response.
-class WebServer::Sinks {
- public:
-  static constexpr int kCount = 2;
-  static constexpr size_t kMaxBytes = 48u << 20;  // a full-size JPEG of a 16 MP photo fits
-
-  class Sink final : public ByteSink {
-   public:
-    bool Append(const uint8_t* data, size_t size) override {
-      if (size > kMaxBytes - bytes.size()) return false;
-      bytes.insert(bytes.end(), data, data + size);
-      return true;
-    }
-    std::vector<uint8_t> bytes;
-    Sinks* owner = nullptr;
-    bool lent = false;
-  };
-
-  Sinks() {
-    for (Sink& s : sinks_) s.owner = this;
-  }
-  Sink* Acquire() {
-    std::lock_guard<std::mutex> lock(mutex_);
-    for (Sink& s : sinks_) {
-      if (!s.lent) {
-        s.lent = true;
-        s.bytes.clear();
-        return &s;
-      }
-    }
-    return nullptr;
-  }
-  void Release(Sink* s) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    s->lent = false;
-  }
-
- private:
-  std::mutex mutex_;
-  Sink sinks_[kCount];
-};
-
 namespace {
 
 struct ErrText {
@@ -145,40 +49,6 @@ void OnLibraryMessage(void* cls, const char* format, va_list args) {
   static_cast<WebServer*>(cls)->LogLibraryMessage(text);
 }
 
-void ReleaseSink(void* cls) {
-  auto* sink = static_cast<WebServer::Sinks::Sink*>(cls);
-  sink->owner->Release(sink);
-}
-
-// Equal in time that does not depend on where the first difference is.
-bool SameSecret(const char* given, const std::string& secret) {
-  const size_t n = strnlen(given, 1024);
-  unsigned diff = n != secret.size() ? 1u : 0u;
-  for (size_t i = 0; i < secret.size(); ++i) {
-    const unsigned char g = i < n ? static_cast<unsigned char>(given[i]) : 0;
-    diff |= g ^ static_cast<unsigned char>(secret[i]);
-  }
-  return diff == 0;
-}
-
-void AppendJsonString(std::string* out, const char* s) {
-  out->push_back('"');
-  for (; *s != '\0'; ++s) {
-    const unsigned char ch = static_cast<unsigned char>(*s);
-    if (ch == '"' || ch == '\\') {
-      out->push_back('\\');
-      out->push_back(static_cast<char>(ch));
-    } else if (ch < 0x20 || ch == 0x7f) {
-      char esc[8];
-      snprintf(esc, sizeof(esc), "\\u%04x", ch);
-      out->append(esc);
-    } else {
-      out->push_back(static_cast<char>(ch));
-    }
-  }
-  out->push_back('"');
-}
-
 // A request path as the log shows it: printable ASCII, at most 160 characters (a decoded
 // "%0a" cannot start a fake log line).
 void LoggablePath(const char* url, char* out, size_t size) {
@@ -194,48 +64,6 @@ MHD_Result OnFormField(void* cls, MHD_ValueKind /*kind*/, const char* key, const
                        const char* /*type*/, const char* /*encoding*/, const char* data,
                        uint64_t offset, size_t size) {
   return static_cast<Fields*>(cls)->Add(key, data, offset, size) ? MHD_YES : MHD_NO;
-}
-
-bool Number(const char* text, float lo, float hi, float* out) {
-  if (text == nullptr || *text == '\0') return false;
-  char* end = nullptr;
-  const float v = strtof(text, &end);
-  if (*end != '\0' || !std::isfinite(v) || v < lo || v > hi) return false;
-  *out = v;
-  return true;
-}
-
-// The page's choice from a preview/render/save body.
-Status ParseRefocus(const Fields& f, std::string* name, RefocusParams* p) {
-  const char* n = f.Get("name");
-  if (n == nullptr) return Status(Code::kInvalidArgument, "the body names no photo (name=)");
-  *name = n;
-  if (!Number(f.Get("x0"), 0.0f, 1.0f, &p->x0) || !Number(f.Get("y0"), 0.0f, 1.0f, &p->y0)) {
-    return Status(Code::kInvalidArgument, "x0 and y0 must be numbers from 0 to 1");
-  }
-  p->x1 = p->x0;
-  p->y1 = p->y0;
-  if ((f.Get("x1") != nullptr && !Number(f.Get("x1"), 0.0f, 1.0f, &p->x1)) ||
-      (f.Get("y1") != nullptr && !Number(f.Get("y1"), 0.0f, 1.0f, &p->y1))) {
-    return Status(Code::kInvalidArgument, "x1 and y1 must be numbers from 0 to 1");
-  }
-  if (p->x1 < p->x0) std::swap(p->x0, p->x1);
-  if (p->y1 < p->y0) std::swap(p->y0, p->y1);
-  if (f.Get("f") != nullptr &&
-      !Number(f.Get("f"), RenderParams::kMinFNumber, RenderParams::kMaxFNumber, &p->f_number)) {
-    return Status(Code::kInvalidArgument, "f must be an f-number from %g to %g",
-                  static_cast<double>(RenderParams::kMinFNumber),
-                  static_cast<double>(RenderParams::kMaxFNumber));
-  }
-  float blades = 0.0f;
-  if (f.Get("blades") != nullptr) {
-    if (!Number(f.Get("blades"), 0.0f, 12.0f, &blades) || blades != std::floor(blades) ||
-        (blades > 0.0f && blades < 3.0f)) {
-      return Status(Code::kInvalidArgument, "blades must be 0 (a disc) or 3 to 12");
-    }
-  }
-  p->aperture.blades = static_cast<int32_t>(blades);
-  return Status::Ok();
 }
 
 int HttpStatusFor(Code code) {
@@ -266,6 +94,48 @@ bool StartsWith(const char* s, const char* prefix, const char** rest) {
 int ThreadId() { return static_cast<int>(gettid()); }
 
 }  // namespace
+
+namespace web {
+
+void CommonHeaders(MHD_Response* response) {
+  MHD_add_response_header(response, "X-Content-Type-Options", "nosniff");
+  MHD_add_response_header(response, "X-Frame-Options", "DENY");
+  MHD_add_response_header(response, "Referrer-Policy", "no-referrer");
+}
+
+void AppendJsonString(std::string* out, const char* s) {
+  out->push_back('"');
+  for (; *s != '\0'; ++s) {
+    const unsigned char ch = static_cast<unsigned char>(*s);
+    if (ch == '"' || ch == '\\') {
+      out->push_back('\\');
+      out->push_back(static_cast<char>(ch));
+    } else if (ch < 0x20 || ch == 0x7f) {
+      char esc[8];
+      snprintf(esc, sizeof(esc), "\\u%04x", ch);
+      out->append(esc);
+    } else {
+      out->push_back(static_cast<char>(ch));
+    }
+  }
+  out->push_back('"');
+}
+
+bool SameSecret(const char* given, const std::string& secret) {
+  const size_t n = strnlen(given, 1024);
+  unsigned diff = n != secret.size() ? 1u : 0u;
+  for (size_t i = 0; i < secret.size(); ++i) {
+    const unsigned char g = i < n ? static_cast<unsigned char>(given[i]) : 0;
+    diff |= g ^ static_cast<unsigned char>(secret[i]);
+  }
+  return diff == 0;
+}
+
+}  // namespace web
+
+using web::AppendJsonString;
+using web::CommonHeaders;
+using web::SameSecret;
 
 WebServerOptions WebOptionsFrom(const DaemonConfig& config) {
   WebServerOptions o;
@@ -531,17 +401,6 @@ void WebServer::LogRequest(MHD_Connection* c, const Request* r, int status, cons
                why != nullptr ? ": " : "", why != nullptr ? why : "");
 }
 
-namespace {
-
-// Headers every answer carries: nothing is sniffed, framed or sent on to another site.
-void CommonHeaders(MHD_Response* response) {
-  MHD_add_response_header(response, "X-Content-Type-Options", "nosniff");
-  MHD_add_response_header(response, "X-Frame-Options", "DENY");
-  MHD_add_response_header(response, "Referrer-Policy", "no-referrer");
-}
-
-}  // namespace
-
 bool WebServer::Reply(MHD_Connection* c, Request* r, int status, const char* type, const void* data,
                       size_t size, const char* why) {
   MHD_Response* response =
@@ -553,6 +412,11 @@ bool WebServer::Reply(MHD_Connection* c, Request* r, int status, const char* typ
   if (status == MHD_HTTP_SERVICE_UNAVAILABLE) {
     MHD_add_response_header(response, MHD_HTTP_HEADER_RETRY_AFTER, "1");
   }
+  return Send(c, r, response, status, why);
+}
+
+bool WebServer::Send(MHD_Connection* c, Request* r, MHD_Response* response, int status,
+                     const char* why) {
   const bool ok = MHD_queue_response(c, static_cast<unsigned>(status), response) == MHD_YES;
   MHD_destroy_response(response);
   r->replied = true;
@@ -569,204 +433,6 @@ bool WebServer::ReplyError(MHD_Connection* c, Request* r, int status, const char
 
 bool WebServer::ReplyStatus(MHD_Connection* c, Request* r, const Status& s) {
   return ReplyError(c, r, HttpStatusFor(s.code()), s.message());
-}
-
-bool WebServer::ServePage(MHD_Connection* c, Request* r, const char* file, const char* type) {
-  const std::string path = options_.web_root + "/" + file;
-  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-  struct stat st;
-  if (fd < 0 || fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    if (fd >= 0) close(fd);
-    char why[160];
-    snprintf(why, sizeof(why), "the page file %s is missing (web_root)", file);
-    return ReplyError(c, r, MHD_HTTP_NOT_FOUND, why);
-  }
-  MHD_Response* response = MHD_create_response_from_fd(static_cast<size_t>(st.st_size), fd);
-  if (response == nullptr) {
-    close(fd);
-    return false;
-  }
-  CommonHeaders(response);
-  MHD_add_response_header(response, MHD_HTTP_HEADER_CONTENT_TYPE, type);
-  MHD_add_response_header(response, MHD_HTTP_HEADER_CACHE_CONTROL, "no-cache");
-  // The page loads only its own files and the photos; no inline script, nothing from outside.
-  MHD_add_response_header(response, MHD_HTTP_HEADER_CONTENT_SECURITY_POLICY,
-                          "default-src 'self'; img-src 'self' blob: data:; "
-                          "frame-ancestors 'none'; base-uri 'none'; form-action 'self'");
-  const bool ok = MHD_queue_response(c, MHD_HTTP_OK, response) == MHD_YES;
-  MHD_destroy_response(response);
-  r->replied = true;
-  LogRequest(c, r, MHD_HTTP_OK, nullptr);
-  return ok;
-}
-
-bool WebServer::Login(MHD_Connection* c, Request* r) {
-  const char* token = r->fields.Get("token");
-  if (token == nullptr || !SameSecret(token, options_.token)) {
-    // Each wrong guess costs its connection a moment (and the per-client limit caps those).
-    std::this_thread::sleep_for(std::chrono::milliseconds(options_.failed_login_delay_ms));
-    return ReplyError(c, r, MHD_HTTP_UNAUTHORIZED, "wrong token");
-  }
-  MHD_Response* response = MHD_create_response_from_buffer(0, nullptr, MHD_RESPMEM_PERSISTENT);
-  if (response == nullptr) return false;
-  CommonHeaders(response);
-  const std::string cookie = "refocusd=" + session_ + "; HttpOnly; SameSite=Strict; Path=/";
-  MHD_add_response_header(response, MHD_HTTP_HEADER_SET_COOKIE, cookie.c_str());
-  MHD_add_response_header(response, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
-  const bool ok = MHD_queue_response(c, MHD_HTTP_NO_CONTENT, response) == MHD_YES;
-  MHD_destroy_response(response);
-  r->replied = true;
-  LogRequest(c, r, MHD_HTTP_NO_CONTENT, "logged in");
-  return ok;
-}
-
-bool WebServer::ListPhotos(MHD_Connection* c, Request* r) {
-  int dir_fd = -1;
-  Status s = OpenPhotoFolder(options_.photo_dir.c_str(), &dir_fd);
-  std::vector<PhotoEntry> photos;
-  if (s.ok()) {
-    s = ListPhotoFolder(dir_fd, options_.max_listed, &photos);
-    close(dir_fd);
-  }
-  if (!s.ok()) return ReplyStatus(c, r, s);
-  std::string json = "{\"photos\":[";
-  for (size_t i = 0; i < photos.size(); ++i) {
-    if (i > 0) json += ",";
-    json += "{\"name\":";
-    AppendJsonString(&json, photos[i].name.c_str());
-    char numbers[80];
-    snprintf(numbers, sizeof(numbers), ",\"mtime\":%lld,\"size\":%lld}",
-             static_cast<long long>(photos[i].mtime_ns / 1000000000),
-             static_cast<long long>(photos[i].size));
-    json += numbers;
-  }
-  json += "]}";
-  return Reply(c, r, MHD_HTTP_OK, "application/json", json.data(), json.size(), nullptr);
-}
-
-Status WebServer::OpenNamedPhoto(const char* name, int* fd, struct stat* st) const {
-  int dir_fd = -1;
-  Status s = OpenPhotoFolder(options_.photo_dir.c_str(), &dir_fd);
-  if (!s.ok()) return s;
-  s = OpenPhoto(dir_fd, name, fd, st);
-  close(dir_fd);
-  return s;
-}
-
-bool WebServer::ServePhoto(MHD_Connection* c, Request* r, const char* name, bool thumbnail) {
-  int fd = -1;
-  struct stat st;
-  Status s = OpenNamedPhoto(name, &fd, &st);
-  if (!s.ok()) return ReplyStatus(c, r, s);
-  if (thumbnail) {
-    std::vector<uint8_t> jpeg;
-    s = MakeThumbnail(fd, options_.thumb_width, 80, &jpeg);
-    close(fd);
-    if (!s.ok()) return ReplyStatus(c, r, s.Prefix("%s: ", name));
-    return Reply(c, r, MHD_HTTP_OK, "image/jpeg", jpeg.data(), jpeg.size(), nullptr);
-  }
-  MHD_Response* response = MHD_create_response_from_fd(static_cast<size_t>(st.st_size), fd);
-  if (response == nullptr) {
-    close(fd);
-    return false;
-  }
-  CommonHeaders(response);
-  MHD_add_response_header(response, MHD_HTTP_HEADER_CONTENT_TYPE, "image/jpeg");
-  MHD_add_response_header(response, MHD_HTTP_HEADER_CACHE_CONTROL, "private, no-cache");
-  const char* download = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "download");
-  if (download != nullptr && strcmp(download, "1") == 0) {
-    // The name passed IsServablePhotoName: no quote, slash or control character to escape.
-    const std::string disposition = std::string("attachment; filename=\"") + name + "\"";
-    MHD_add_response_header(response, MHD_HTTP_HEADER_CONTENT_DISPOSITION, disposition.c_str());
-  }
-  const bool ok = MHD_queue_response(c, MHD_HTTP_OK, response) == MHD_YES;
-  MHD_destroy_response(response);
-  r->replied = true;
-  LogRequest(c, r, MHD_HTTP_OK, nullptr);
-  return ok;
-}
-
-bool WebServer::Info(MHD_Connection* c, Request* r, const char* name) {
-  int fd = -1;
-  struct stat st;
-  Status s = OpenNamedPhoto(name, &fd, &st);
-  if (!s.ok()) return ReplyStatus(c, r, s);
-  close(fd);
-  const std::string path = options_.photo_dir + "/" + name;
-  PhotoInfo info;
-  s = backend_->Describe(path.c_str(), &info);
-  if (!s.ok()) return ReplyStatus(c, r, s);
-  char json[400];
-  const RefocusParams& p = info.current;
-  snprintf(json, sizeof(json),
-           "{\"width\":%d,\"height\":%d,\"refocusable\":%s,\"current\":{\"x0\":%.4f,\"y0\":%.4f,"
-           "\"x1\":%.4f,\"y1\":%.4f,\"f\":%.2f,\"blades\":%d}}",
-           info.width, info.height, info.refocusable ? "true" : "false", p.x0, p.y0, p.x1, p.y1,
-           p.f_number, p.aperture.blades);
-  return Reply(c, r, MHD_HTTP_OK, "application/json", json, strlen(json), nullptr);
-}
-
-bool WebServer::Refocus(MHD_Connection* c, Request* r, const char* action) {
-  std::string name;
-  RefocusParams params;
-  Status s = ParseRefocus(r->fields, &name, &params);
-  int dir_fd = -1;
-  if (s.ok()) s = OpenPhotoFolder(options_.photo_dir.c_str(), &dir_fd);
-  if (s.ok()) {
-    int fd = -1;
-    struct stat st;
-    s = OpenPhoto(dir_fd, name.c_str(), &fd, &st);
-    if (fd >= 0) close(fd);
-  }
-  if (!s.ok()) {
-    if (dir_fd >= 0) close(dir_fd);
-    return ReplyStatus(c, r, s);
-  }
-  const std::string path = options_.photo_dir + "/" + name;
-  if (strcmp(action, "save") == 0) {
-    char out[kMaxPhotoName + 1];
-    {
-      // Two saves at once must not pick the same name.
-      std::lock_guard<std::mutex> lock(save_mutex_);
-      s = ChooseRerenderName(dir_fd, name.c_str(), out, sizeof(out));
-      if (s.ok()) {
-        const std::string out_path = options_.photo_dir + "/" + out;
-        s = backend_->Save(path.c_str(), params, out_path.c_str());
-      }
-    }
-    close(dir_fd);
-    if (!s.ok()) return ReplyStatus(c, r, s);
-    std::string body = "{\"name\":";
-    AppendJsonString(&body, out);
-    body += "}";
-    char why[200];
-    snprintf(why, sizeof(why), "saved %s", out);
-    return Reply(c, r, MHD_HTTP_OK, "application/json", body.data(), body.size(), why);
-  }
-  close(dir_fd);
-  Sinks::Sink* sink = sinks_->Acquire();
-  if (sink == nullptr) {
-    return ReplyError(c, r, MHD_HTTP_SERVICE_UNAVAILABLE, "renders in progress; try again");
-  }
-  s = backend_->Render(path.c_str(), params, strcmp(action, "preview") == 0, sink);
-  if (!s.ok()) {
-    sinks_->Release(sink);
-    return ReplyStatus(c, r, s);
-  }
-  MHD_Response* response = MHD_create_response_from_buffer_with_free_callback_cls(
-      sink->bytes.size(), sink->bytes.data(), &ReleaseSink, sink);
-  if (response == nullptr) {
-    sinks_->Release(sink);
-    return false;
-  }
-  CommonHeaders(response);
-  MHD_add_response_header(response, MHD_HTTP_HEADER_CONTENT_TYPE, "image/jpeg");
-  MHD_add_response_header(response, MHD_HTTP_HEADER_CACHE_CONTROL, "no-store");
-  const bool ok = MHD_queue_response(c, MHD_HTTP_OK, response) == MHD_YES;
-  MHD_destroy_response(response);
-  r->replied = true;
-  LogRequest(c, r, MHD_HTTP_OK, nullptr);
-  return ok;
 }
 
 }  // namespace lb

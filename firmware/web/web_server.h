@@ -49,6 +49,7 @@
 
 struct MHD_Daemon;
 struct MHD_Connection;
+struct MHD_Response;
 
 namespace lb {
 
@@ -101,6 +102,8 @@ class WebServer {
   bool Route(MHD_Connection* c, const char* url, const char* method, Request* r);
   bool Reply(MHD_Connection* c, Request* r, int status, const char* type, const void* data,
              size_t size, const char* why);
+  // Queues `response` (and frees it) with `status`, marks the request answered and logs it.
+  bool Send(MHD_Connection* c, Request* r, MHD_Response* response, int status, const char* why);
   bool ReplyError(MHD_Connection* c, Request* r, int status, const char* why);
   bool ReplyStatus(MHD_Connection* c, Request* r, const Status& s);
   bool Authorized(MHD_Connection* c) const;
