@@ -87,6 +87,9 @@ struct DecodeRequest {
   int32_t width = 0;
   int32_t height = 0;
   bool plain_gray = false;  // PNG only: grey without alpha, not interlaced
+  // JPEG only, when non-zero: decoded at libjpeg's smallest scale M/8 (M = 1..8) that is still at
+  // least this wide (or whole), the header recorded at that size.
+  int32_t min_width = 0;
   // The caller's memory (StreamImageMemory): no heap buffer, and a size limit. Null: allocate.
   const ImageReadMemory* memory = nullptr;
 };

@@ -1,7 +1,10 @@
 #include "firmware/codecs/image_file.h"
 
+#include <unistd.h>
+
 #include <cerrno>
 #include <cinttypes>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
@@ -128,6 +131,21 @@ Status ProbeImageFile(const char* path, ImageFileInfo* info) {
 Status StreamImageFile(const char* path, int32_t index, FrameSink& sink) {
   ImageFileInfo info;
   return DecodeFile(path, codecs::StreamRequest(path, &info, &sink, index));
+}
+
+Status StreamImageDescriptor(int fd, const char* name, int32_t min_width, FrameSink& sink) {
+  const int own = dup(fd);
+  FilePtr file(own >= 0 ? fdopen(own, "rb") : nullptr);
+  if (file == nullptr) {
+    const int err = errno;
+    if (own >= 0) close(own);
+    return Status(Code::kIoError, "%s: cannot read: %s", name, strerror(err));
+  }
+  ImageFileInfo info;
+  codecs::DecodeRequest request = codecs::StreamRequest(name, &info, &sink);
+  request.min_width = min_width;
+  codecs::FileSource src(file.get());
+  return Decode(src, ImageFileType::kAuto, request);
 }
 
 Status ReadImageFile(const char* path, ImageFileInfo* info, std::vector<uint8_t>* pixels) {

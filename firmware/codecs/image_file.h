@@ -31,6 +31,12 @@ Status ProbeImageFile(const char* path, ImageFileInfo* info);
 // holding at most a strip of rows in memory. 16-bit samples are delivered native-endian.
 Status StreamImageFile(const char* path, int32_t index, FrameSink& sink);
 
+// StreamImageFile from an open descriptor (borrowed: read from where it stands, not closed) as
+// frame 0, `name` in error messages. A JPEG is decoded at libjpeg's smallest scale M/8 that keeps
+// it at least `min_width` wide (0: whole; FrameInfo gives the size delivered): the web page's
+// thumbnails. Other formats come whole.
+Status StreamImageDescriptor(int fd, const char* name, int32_t min_width, FrameSink& sink);
+
 // Reads the whole image into `pixels` (tightly packed rows, native-endian samples). A host-side
 // convenience for tests, tools and the Middlebury loaders; allocates.
 Status ReadImageFile(const char* path, ImageFileInfo* info, std::vector<uint8_t>* pixels);

@@ -1,4 +1,6 @@
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <string>
@@ -90,6 +92,48 @@ TEST(JpegReader, StreamsIntoTheCallersStrip) {
   s = StreamImageMemory(jpeg.data(), jpeg.size(), "x.jpg", 0, refused, narrow);
   EXPECT_EQ(s.code(), Code::kOutOfMemory) << s.message();
   EXPECT_TRUE(refused.frames.empty());
+}
+
+// The thumbnails' read: from an open descriptor, a JPEG decoded at the smallest M/8 that is
+// still at least the width asked for, and still the picture (its mean level per quarter).
+TEST(JpegReader, ADescriptorReadShrinksAJpegInTheDecoder) {
+  const std::string path = ::testing::TempDir() + "scaled.jpg";
+  ASSERT_TRUE(test::WriteFile(path, Encode(160, 96, 3)));
+  ImageFileInfo whole_info;
+  std::vector<uint8_t> whole;
+  ASSERT_TRUE(ReadImageFile(path.c_str(), &whole_info, &whole).ok());
+  const struct {
+    int32_t min_width, width, height;
+  } kCases[] = {{20, 20, 12},   {21, 40, 24}, {80, 80, 48},
+                {159, 160, 96}, {0, 160, 96}, {500, 160, 96}};
+  for (const auto& c : kCases) {
+    const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    ASSERT_GE(fd, 0);
+    test::RecordingSink sink;
+    const Status s = StreamImageDescriptor(fd, "scaled.jpg", c.min_width, sink);
+    close(fd);
+    ASSERT_TRUE(s.ok()) << s.message() << sink.error;
+    ASSERT_EQ(sink.frames.size(), 1u);
+    const auto& f = sink.frames[0];
+    EXPECT_EQ(f.info.width, c.width) << c.min_width;
+    EXPECT_EQ(f.info.height, c.height) << c.min_width;
+    // Each quadrant's mean against the whole image's (a gradient: the quadrants differ).
+    for (int32_t q = 0; q < 4; ++q) {
+      const auto mean = [&](const std::vector<uint8_t>& px, int32_t w, int32_t h) {
+        double sum = 0;
+        const int32_t x0 = (q % 2) * w / 2, y0 = (q / 2) * h / 2;
+        for (int32_t y = y0; y < y0 + h / 2; ++y)
+          for (int32_t x = x0; x < x0 + w / 2; ++x) sum += px[(y * w + x) * 3];
+        return sum / (w / 2 * (h / 2));
+      };
+      EXPECT_NEAR(mean(f.pixels, c.width, c.height), mean(whole, 160, 96), 3.0)
+          << c.min_width << ", quadrant " << q;
+    }
+  }
+  const int closed = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  close(closed);
+  test::RecordingSink none;
+  EXPECT_EQ(StreamImageDescriptor(closed, "gone.jpg", 20, none).code(), Code::kIoError);
 }
 
 TEST(JpegReader, ReadsGrayAndProgressive) {

@@ -12,6 +12,7 @@
 #include "firmware/codecs/exif.h"
 #include "firmware/codecs/jpeg_writer.h"
 #include "tests/firmware/codecs/jpeg_test_util.h"
+#include "tests/firmware/codecs/test_images.h"
 
 namespace lb {
 namespace {
@@ -93,6 +94,26 @@ TEST(ThumbnailTest, CarriesThePhotosOrientation) {
   const Thumb t = ThumbOf(photo, dir);
   EXPECT_EQ(t.w, 320) << "the pixels stay as stored";
   EXPECT_EQ(ExifOrientation(t.jpeg.data(), t.jpeg.size()), 6);
+}
+
+TEST(ThumbnailTest, AGreyPhotoGivesAGreyThumbnail) {
+  test::ScratchDir dir;
+  const int32_t w = 640, h = 480;
+  std::vector<uint8_t> grey(static_cast<size_t>(w) * h);
+  for (int32_t y = 0; y < h; ++y)
+    for (int32_t x = 0; x < w; ++x) grey[static_cast<size_t>(y * w + x)] = x < w / 2 ? 40 : 210;
+  test::Bytes photo;
+  ASSERT_TRUE(test::EncodeJpeg(w, h, 1, grey.data(), 90, false, &photo));
+  const Thumb t = ThumbOf(photo, dir);
+  EXPECT_EQ(t.w, 320);
+  EXPECT_EQ(t.h, 240);
+  const auto at = [&](int32_t x, int32_t y, int c) {
+    return t.ycc[static_cast<size_t>(y * t.w + x) * 3 + c];
+  };
+  EXPECT_NEAR(at(40, 120, 0), 40, 6);
+  EXPECT_NEAR(at(280, 120, 0), 210, 6);
+  EXPECT_NEAR(at(280, 120, 1), 128, 2) << "no colour";
+  EXPECT_NEAR(at(280, 120, 2), 128, 2) << "no colour";
 }
 
 TEST(ThumbnailTest, CorruptBytesAreAnError) {
