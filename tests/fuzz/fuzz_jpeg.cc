@@ -2,10 +2,13 @@
 // detection), then as a burst frame file the way the file sensor opens one through the codecs
 // (CodecImageDecoder: ProbeImageFile, then libexif through ExifFocalPx and ExifOrientation). The
 // EXIF readers take a path, so the input is also written to an in-memory file (memfd) opened by
-// its /proc name; the orientation read from memory (as `refocus rerender` does) must agree.
+// its /proc name; the orientation read from memory (as `refocus rerender` does) must agree. And
+// the web page's thumbnail read from that descriptor, the JPEG shrunk in the decoder to a width
+// taken from the input: the frame it delivers lies between that width and the probed one.
 #include <sys/mman.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -16,9 +19,11 @@
 
 namespace {
 
-// The input as a file: "/proc/self/fd/N" of a memfd rewritten for every input.
+int g_fd = -1;
+
+// The input as a file: "/proc/self/fd/N" of a memfd (g_fd) rewritten for every input.
 const char* InputFile(const uint8_t* data, size_t size) {
-  static int fd = -1;
+  int& fd = g_fd;
   static char path[64];
   if (fd < 0) {
     fd = memfd_create("fuzz_jpeg", MFD_CLOEXEC);
@@ -41,8 +46,35 @@ const char* InputFile(const uint8_t* data, size_t size) {
     perror("fuzz_jpeg: ftruncate");
     abort();
   }
+  if (lseek(fd, 0, SEEK_SET) != 0) {
+    perror("fuzz_jpeg: lseek");
+    abort();
+  }
   return path;
 }
+
+// Counts what a read delivers and checks its order.
+class CountingSink final : public lb::FrameSink {
+ public:
+  lb::Status BeginFrame(const lb::FrameInfo& info) override {
+    info_ = info;
+    ++frames_;
+    return lb::Status::Ok();
+  }
+  lb::Status Rows(const lb::FrameRows& rows) override {
+    LB_FUZZ_REQUIRE(rows.y0 == rows_ && rows.height > 0, "rows %d+%d after %d", rows.y0,
+                    rows.height, rows_);
+    rows_ += rows.height;
+    return lb::Status::Ok();
+  }
+  lb::Status EndFrame() override {
+    ended_ = true;
+    return lb::Status::Ok();
+  }
+  lb::FrameInfo info_;
+  int32_t frames_ = 0, rows_ = 0;
+  bool ended_ = false;
+};
 
 }  // namespace
 
@@ -75,5 +107,20 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const int32_t in_memory = lb::ExifOrientation(data, size);
   LB_FUZZ_REQUIRE(in_memory == orientation, "orientation %d from memory, %d from the file",
                   in_memory, orientation);
+  if (memory.ok() && int64_t{memory_info.width} * memory_info.height <= lb::fuzz::kMaxFuzzPixels) {
+    const int32_t min_width = 1 + static_cast<int32_t>(size % 97);
+    CountingSink sink;
+    const lb::Status thumb = lb::StreamImageDescriptor(g_fd, "fuzz.jpeg", min_width, sink);
+    LB_FUZZ_REQUIRE(thumb.code() != lb::Code::kInternal, "%s", thumb.message());
+    if (thumb.ok()) {
+      const int32_t w = sink.info_.width, want = std::min(min_width, memory_info.width);
+      LB_FUZZ_REQUIRE(sink.frames_ == 1 && sink.ended_ && sink.rows_ == sink.info_.height,
+                      "%d frames, %d of %d rows", sink.frames_, sink.rows_, sink.info_.height);
+      LB_FUZZ_REQUIRE(w >= want && w <= memory_info.width && sink.info_.height >= 1 &&
+                          sink.info_.height <= memory_info.height,
+                      "%dx%d for at least %d of %dx%d", w, sink.info_.height, min_width,
+                      memory_info.width, memory_info.height);
+    }
+  }
   return 0;
 }
