@@ -3,6 +3,9 @@
 #include <libexif/exif-data.h>
 #include <libexif/exif-loader.h>
 
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstring>
 
 #include "algo/motion/camera.h"
@@ -166,22 +169,50 @@ int32_t ExifOrientation(const char* path) {
   return ShortTag(exif_data_new_from_file(path), EXIF_IFD_0, EXIF_TAG_ORIENTATION, 1, 8);
 }
 
-int32_t ExifOrientation(const uint8_t* data, size_t size) {
-  // The loader a path goes through too, so both find the same APP1 segment.
+namespace {
+
+// The loader a path goes through too, so every read finds the same APP1 segment. It is fed the
+// 1 KiB pieces libexif's own file reader hands it, so that every read makes the same calls; it
+// takes a non-const buffer it only reads, and says when it has enough. `next` fills a piece
+// and returns its length, 0 at the end.
+template <typename Next>
+int32_t OrientationFromPieces(Next&& next) {
   ExifLoader* loader = exif_loader_new();
   if (loader == nullptr) return 0;
-  // In the 1 KiB pieces libexif's own file reader hands the loader, so that both reads make the
-  // same calls; the loader takes a non-const buffer it only reads, and says when it has enough.
   constexpr size_t kPiece = 1024;
   unsigned char piece[kPiece];
-  for (size_t pos = 0; pos < size; pos += kPiece) {
-    const size_t n = size - pos < kPiece ? size - pos : kPiece;
-    memcpy(piece, data + pos, n);
+  for (size_t n = next(piece, kPiece); n > 0; n = next(piece, kPiece)) {
     if (!exif_loader_write(loader, piece, static_cast<unsigned int>(n))) break;
   }
   ExifData* exif = exif_loader_get_data(loader);
   exif_loader_unref(loader);
   return ShortTag(exif, EXIF_IFD_0, EXIF_TAG_ORIENTATION, 1, 8);
+}
+
+}  // namespace
+
+int32_t ExifOrientation(const uint8_t* data, size_t size) {
+  size_t pos = 0;
+  return OrientationFromPieces([&](unsigned char* piece, size_t max) {
+    const size_t n = size - pos < max ? size - pos : max;
+    if (n == 0) return n;  // data may be null when size is 0
+    memcpy(piece, data + pos, n);
+    pos += n;
+    return n;
+  });
+}
+
+int32_t ExifOrientationAt(int fd) {
+  off_t pos = 0;
+  return OrientationFromPieces([&](unsigned char* piece, size_t max) -> size_t {
+    for (;;) {
+      const ssize_t n = pread(fd, piece, max, pos);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) return 0;
+      pos += n;
+      return static_cast<size_t>(n);
+    }
+  });
 }
 
 namespace {

@@ -40,6 +40,9 @@ double ExifFocalPx(const char* path, int32_t width, int32_t height);
 int32_t ExifOrientation(const char* path);
 // The same from a whole file already in memory.
 int32_t ExifOrientation(const uint8_t* data, size_t size);
+// The same from an open file (borrowed; read from its start with pread, so where it stands does
+// not move), read only as far as its EXIF segment.
+int32_t ExifOrientationAt(int fd);
 
 // How a viewer turns the stored pixels for EXIF Orientation `o`, on points given as fractions
 // of the image's sides: stored (s, t) -> displayed (u, v), and back. Orientations outside 1..8

@@ -1,9 +1,5 @@
 #include "firmware/web/thumbnail.h"
 
-#include <unistd.h>
-
-#include <cerrno>
-
 #include "algo/core/color.h"
 #include "algo/core/frame.h"
 #include "firmware/codecs/exif.h"
@@ -14,22 +10,6 @@ namespace lb {
 namespace {
 
 constexpr int32_t kStripRows = 16;  // JpegWriter's
-// Where a photo's EXIF segment is looked for: it comes first, after at most a JFIF APP0.
-constexpr size_t kExifHead = 128 * 1024;
-
-// The photo's EXIF Orientation (0: none) from the head of the file, read where it stands.
-int32_t OrientationAt(int fd) {
-  std::vector<uint8_t> head(kExifHead);
-  size_t got = 0;
-  while (got < head.size()) {
-    const ssize_t n = pread(fd, head.data() + got, head.size() - got, static_cast<off_t>(got));
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;
-    got += static_cast<size_t>(n);
-  }
-  return ExifOrientation(head.data(), got);
-}
-
 // Takes the decoded rows (already shrunk by the decoder to at least the thumbnail's width) the
 // rest of the way by area averages: input row y belongs to output row y * out_h / in_h, column x
 // to x * out_w / in_w, and an output pixel is the mean of its own. Finished rows go to the JPEG
@@ -147,7 +127,7 @@ class ShrinkSink final : public FrameSink {
 Status MakeThumbnail(int fd, int32_t width, int quality, std::vector<uint8_t>* out) {
   out->clear();
   if (width < 1) return Status(Code::kInvalidArgument, "thumbnail width %d", width);
-  ShrinkSink shrink(width, quality, OrientationAt(fd), out);
+  ShrinkSink shrink(width, quality, ExifOrientationAt(fd), out);
   const Status s = StreamImageDescriptor(fd, "thumbnail", width, shrink);
   if (!s.ok()) out->clear();
   return s;

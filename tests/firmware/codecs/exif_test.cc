@@ -1,6 +1,8 @@
 #include "firmware/codecs/exif.h"
 
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <string>
 #include <vector>
@@ -41,6 +43,14 @@ TEST(ExifTest, TagsReadFromMemoryAndFromTheFileAgree) {
   EXPECT_EQ(ExifOrientation(path.c_str()), 6);
   EXPECT_EQ(ExifOrientation(jpeg.data(), jpeg.size()), 6);
   EXPECT_DOUBLE_EQ(ExifFocalPx(path.c_str(), 4000, 3000), FocalPxFrom35mm(28, 4000, 3000));
+  // From an open descriptor (the thumbnails'): the same, and where it stands does not move.
+  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(lseek(fd, 5, SEEK_SET), 5);
+  EXPECT_EQ(ExifOrientationAt(fd), 6);
+  EXPECT_EQ(lseek(fd, 0, SEEK_CUR), 5);
+  close(fd);
+  EXPECT_EQ(ExifOrientationAt(fd), 0) << "a closed descriptor reads as no tag";
 }
 
 TEST(ExifTest, NoTagsReadAsZero) {

@@ -94,6 +94,13 @@ TEST(ThumbnailTest, CarriesThePhotosOrientation) {
   const Thumb t = ThumbOf(photo, dir);
   EXPECT_EQ(t.w, 320) << "the pixels stay as stored";
   EXPECT_EQ(ExifOrientation(t.jpeg.data(), t.jpeg.size()), 6);
+  // Behind 300 KB of other APP segments (an ICC profile, say) the orientation is still found.
+  std::vector<uint8_t> app2 = {0xff, 0xe2, 0xff, 0xff};
+  app2.resize(2 + 0xffff, 0x5a);
+  for (int i = 0; i < 5; ++i) photo.insert(photo.begin() + 2, app2.begin(), app2.end());
+  ASSERT_EQ(ExifOrientation(photo.data(), photo.size()), 6);
+  const Thumb behind = ThumbOf(photo, dir);
+  EXPECT_EQ(ExifOrientation(behind.jpeg.data(), behind.jpeg.size()), 6);
 }
 
 TEST(ThumbnailTest, AGreyPhotoGivesAGreyThumbnail) {
