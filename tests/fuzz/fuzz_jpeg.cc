@@ -4,7 +4,8 @@
 // EXIF readers take a path, so the input is also written to an in-memory file (memfd) opened by
 // its /proc name; the orientation read from memory (as `refocus rerender` does) must agree. And
 // the web page's thumbnail read from that descriptor, the JPEG shrunk in the decoder to a width
-// taken from the input: the frame it delivers lies between that width and the probed one.
+// taken from the input: the frame it delivers lies between that width and the probed one, and
+// the orientation read from the descriptor agrees with the others.
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -107,6 +108,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const int32_t in_memory = lb::ExifOrientation(data, size);
   LB_FUZZ_REQUIRE(in_memory == orientation, "orientation %d from memory, %d from the file",
                   in_memory, orientation);
+  const int32_t at = lb::ExifOrientationAt(g_fd);  // the thumbnails' read
+  LB_FUZZ_REQUIRE(at == orientation, "orientation %d from the descriptor, %d from the file", at,
+                  orientation);
   if (memory.ok() && int64_t{memory_info.width} * memory_info.height <= lb::fuzz::kMaxFuzzPixels) {
     const int32_t min_width = 1 + static_cast<int32_t>(size % 97);
     CountingSink sink;
