@@ -13,7 +13,7 @@ namespace lb {
 
 namespace {
 
-constexpr int32_t kStripRows = 16;  // luma rows per iMCU row at 4:2:0
+constexpr int32_t kStripRows = JpegWriter::kStripRows;
 constexpr size_t kOutputBuffer = 16384;
 
 // Luma width that libjpeg reads per row (whole MCUs), and the chroma width likewise.

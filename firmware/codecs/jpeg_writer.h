@@ -36,6 +36,8 @@ struct JpegMetadata : ExifTags {
 
 class JpegWriter {
  public:
+  static constexpr int32_t kStripRows = 16;  // luma rows a strip (one iMCU row at 4:2:0)
+
   JpegWriter();
   ~JpegWriter();
   JpegWriter(const JpegWriter&) = delete;
@@ -49,8 +51,8 @@ class JpegWriter {
   Status BeginMemory(std::vector<uint8_t>* out, int32_t width, int32_t height, int quality,
                      const JpegMetadata& meta);
 
-  // Y, Cb, Cr planes of the next `rows` luma rows: 16 for every strip but the last, which may be
-  // shorter; chroma planes hold (rows + 1) / 2 rows of (width + 1) / 2 samples.
+  // Y, Cb, Cr planes of the next `rows` luma rows: kStripRows for every strip but the last, which
+  // may be shorter; chroma planes hold (rows + 1) / 2 rows of (width + 1) / 2 samples.
   Status WriteStrip(const ConstPlanarU8& strip, int32_t rows);
 
   // The segments announced by JpegMetadata::segments_later, at any point after Begin and

@@ -140,9 +140,7 @@ Status AtomicFile::Commit(Replace replace) {
   // replaced: they wait until the file is in place and marked (temp_registry.h).
   sigset_t stops, old;
   sigemptyset(&stops);
-  sigaddset(&stops, SIGINT);
-  sigaddset(&stops, SIGTERM);
-  sigaddset(&stops, SIGHUP);
+  for (int sig : temp_registry::kStopSignals) sigaddset(&stops, sig);
   pthread_sigmask(SIG_BLOCK, &stops, &old);
   const int err = replace == Replace::kNever             ? RenameNoReplace()
                   : rename(temp_path_, final_path_) == 0 ? 0

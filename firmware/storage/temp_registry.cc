@@ -71,7 +71,7 @@ void RemoveTemporariesOnSignals() {
   sa.sa_handler = OnFatalSignal;
   sa.sa_flags = SA_RESTART;
   sigemptyset(&sa.sa_mask);
-  for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &sa, nullptr);
+  for (int sig : temp_registry::kStopSignals) sigaction(sig, &sa, nullptr);
 }
 
 }  // namespace lb

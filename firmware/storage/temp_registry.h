@@ -3,6 +3,8 @@
 // allocates and the handler reads them safely.
 #pragma once
 
+#include <signal.h>
+
 namespace lb::temp_registry {
 
 inline constexpr int kSlots = 16;
@@ -19,6 +21,8 @@ void UnlinkAll();
 // interrupted command has left the old file or ends as if not interrupted, never both.
 // AtomicFile calls it with the signals blocked from before its rename, so none falls between.
 void MarkCommitted();
+// The signals that end a command (RemoveTemporariesOnSignals) and that a commit holds off.
+inline constexpr int kStopSignals[] = {SIGINT, SIGTERM, SIGHUP};
 
 }  // namespace lb::temp_registry
 

@@ -9,7 +9,8 @@
 namespace lb {
 namespace {
 
-constexpr int32_t kStripRows = 16;  // JpegWriter's
+constexpr int32_t kStripRows = JpegWriter::kStripRows;
+
 // Takes the decoded rows (already shrunk by the decoder to at least the thumbnail's width) the
 // rest of the way by area averages: input row y belongs to output row y * out_h / in_h, column x
 // to x * out_w / in_w, and an output pixel is the mean of its own. Finished rows go to the JPEG
