@@ -156,7 +156,7 @@ LB_KEEP_CALLS void DataTerm::PrefetchRow(int32_t y, int32_t x0, int32_t x1) cons
     }
     return;
   }
-  constexpr int32_t kChunk = 64;
+  constexpr int32_t kChunk = 64, kMaxRows = 4;
   for (int32_t j = 0; j < others; ++j) {
     const int32_t v = OtherView(j);
     const PlaneRowMap map(planes_[v], row);
@@ -168,7 +168,8 @@ LB_KEEP_CALLS void DataTerm::PrefetchRow(int32_t y, int32_t x0, int32_t x1) cons
       if (a_ok && b_ok) {
         const int32_t r0 = Max(Min(ay, by) >> 16, 0), r1 = Min((Max(ay, by) >> 16) + 1, h - 1);
         const int32_t c0 = Max((Min(ax, bx) >> 16) - 1, 0), c1 = Min((Max(ax, bx) >> 16) + 2, w);
-        for (int32_t r = r0; r <= r1 && c0 < c1; ++r) {
+        // A chunk crossing more rows is steep (a plane seen almost edge-on): not worth asking for.
+        for (int32_t r = r0; r <= r1 && r1 - r0 <= kMaxRows && c0 < c1; ++r) {
           PrefetchLines(images_[v].Row(r) + 3 * c0, static_cast<size_t>(3) * (c1 - c0));
           const uint8_t* census = census_[v] + static_cast<ptrdiff_t>(r) * 3 * w + c0;
           for (int32_t k = 0; k < 3; ++k) {
