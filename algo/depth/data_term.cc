@@ -165,16 +165,15 @@ LB_KEEP_CALLS void DataTerm::PrefetchRow(int32_t y, int32_t x0, int32_t x1) cons
     for (int32_t c = x0; c < x1; c += kChunk) {
       int32_t bx = 0, by = 0;
       const bool b_ok = map.At(Min(c + kChunk, x1 - 1), &bx, &by);
-      if (a_ok && b_ok) {
-        const int32_t r0 = Max(Min(ay, by) >> 16, 0), r1 = Min((Max(ay, by) >> 16) + 1, h - 1);
-        const int32_t c0 = Max((Min(ax, bx) >> 16) - 1, 0), c1 = Min((Max(ax, bx) >> 16) + 2, w);
-        // A chunk crossing more rows is steep (a plane seen almost edge-on): not worth asking for.
-        for (int32_t r = r0; r <= r1 && r1 - r0 <= kMaxRows && c0 < c1; ++r) {
-          PrefetchLines(images_[v].Row(r) + 3 * c0, static_cast<size_t>(3) * (c1 - c0));
+      const int32_t r0 = Max(Min(ay, by) >> 16, 0), r1 = Min((Max(ay, by) >> 16) + 1, h - 1);
+      const int32_t c0 = Max((Min(ax, bx) >> 16) - 1, 0), c1 = Min((Max(ax, bx) >> 16) + 2, w);
+      // A chunk crossing more rows is steep (a plane seen almost edge-on): not worth asking for.
+      if (a_ok && b_ok && r1 - r0 <= kMaxRows && c0 < c1) {
+        const size_t n = static_cast<size_t>(c1 - c0);
+        for (int32_t r = r0; r <= r1; ++r) {
+          PrefetchLines(images_[v].Row(r) + 3 * c0, 3 * n);
           const uint8_t* census = census_[v] + static_cast<ptrdiff_t>(r) * 3 * w + c0;
-          for (int32_t k = 0; k < 3; ++k) {
-            PrefetchLines(census + k * w, static_cast<size_t>(c1 - c0));
-          }
+          for (int32_t k = 0; k < 3; ++k) PrefetchLines(census + k * w, n);
         }
       }
       ax = bx;
