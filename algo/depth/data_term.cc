@@ -380,9 +380,9 @@ void DataTerm::ComputeBand(const Scratch& s, int32_t disp_q8, int32_t x0, int32_
   for (int32_t r = y0 - 1; r <= y0; ++r) window_rows(r);
   for (int32_t y = y0; y < y1; ++y) {
     window_rows(y + 1);
-    // No PrefetchRow: whole rows come from the winner-take-all's bands, whose view rows stay in
-    // cache from one label to the next, and asking for them again cost more than it saved (on
-    // teddy's shifts 3 % of the depth time, as on the plane sweep).
+    // No PrefetchRow: whole rows follow each other in every view (a stream the hardware
+    // prefetcher follows), and the winner-take-all's bands keep them in cache from one label to
+    // the next; asking again cost more than it saved (teddy's shifts, as the plane sweep).
     // The ring's three rows of each view are y - 1 .. y + 1.
     kernels_->select(s.hsum, w, others, x0, x1, out + (y - y0) * stride);
   }
