@@ -147,17 +147,35 @@ LB_KEEP_CALLS void DataTerm::PrefetchRow(int32_t y, int32_t x0, int32_t x1) cons
     }
     return;
   }
+  // The view positions of the chunks' ends only pick lines to ask for, so they come from the
+  // homography in double (one division), not from the exact integer Map (two 64-bit ones). A
+  // position off by a rounding asks for a neighbouring line; whole pixels, truncated.
   constexpr int32_t kChunk = 64, kMaxRows = 4;
+  constexpr double kMinDen = 1 << 20, kMaxDen = 4294967296.0, kMaxPos = 1 << 14;
   for (int32_t j = 0; j < others; ++j) {
     const int32_t v = OtherView(j);
-    const PlaneRowMap map(planes_[v], row);
+    const int64_t* m = planes_[v].m;
+    const double den_row = static_cast<double>(m[7] * row + m[8]);
+    const double nx_row = static_cast<double>(m[1] * row + m[2]);
+    const double ny_row = static_cast<double>(m[4] * row + m[5]);
+    const double m6 = static_cast<double>(m[6]), m0 = static_cast<double>(m[0]);
+    const double m3 = static_cast<double>(m[3]);
+    auto at = [&](int32_t x, int32_t* px, int32_t* py) {
+      const double den = m6 * x + den_row;
+      if (!(den >= kMinDen && den < kMaxDen)) return false;
+      const double inv = 1.0 / den, fx = (m0 * x + nx_row) * inv, fy = (m3 * x + ny_row) * inv;
+      if (!(fx > -kMaxPos && fx < kMaxPos && fy > -kMaxPos && fy < kMaxPos)) return false;
+      *px = static_cast<int32_t>(fx);
+      *py = static_cast<int32_t>(fy);
+      return true;
+    };
     int32_t ax = 0, ay = 0;
-    bool a_ok = map.At(x0, &ax, &ay);
+    bool a_ok = at(x0, &ax, &ay);
     for (int32_t c = x0; c < x1; c += kChunk) {
       int32_t bx = 0, by = 0;
-      const bool b_ok = map.At(Min(c + kChunk, x1 - 1), &bx, &by);
-      const int32_t r0 = Max(Min(ay, by) >> 16, 0), r1 = Min((Max(ay, by) >> 16) + 1, h - 1);
-      const int32_t c0 = Max((Min(ax, bx) >> 16) - 1, 0), c1 = Min((Max(ax, bx) >> 16) + 2, w);
+      const bool b_ok = at(Min(c + kChunk, x1 - 1), &bx, &by);
+      const int32_t r0 = Max(Min(ay, by), 0), r1 = Min(Max(ay, by) + 1, h - 1);
+      const int32_t c0 = Max(Min(ax, bx) - 1, 0), c1 = Min(Max(ax, bx) + 2, w);
       // A chunk crossing more rows is steep (a plane seen almost edge-on): not worth asking for.
       if (a_ok && b_ok && r1 - r0 <= kMaxRows && c0 < c1) {
         const size_t n = static_cast<size_t>(c1 - c0);
