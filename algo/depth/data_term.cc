@@ -102,7 +102,8 @@ void DataTerm::PixelCostRow(int32_t view, int32_t y, int32_t x0, int32_t x1, uin
                             const int32_t* ref_lanes) const {
   const WarpSource src{images_[reference_], images_[view], census_[reference_],
                        census_[view],       ref_lanes,     width_};
-  PlaneCostRow(planes_[view], src, y, params_, invalid_cost_, x0, x1, out, kernels_->plane);
+  PlaneCostRow(planes_[view], src, y, params_, invalid_cost_, x0, x1, out, kernels_->plane,
+               kernels_->plane_anchors);
 }
 
 // Horizontal 3-sum of the pixel costs of row y (borders replicated) for columns x0..x1-1:

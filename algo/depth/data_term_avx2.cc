@@ -428,8 +428,8 @@ constexpr SelectRowFn kAvx2ByKeep[kMaxBest] = {
 
 const DataTerm::Kernels* Avx2Kernels() {
   static constexpr DataTerm::Kernels kAvx2 = {
-      CensusRowAvx2, CostRowAvx2,    HSumRowAvx2,   SelectByKeep<kAvx2ByKeep>,
-      RectRowAvx2,   PlaneSpansAvx2, PlaneLanesAvx2};
+      CensusRowAvx2, CostRowAvx2,    HSumRowAvx2,    SelectByKeep<kAvx2ByKeep>,
+      RectRowAvx2,   PlaneSpansAvx2, PlaneLanesAvx2, PlaneAnchorsAvx2};
   return __builtin_cpu_supports("avx2") ? &kAvx2 : nullptr;
 }
 

@@ -98,6 +98,7 @@ struct DataTerm::Kernels {
   // read them.
   void (*plane_lanes)(const uint8_t* ref, const uint8_t* cref, int32_t width, int32_t x0,
                       int32_t x1, int32_t* lanes, ptrdiff_t stride);
+  PlaneAnchorsFn plane_anchors;  // a row's anchors for `plane` (warp_cost.h)
 };
 
 namespace dtk {
@@ -130,10 +131,16 @@ void CostRowCAvx2(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, c
                   ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc, int32_t cw, uint8_t* out);
 #endif
 // The plane sweep's span kernels, one run of spans a call: the C reference (warp_cost.cc), AVX2
-// (warp_cost_avx2.cc, the caller checks the CPU) and NEON (warp_cost_neon.cc).
+// (warp_cost_avx2.cc, the caller checks the CPU) and NEON (warp_cost_neon.cc). Its anchor
+// kernels, a row's anchors a call: the C reference and AVX2 (ARM takes the reference: aarch64
+// divides in one instruction, and armhf has no 64-bit lanes to divide in).
 void PlaneSpansC(const WarpRow& row, const WarpRun& run, uint8_t* out);
+bool PlaneAnchorsC(const int64_t* sums, const int64_t* changes, int32_t count, int32_t* x_q16,
+                   int32_t* y_q16, bool* ok);
 #if defined(__x86_64__)
 void PlaneSpansAvx2(const WarpRow& row, const WarpRun& run, uint8_t* out);
+bool PlaneAnchorsAvx2(const int64_t* sums, const int64_t* changes, int32_t count, int32_t* x_q16,
+                      int32_t* y_q16, bool* ok);
 void PlaneLanesAvx2(const uint8_t* ref, const uint8_t* cref, int32_t width, int32_t x0, int32_t x1,
                     int32_t* lanes, ptrdiff_t stride);
 #endif

@@ -210,7 +210,8 @@ const DataTerm::Kernels* NeonKernels() {
                                               SelectByKeep<kNeonByKeep>,
                                               RectRowWith<CostRowNeon, HSumRowNeon>,
                                               PlaneSpansNeon,
-                                              nullptr};
+                                              nullptr,
+                                              PlaneAnchorsC};
   return &kNeon;
 }
 

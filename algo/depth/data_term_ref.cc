@@ -158,14 +158,14 @@ void SelectRowC(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t 
 }
 
 const DataTerm::Kernels kReference = {
-    CensusRowC,  CostRowC, HSumRowC, SelectRowC, RectRowWith<CostRowC, HSumRowC>,
-    PlaneSpansC, nullptr};
+    CensusRowC,  CostRowC, HSumRowC,     SelectRowC, RectRowWith<CostRowC, HSumRowC>,
+    PlaneSpansC, nullptr,  PlaneAnchorsC};
 
 const DataTerm::Kernels* Ssse3Kernels() {
 #if defined(__x86_64__)
   static constexpr DataTerm::Kernels kSsse3 = {
-      CensusRowC,  CostRowCSsse3, HSumRowC, SelectRowC, RectRowWith<CostRowCSsse3, HSumRowC>,
-      PlaneSpansC, nullptr};
+      CensusRowC,  CostRowCSsse3, HSumRowC,     SelectRowC, RectRowWith<CostRowCSsse3, HSumRowC>,
+      PlaneSpansC, nullptr,       PlaneAnchorsC};
   return __builtin_cpu_supports("ssse3") ? &kSsse3 : nullptr;
 #else
   return nullptr;

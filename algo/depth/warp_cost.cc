@@ -95,6 +95,24 @@ void PlaneSpansC(const WarpRow& row, const WarpRun& run, uint8_t* out) {
   }
 }
 
+bool PlaneAnchorsC(const int64_t* sums, const int64_t* changes, int32_t count, int32_t* x_q16,
+                   int32_t* y_q16, bool* ok) {
+  // Where a 64-bit division is an instruction (x86-64, aarch64) Map's two are as fast as the
+  // row map's estimate and correction; on 32-bit ARM they are library calls.
+  constexpr bool kExactDivide = sizeof(void*) >= 8;
+  int64_t den = sums[0], nx = sums[1], ny = sums[2];
+  bool all = true;
+  for (int32_t k = 0; k < count; ++k) {
+    den += changes[0];
+    nx += changes[1];
+    ny += changes[2];
+    ok[k] = PlaneRowMap::FromSums<kExactDivide>(den, nx, ny, &x_q16[k], &y_q16[k]);
+    if (!ok[k]) x_q16[k] = y_q16[k] = 0;
+    all &= ok[k];
+  }
+  return all;
+}
+
 }  // namespace dtk
 
 bool WarpSpan(const PlaneHomography& h, int32_t x0, int32_t x1, int32_t y, int32_t* x_q16,
@@ -107,8 +125,9 @@ bool WarpSpan(const PlaneHomography& h, int32_t x0, int32_t x1, int32_t y, int32
 
 void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
                   const DataTermParams& params, int32_t invalid_cost, int32_t x_begin,
-                  int32_t x_end, uint8_t* out, PlaneSpanFn span) {
+                  int32_t x_end, uint8_t* out, PlaneSpanFn span, PlaneAnchorsFn anchors) {
   if (span == nullptr) span = dtk::PlaneSpansC;
+  if (anchors == nullptr) anchors = dtk::PlaneAnchorsC;
   const int32_t w = src.ref.width;
   const ptrdiff_t census_row = static_cast<ptrdiff_t>(y) * 3 * w;
   const WarpRow row{src.view.data,
@@ -127,9 +146,7 @@ void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
   int32_t first = x_begin - x_begin % kAnchorStep;
   if (first == w - 1 && first > 0) first -= kAnchorStep;  // w - 1 ends the span before it
   // A span's end anchor is the next one's start: one Map per span.
-  // Where a 64-bit division is an instruction (x86-64, aarch64) Map's two are as fast as the
-  // row map's estimate and correction; on 32-bit ARM they are library calls.
-  constexpr bool kExactDivide = sizeof(void*) >= 8;
+  constexpr bool kExactDivide = sizeof(void*) >= 8;  // as PlaneAnchorsC
   const PlaneRowMap row_map(h, y);
   // An anchor that does not map gets 0s: its entries are copied along, never read.
   auto map = [&](int32_t x, int32_t* x_q16, int32_t* y_q16) {
@@ -157,14 +174,7 @@ void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
     int64_t sums[3], changes[3];
     row_map.Sums(x0, sums);
     row_map.Changes(kAnchorStep, changes);
-    for (int32_t k = 1; k <= stepped; ++k) {
-      sums[0] += changes[0];
-      sums[1] += changes[1];
-      sums[2] += changes[2];
-      ok[k] = PlaneRowMap::FromSums<kExactDivide>(sums[0], sums[1], sums[2], &ax[k], &ay[k]);
-      if (!ok[k]) ax[k] = ay[k] = 0;
-      all &= ok[k];
-    }
+    if (stepped > 0) all &= anchors(sums, changes, stepped, ax + 1, ay + 1, ok + 1);
     int32_t k = stepped + 1;
     int32_t spans = k - 1, last = x0 + kAnchorStep * spans;
     if (k <= count) {

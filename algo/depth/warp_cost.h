@@ -210,12 +210,20 @@ inline void RunSpans(const WarpRun& run, int32_t* first, int32_t* end) {
 // (data_term_kernels.h).
 using PlaneSpanFn = void (*)(const WarpRow& row, const WarpRun& run, uint8_t* out);
 
+// The anchors of one row after a first one: sums (den, nx, ny: PlaneRowMap::Sums at the first
+// anchor) stepped by changes (PlaneRowMap::Changes), anchor k = 1..count into x_q16[k - 1],
+// y_q16[k - 1] and ok[k - 1] as PlaneRowMap::FromSums gives them (0s where it refuses). True
+// when every one maps. The C reference is dtk::PlaneAnchorsC (warp_cost.cc); the AVX2 twin
+// (warp_cost_avx2.cc) gives the same values four anchors at a time.
+using PlaneAnchorsFn = bool (*)(const int64_t* sums, const int64_t* changes, int32_t count,
+                                int32_t* x_q16, int32_t* y_q16, bool* ok);
+
 // Pixel costs 0..255 of columns x0..x1-1 of reference row y (out indexed by x) against the view
 // seen through h (invalid_cost where a sample needs a pixel outside the view, or the plane has no
 // map there). The anchors stay at multiples of kAnchorStep, so a column's cost does not depend on
-// the range asked for. `span` is the kernel (nullptr: the C reference).
+// the range asked for. `span` and `anchors` are the kernels (nullptr: the C references).
 void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
                   const DataTermParams& params, int32_t invalid_cost, int32_t x0, int32_t x1,
-                  uint8_t* out, PlaneSpanFn span = nullptr);
+                  uint8_t* out, PlaneSpanFn span = nullptr, PlaneAnchorsFn anchors = nullptr);
 
 }  // namespace lb

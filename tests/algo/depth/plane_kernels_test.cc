@@ -223,6 +223,97 @@ PlaneHomography RandomPlane(std::mt19937& rng, int32_t w, int32_t h, double deg,
   return MakePlaneHomography(CameraIntrinsics{f, f, w / 2.0, h / 2.0}, m, rho);
 }
 
+// A row's anchors (PlaneAnchorsFn) against the reference, every count 1..kRunSpans: sums and
+// changes of random homographies along rows in and around the view, and made ones at FromSums's
+// edges: denominators at 2^20 - 1, 2^20, 2^32 - 1 and 2^32, numerators at +-(den 2^14 - 1) and
+// +-den 2^14, quotients on and just beside a half (odd denominators), INT64_MIN.
+TEST(PlaneKernels, AnchorVariantsEqualTheReference) {
+  LB_SKIP_WITHOUT_VARIANTS();
+  std::mt19937 rng(23);
+  int64_t mapped = 0, refused = 0;
+  auto compare = [&](const int64_t* sums, const int64_t* changes, const char* what,
+                     int32_t max_count = kRunSpans) {
+    for (int32_t count = 1; count <= max_count; ++count) {
+      int32_t wx[kRunSpans], wy[kRunSpans];
+      bool wok[kRunSpans];
+      const bool want = dtk::PlaneAnchorsC(sums, changes, count, wx, wy, wok);
+      for (int32_t k = 0; k < count; ++k) (wok[k] ? mapped : refused) += 1;
+      for (const dtk::Variant& var : Others()) {
+        int32_t gx[kRunSpans + 1], gy[kRunSpans + 1];
+        bool gok[kRunSpans + 1];
+        gx[count] = gy[count] = 0x5a5a5a5a;  // not written past count
+        ASSERT_EQ(var.kernels->plane_anchors(sums, changes, count, gx, gy, gok), want)
+            << var.name << " " << what << " count " << count;
+        ASSERT_EQ(gx[count], 0x5a5a5a5a) << var.name << " " << what;
+        for (int32_t k = 0; k < count; ++k) {
+          ASSERT_EQ(gok[k], wok[k]) << var.name << " " << what << " anchor " << k;
+          ASSERT_EQ(gx[k], wx[k]) << var.name << " " << what << " anchor " << k;
+          ASSERT_EQ(gy[k], wy[k]) << var.name << " " << what << " anchor " << k;
+        }
+      }
+    }
+  };
+  for (int32_t trial = 0; trial < 200; ++trial) {
+    const PlaneHomography hom =
+        RandomPlane(rng, 640, 480, trial < 100 ? 2.0 : 12.0, 0.2 + 0.8 * (trial % 5));
+    const int32_t y = static_cast<int32_t>(rng() % 600) - 60;
+    const int32_t x = static_cast<int32_t>(rng() % 800) - 80;
+    const PlaneRowMap map(hom, y);
+    int64_t sums[3], changes[3];
+    map.Sums(x, sums);
+    map.Changes(kAnchorStep, changes);
+    compare(sums, changes, "homography");
+  }
+  const int64_t edges[] = {(int64_t{1} << 20) - 1, int64_t{1} << 20, (int64_t{1} << 32) - 1,
+                           int64_t{1} << 32,       1000003,          (int64_t{1} << 31) + 1};
+  for (const int64_t den : edges) {
+    for (const int64_t n : {(den << 14) - 1, den << 14, -(den << 14) + 1, -(den << 14), den / 2,
+                            -(den / 2) - 1, int64_t{0}, INT64_MIN}) {
+      // Steps that cross the edges: the denominator by one each anchor, or the numerator.
+      for (const int64_t dd : {int64_t{-1}, int64_t{0}, int64_t{1}}) {
+        const int64_t sums[3] = {den - 20 * dd, n, n == INT64_MIN ? 0 : -n};
+        const int64_t changes[3] = {dd, n == INT64_MIN ? 0 : dd, n == INT64_MIN ? 1 : -dd};
+        compare(sums, changes, "edge");
+      }
+    }
+  }
+  // Quotients just at a whole value and just below the next (remainders 0, 1, den - 1, den - 2
+  // of |n| 2^16 + den / 2), where the estimate is corrected: odd denominators, so 2^16 has an
+  // inverse modulo den.
+  std::uniform_int_distribution<int64_t> odd_den(int64_t{1} << 19, (int64_t{1} << 31) - 1);
+  auto inverse_2_16 = [](int64_t den) {  // extended Euclid
+    int64_t r0 = den, r1 = 65536 % den, t0 = 0, t1 = 1;
+    while (r1 != 0) {
+      const int64_t q = r0 / r1;
+      std::swap(r0, r1);
+      r1 -= q * r0;
+      std::swap(t0, t1);
+      t1 -= q * t0;
+    }
+    return (t0 % den + den) % den;
+  };
+  for (int32_t trial = 0; trial < 40000; ++trial) {
+    const int64_t den = 2 * odd_den(rng) + 1;
+    const int64_t targets[4] = {0, 1, den - 1, den - 2};
+    const int64_t t = targets[trial % 4];
+    const uint64_t residue =
+        static_cast<uint64_t>(((t - den / 2) % den + den) % den) * inverse_2_16(den) % den;
+    const int64_t a = static_cast<int64_t>(residue) + static_cast<int64_t>(rng() % 16384) * den;
+    const int64_t sums[3] = {den, trial % 2 == 0 ? a : -a, trial % 3 == 0 ? -a : a};
+    const int64_t changes[3] = {0, 0, 0};
+    compare(sums, changes, "remainder", 4);
+  }
+  std::uniform_int_distribution<int64_t> big(-(int64_t{1} << 47), int64_t{1} << 47);
+  std::uniform_int_distribution<int64_t> den_of(int64_t{1} << 19, int64_t{1} << 33);
+  for (int32_t trial = 0; trial < 2000; ++trial) {
+    const int64_t sums[3] = {den_of(rng) | 1, big(rng), big(rng)};
+    const int64_t changes[3] = {big(rng) >> 20, big(rng) >> (trial % 30), big(rng) >> 10};
+    compare(sums, changes, "random");
+  }
+  EXPECT_GT(mapped, 100000);
+  EXPECT_GT(refused, 10000);
+}
+
 TEST(PlaneKernels, RowsThroughRandomHomographiesEqualTheReference) {
   LB_SKIP_WITHOUT_VARIANTS();
   std::mt19937 rng(22);
@@ -249,7 +340,7 @@ TEST(PlaneKernels, RowsThroughRandomHomographiesEqualTheReference) {
           for (const dtk::Variant& var : Others()) {
             std::vector<uint8_t> got(w, 0x5a);
             PlaneCostRow(hom, v.Source(), y, params, invalid, begin, x1, got.data(),
-                         var.kernels->plane);
+                         var.kernels->plane, var.kernels->plane_anchors);
             ASSERT_EQ(got, want) << var.name << " w " << w << " y " << y << " [" << begin << ", "
                                  << x1 << ") trial " << trial;
           }
