@@ -38,13 +38,18 @@ void DepthStage::BlockWeights() {
 
 // D of `label` for the blocks of rectangle b into out (block grid), through the pixels' D in
 // fine_.cost_alpha (scratch until the fine moves). At most 4 * 2295.
-void DepthStage::BlockCosts(int32_t label, const Rect& b, uint16_t* out) {
+void DepthStage::BlockCosts(int32_t label, const Rect& b, uint16_t* out, uint16_t* ring,
+                            bool continues) {
   const int32_t w = config_.width, h = config_.height, bw = coarse_.width;
   const int32_t x0 = 2 * b.x0, x1 = 2 * b.x1 < w ? 2 * b.x1 : w;
   const int32_t y0 = 2 * b.y0, y1 = 2 * b.y1 < h ? 2 * b.y1 : h;
   UseLabelPlanes(label);
   uint16_t* d = fine_.cost_alpha;
-  data_.ComputeRect(LabelDispQ8(label), x0, x1, y0, y1, d + y0 * w, w);
+  if (ring != nullptr) {
+    data_.ComputeRowsCarried(LabelDispQ8(label), y0, y1, continues, ring, d + y0 * w, w);
+  } else {
+    data_.ComputeRect(LabelDispQ8(label), x0, x1, y0, y1, d + y0 * w, w);
+  }
   // Whole blocks in a loop that vectorizes; a last odd column or row holds half blocks.
   const int32_t whole = Min(b.x1, w / 2);
   for (int32_t by = b.y0; by < b.y1; ++by) {
@@ -78,18 +83,27 @@ void DepthStage::CoarseWinnerTakeAll() {
   const int32_t coarse_labels = (config_.labels + config_.coarse_step - 1) / config_.coarse_step;
   size_t spare = 0;
   uint8_t* room = maxflow_.Spare(g.width, g.height, &spare);
-  block_costs_ = spare >= sizeof(uint16_t) * static_cast<size_t>(n) * coarse_labels
-                     ? reinterpret_cast<uint16_t*>(room)
-                     : nullptr;
+  const size_t block_bytes = sizeof(uint16_t) * static_cast<size_t>(n) * coarse_labels;
+  block_costs_ = spare >= block_bytes ? reinterpret_cast<uint16_t*>(room) : nullptr;
+  // Each label's 3-sums carried from band to band, after them when there is room.
+  const size_t ring_bytes = sizeof(uint16_t) * data_.CarriedRingSize();
+  const size_t rings_at = Arena::RoundUp(block_bytes);
+  uint16_t* rings = block_costs_ != nullptr && spare >= rings_at + ring_bytes * coarse_labels
+                        ? reinterpret_cast<uint16_t*>(room + rings_at)
+                        : nullptr;
   // Band by band, every label in turn: the views' rows of a band stay in cache from one label
-  // to the next (the data term streams every view once per call). A band costs the data term
-  // two more rows, so bands are not too thin either. The labels still come in order per block.
+  // to the next (the data term streams every view once per call). Without rings, a band costs
+  // the data term two more rows, so bands are not too thin either. The labels still come in
+  // order per block.
   const int32_t band = Max(1, kBandPixels / config_.width / 2);  // block rows
   for (int32_t by0 = 0; by0 < g.height; by0 += band) {
     const Rect rows{0, g.width, by0, Min(by0 + band, g.height)};
     for (int32_t label = 0; label < config_.labels; label += config_.coarse_step) {
       uint16_t* d = block_costs_ != nullptr ? CoarseCosts(label) : g.cost_alpha;
-      BlockCosts(label, rows, d);
+      uint16_t* ring = rings != nullptr
+                           ? rings + data_.CarriedRingSize() * (label / config_.coarse_step)
+                           : nullptr;
+      BlockCosts(label, rows, d, ring, by0 > 0);
       for (int32_t p = rows.y0 * g.width; p < rows.y1 * g.width; ++p) {
         if (d[p] < g.cost[p]) {
           g.cost[p] = d[p];

@@ -243,14 +243,20 @@ void DataTerm::ComputeRect(int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0, 
   const int32_t rows = y1 - y0, cols = x1 - x0;
   const int32_t bands = Bands(rows, int64_t{rows} * cols);
   if (bands <= 1) {
-    ComputeBand(scratch_[0], disp_q8, x0, x1, y0, y1, out, stride);
+    ComputeBand(scratch_[0], scratch_[0].hsum, false, disp_q8, x0, x1, y0, y1, out, stride);
     return;
   }
   ParallelFor(*runner_, bands, [&](int32_t band, int32_t worker) {
     const int32_t b0 = y0 + static_cast<int32_t>(int64_t{rows} * band / bands);
     const int32_t b1 = y0 + static_cast<int32_t>(int64_t{rows} * (band + 1) / bands);
-    ComputeBand(scratch_[worker], disp_q8, x0, x1, b0, b1, out + (b0 - y0) * stride, stride);
+    const Scratch& s = scratch_[worker];
+    ComputeBand(s, s.hsum, false, disp_q8, x0, x1, b0, b1, out + (b0 - y0) * stride, stride);
   });
+}
+
+void DataTerm::ComputeRowsCarried(int32_t disp_q8, int32_t y0, int32_t y1, bool continues,
+                                  uint16_t* ring, uint16_t* out, ptrdiff_t stride) {
+  if (y0 < y1) ComputeBand(scratch_[0], ring, continues, disp_q8, 0, width_, y0, y1, out, stride);
 }
 
 void RowRuns::Add(int32_t lo, int32_t hi, int32_t width, int32_t join) {
@@ -383,12 +389,13 @@ void DataTerm::ComputeRunBand(const Scratch& s, int32_t disp_q8, const RowRuns* 
   }
 }
 
-void DataTerm::ComputeBand(const Scratch& s, int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0,
-                           int32_t y1, uint16_t* out, ptrdiff_t stride) const {
+void DataTerm::ComputeBand(const Scratch& s, uint16_t* hsum, bool continues, int32_t disp_q8,
+                           int32_t x0, int32_t x1, int32_t y0, int32_t y1, uint16_t* out,
+                           ptrdiff_t stride) const {
   const int32_t w = width_;
   const int32_t others = views_ - 1;
-  auto ring = [&](int32_t j, int32_t row) {
-    return s.hsum + (static_cast<size_t>(j) * 3 + static_cast<size_t>((row - y0 + 1) % 3)) * w;
+  auto ring = [&](int32_t j, int32_t row) {  // row >= -1
+    return hsum + (static_cast<size_t>(j) * 3 + static_cast<size_t>((row + 3) % 3)) * w;
   };
   dtk::RectRow row;
   StartRows(disp_q8, &row);
@@ -396,14 +403,16 @@ void DataTerm::ComputeBand(const Scratch& s, int32_t disp_q8, int32_t x0, int32_
     for (int32_t j = 0; j < others; ++j) row.hsum[j] = ring(j, r);
     WindowRows(s, r, x0, x1, &row);
   };
-  for (int32_t r = y0 - 1; r <= y0; ++r) window_rows(r);
+  if (!continues) {
+    for (int32_t r = y0 - 1; r <= y0; ++r) window_rows(r);
+  }
   for (int32_t y = y0; y < y1; ++y) {
     window_rows(y + 1);
     // No PrefetchRow: whole rows follow each other in every view (a stream the hardware
     // prefetcher follows), and the winner-take-all's bands keep them in cache from one label to
     // the next; asking again cost more than it saved (teddy's shifts, as the plane sweep).
-    // The ring's three rows of each view are y - 1 .. y + 1.
-    kernels_->select(s.hsum, w, others, x0, x1, out + (y - y0) * stride);
+    // The ring's three rows of each view are y - 1 .. y + 1, in any order.
+    kernels_->select(hsum, w, others, x0, x1, out + (y - y0) * stride);
   }
 }
 

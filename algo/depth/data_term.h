@@ -84,6 +84,15 @@ class DataTerm {
   // ComputeRows, bit for bit.
   void ComputeRect(int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0, int32_t y1, uint16_t* out,
                    ptrdiff_t stride);
+  // ComputeRows on the caller's thread, its 3-sums kept in `ring` (CarriedRingSize() entries, the
+  // caller's): a call that `continues` the one before on the same ring (the same disparity or
+  // planes, its y0 that call's y1) takes that call's last two rows of 3-sums instead of
+  // computing them again. For callers that go down the image in bands, label by label (the
+  // winner-take-all): the bands stay short enough for the views' rows to stay in cache, and
+  // none pays the two rows a band's start otherwise costs.
+  void ComputeRowsCarried(int32_t disp_q8, int32_t y0, int32_t y1, bool continues, uint16_t* ring,
+                          uint16_t* out, ptrdiff_t stride);
+  size_t CarriedRingSize() const { return static_cast<size_t>(3) * (views_ - 1) * width_; }
   // Rows y0..y1-1, each over its own runs of columns (runs[y], indexed by absolute row), out
   // still pointing at (0, y0); the values of ComputeRows, bit for bit, and nothing written
   // outside the runs. For callers whose rows need different columns (a restricted move): the
@@ -135,8 +144,10 @@ class DataTerm {
   // The view index of other view j (every view but the reference, in order).
   int32_t OtherView(int32_t j) const { return j < reference_ ? j : j + 1; }
   void CensusOfView(const Scratch& s, int32_t view);
-  void ComputeBand(const Scratch& s, int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0,
-                   int32_t y1, uint16_t* out, ptrdiff_t stride) const;
+  // ring: 3 rows of 3-sums per other view, row r in slot r mod 3; `continues`: rows y0 - 1 and
+  // y0 are there already.
+  void ComputeBand(const Scratch& s, uint16_t* ring, bool continues, int32_t disp_q8, int32_t x0,
+                   int32_t x1, int32_t y0, int32_t y1, uint16_t* out, ptrdiff_t stride) const;
   void ComputeRunBand(const Scratch& s, int32_t disp_q8, const RowRuns* runs, int32_t y0,
                       int32_t y1, uint16_t* out, ptrdiff_t stride) const;
   // How many bands a request of `rows` rows and `pixels` pixels is cut into.

@@ -180,7 +180,10 @@ class DepthStage {
   // The coarse pass (coarse_grid.cc): block weights, block costs, the best coarse label of
   // each block, the full moves over the blocks, and the pixels' labels and costs from them.
   void BlockWeights();
-  void BlockCosts(int32_t label, const Rect& blocks, uint16_t* out);
+  // ring: the label's carried 3-sums (DataTerm::ComputeRowsCarried) when `blocks` is a band of
+  // whole block rows, `continues` when the band before it was the label's last call.
+  void BlockCosts(int32_t label, const Rect& blocks, uint16_t* out, uint16_t* ring = nullptr,
+                  bool continues = false);
   void CoarseWinnerTakeAll();
   uint16_t* CoarseCosts(int32_t label) {
     return block_costs_ +

@@ -164,6 +164,35 @@ TEST(DataTermTest, RowBandsEqualTheWholeImage) {
   EXPECT_EQ(whole, bands);
 }
 
+// The winner-take-all goes down the image in bands, label by label, each label carrying its
+// 3-sums from band to band: bands of any height, two labels taking turns (each on its own ring,
+// which starts as garbage), must give the whole image's values bit for bit.
+TEST(DataTermTest, CarriedBandsEqualTheWholeImage) {
+  const int32_t w = 40, h = 24;
+  const synth::Burst b = synth::MakeBurst(w, h, 5, 2, 1, 4, 10, 30, 5, 18, 4u);
+  Fixed f;
+  PrepareTerm(f, b, DataTermParams{});
+  const int32_t disps[2] = {300, 700};
+  std::vector<uint16_t> rings[2], bands[2], whole[2];
+  for (int32_t i = 0; i < 2; ++i) {
+    rings[i].assign(f.term.CarriedRingSize(), static_cast<uint16_t>(0x5a5a + i));
+    bands[i].assign(static_cast<size_t>(w) * h, 0xabcd);
+    whole[i].assign(bands[i].size(), 0);
+    f.term.ComputeRows(disps[i], 0, h, whole[i].data(), w);
+  }
+  int32_t y0 = 0;
+  for (const int32_t rows : {7, 1, 2, 9, 5}) {
+    for (int32_t i = 0; i < 2; ++i) {
+      f.term.ComputeRowsCarried(disps[i], y0, y0 + rows, y0 > 0, rings[i].data(),
+                                bands[i].data() + y0 * w, w);
+    }
+    y0 += rows;
+  }
+  ASSERT_EQ(y0, h);
+  EXPECT_EQ(whole[0], bands[0]);
+  EXPECT_EQ(whole[1], bands[1]);
+}
+
 // Restricted moves compute D over rectangles: every column range, at the borders and inside,
 // must give the whole image's values bit for bit, and write nothing outside it.
 TEST(DataTermTest, RectanglesEqualTheWholeImage) {
