@@ -7,6 +7,7 @@
 
 #include <cstring>
 
+#include "algo/core/clones.h"
 #include "algo/core/int_math.h"
 
 namespace lb {
@@ -91,6 +92,16 @@ void DepthStage::CoarseWinnerTakeAll() {
   uint16_t* rings = block_costs_ != nullptr && spare >= rings_at + ring_bytes * coarse_labels
                         ? reinterpret_cast<uint16_t*>(room + rings_at)
                         : nullptr;
+  // The winners' pixel D and labels, after those: the coarse moves leave most blocks their
+  // label (about 90 % on handheld bursts and on teddy), so the hand-over finds their D here.
+  const int32_t w = fine_.width, h = fine_.height;
+  const size_t winners_at = Arena::RoundUp(rings_at + ring_bytes * coarse_labels);
+  const size_t labels_at =
+      Arena::RoundUp(winners_at + sizeof(uint16_t) * static_cast<size_t>(w) * h);
+  const bool winners =
+      keep_winners_ && rings != nullptr && spare >= labels_at + static_cast<size_t>(n);
+  winner_costs_ = winners ? reinterpret_cast<uint16_t*>(room + winners_at) : nullptr;
+  winner_labels_ = winners ? room + labels_at : nullptr;
   // Band by band, every label in turn: the views' rows of a band stay in cache from one label
   // to the next (the data term streams every view once per call). Without rings, a band costs
   // the data term two more rows, so bands are not too thin either. The labels still come in
@@ -104,11 +115,40 @@ void DepthStage::CoarseWinnerTakeAll() {
                            ? rings + data_.CarriedRingSize() * (label / config_.coarse_step)
                            : nullptr;
       BlockCosts(label, rows, d, ring, by0 > 0);
+      if (winner_costs_ != nullptr) KeepWinners(rows, d);
       for (int32_t p = rows.y0 * g.width; p < rows.y1 * g.width; ++p) {
         if (d[p] < g.cost[p]) {
           g.cost[p] = d[p];
           g.labels[p] = static_cast<uint8_t>(label);
         }
+      }
+    }
+  }
+  if (winner_labels_ != nullptr) memcpy(winner_labels_, g.labels, static_cast<size_t>(n));
+}
+
+// Before the winner-take-all takes a label's block costs d over the band b: the pixels' D
+// (fine_.cost_alpha, as BlockCosts left it) of the blocks the label wins, into winner_costs_.
+// A block's two pixels of a row as one 32-bit word, so the loop vectorizes.
+LB_CLONES_AVX2 void DepthStage::KeepWinners(const Rect& b, const uint16_t* d) {
+  const int32_t w = fine_.width, h = fine_.height, bw = coarse_.width;
+  const int32_t whole = Min(b.x1, w / 2);  // blocks of two columns; an odd last one has one
+  for (int32_t by = b.y0; by < b.y1; ++by) {
+    const uint16_t* block_d = d + by * bw;
+    const uint16_t* best = coarse_.cost + by * bw;
+    for (int32_t y = 2 * by; y < 2 * by + 2 && y < h; ++y) {
+      const uint16_t* from = fine_.cost_alpha + y * w;
+      uint16_t* to = winner_costs_ + y * w;
+      for (int32_t bx = b.x0; bx < whole; ++bx) {
+        uint32_t a, k;
+        memcpy(&a, from + 2 * bx, sizeof(a));
+        memcpy(&k, to + 2 * bx, sizeof(k));
+        const uint32_t wins = 0u - static_cast<uint32_t>(block_d[bx] < best[bx]);
+        k = (a & wins) | (k & ~wins);
+        memcpy(to + 2 * bx, &k, sizeof(k));
+      }
+      for (int32_t bx = Max(whole, b.x0); bx < b.x1; ++bx) {
+        if (block_d[bx] < best[bx]) to[2 * bx] = from[2 * bx];
       }
     }
   }
@@ -135,19 +175,37 @@ void DepthStage::CoarsePass() {
   stats_.coarse_energy = energy_;
   on_coarse_ = false;
   FineFromBlocks();
+  winner_costs_ = nullptr;
+  winner_labels_ = nullptr;
 }
 
-// Every pixel takes its block's label; its D comes from one pass of the data term per label
-// present, each row over the runs of its pixels of the label.
+// Every pixel takes its block's label. Its D is the winner-take-all's where the block kept the
+// label it won there (when kept: winner_costs_), else it comes from one pass of the data term
+// per label those others hold, each row over the runs of its pixels of the label.
 void DepthStage::FineFromBlocks() {
   const int32_t w = config_.width, h = config_.height, bw = coarse_.width;
-  uint64_t present[4] = {};
+  uint64_t present[4] = {};  // the labels whose D is needed
+  handover_kept_ = 0;
   for (int32_t y = 0; y < h; ++y) {
     const uint8_t* block = coarse_.labels + (y / 2) * bw;
     uint8_t* f = fine_.labels + y * w;
     for (int32_t x = 0; x < w; ++x) f[x] = block[x / 2];
     RowLabels(fine_, y);
-    for (int32_t i = 0; i < 4; ++i) present[i] |= fine_.row_labels[4 * y + i];
+    if (winner_costs_ == nullptr) {
+      for (int32_t i = 0; i < 4; ++i) present[i] |= fine_.row_labels[4 * y + i];
+      continue;
+    }
+    const uint8_t* won = winner_labels_ + (y / 2) * bw;
+    const uint16_t* kept = winner_costs_ + y * w;
+    uint16_t* cost = fine_.cost + y * w;
+    for (int32_t x = 0; x < w; ++x) {
+      if (won[x / 2] == f[x]) {
+        cost[x] = kept[x];
+        ++handover_kept_;
+      } else {
+        present[f[x] >> 6] |= uint64_t{1} << (f[x] & 63);
+      }
+    }
   }
   // Each row over the runs of its own pixels of the label.
   uint8_t* const mark = run_marks_;
@@ -165,7 +223,12 @@ void DepthStage::FineFromBlocks() {
                                                   f + x0, label, static_cast<size_t>(w - x0))) -
                                               f) +
                          1;
-      for (int32_t x = x0; x < x1; ++x) mark[x] = f[x] == label ? 1 : 0;
+      if (winner_costs_ == nullptr) {
+        for (int32_t x = x0; x < x1; ++x) mark[x] = f[x] == label ? 1 : 0;
+      } else {
+        const uint8_t* won = winner_labels_ + (y / 2) * bw;
+        for (int32_t x = x0; x < x1; ++x) mark[x] = f[x] == label && won[x / 2] != label ? 1 : 0;
+      }
       runs_[y].FromMarks(mark, x0, x1, w, data_.RunJoin());
     }
     data_.ComputeRuns(LabelDispQ8(l), runs_, 0, h, fine_.cost_alpha, w);

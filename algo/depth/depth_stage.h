@@ -185,6 +185,7 @@ class DepthStage {
   void BlockCosts(int32_t label, const Rect& blocks, uint16_t* out, uint16_t* ring = nullptr,
                   bool continues = false);
   void CoarseWinnerTakeAll();
+  void KeepWinners(const Rect& blocks, const uint16_t* block_costs);
   uint16_t* CoarseCosts(int32_t label) {
     return block_costs_ +
            static_cast<size_t>(label / config_.coarse_step) * coarse_.width * coarse_.height;
@@ -252,6 +253,12 @@ class DepthStage {
   // The coarse pass's block D of every coarse label, kept from its winner-take-all for its moves
   // in storage the max-flow does not touch on the blocks' graphs; nullptr when it does not fit.
   uint16_t* block_costs_ = nullptr;
+  // The winner-take-all's winners for the hand-over, in the max-flow's spare when there is room
+  // (else nullptr): each block's label and its pixels' D at it (indexed as the fine grid).
+  uint8_t* winner_labels_ = nullptr;
+  uint16_t* winner_costs_ = nullptr;
+  bool keep_winners_ = true;   // off: the hand-over computes every D (DepthStageProbe)
+  int32_t handover_kept_ = 0;  // pixels whose D the last hand-over took from the winners
   enum : uint8_t { kFree = 0, kKeep = 1, kTake = 2 };
   // A pixel's D in fine_.cost_alpha or prev_alpha where its move did not compute it: no D is
   // this large (DataTerm::kMaxCost).
@@ -283,6 +290,10 @@ class DepthStage {
 // (slow: D for every label).
 struct DepthStageProbe {
   static int64_t TrackedEnergy(const DepthStage& stage) { return stage.energy_; }
+  // Whether the hand-over may take the winner-take-all's D where a block kept its label (when
+  // there is room to keep them), and how many pixels the last Compute's took.
+  static void KeepWinners(DepthStage& stage, bool on) { stage.keep_winners_ = on; }
+  static int32_t HandoverKept(const DepthStage& stage) { return stage.handover_kept_; }
   // Garbage in every max-flow node before the next move (GridMaxflowProbe::Poison).
   static void PoisonSolver(DepthStage& stage, uint8_t byte) {
     GridMaxflowProbe::Poison(stage.maxflow_, byte);

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <tuple>
 #include <utility>
 
 #include <cstdlib>
@@ -144,6 +145,37 @@ TEST(DepthStageTest, CoarseBlocksHaveThePixelsEnergy) {
     EXPECT_LE(st.energy, st.handover_energy);
     EXPECT_EQ(DepthStageProbe::Energy(s.depth, s.depth.labels()), st.energy);
   }
+}
+
+// The hand-over takes the winner-take-all's pixel D where a block kept the label it won there,
+// and computes the rest: the same labels, energies and output as computing every D again, odd
+// sizes included; some pixels are taken and some computed.
+TEST(DepthStageTest, HandoverFromTheWinnersIsExact) {
+  int64_t kept = 0, computed = 0;
+  for (const auto& [w, h, labels] :
+       {std::tuple{64, 40, 33}, {63, 41, 64}, {9, 8, 33}, {31, 17, 20}}) {
+    const synth::Burst b = synth::MakeBurst(w, h, 5, 2, 1, 6, w / 3, 2 * w / 3, h / 4, h / 2, 5u);
+    const DepthConfig c = SmallConfig(b, labels, 64);
+    Stage taken, again;
+    ASSERT_TRUE(taken.Configure(c).ok());
+    ASSERT_TRUE(again.Configure(c).ok());
+    DepthStageProbe::KeepWinners(again.depth, false);
+    ASSERT_TRUE(taken.Compute(b).ok());
+    ASSERT_TRUE(again.Compute(b).ok());
+    EXPECT_EQ(DepthStageProbe::HandoverKept(again.depth), 0);
+    kept += DepthStageProbe::HandoverKept(taken.depth);
+    computed += w * h - DepthStageProbe::HandoverKept(taken.depth);
+    const DepthStats &st = taken.depth.stats(), &sa = again.depth.stats();
+    EXPECT_EQ(st.handover_energy, sa.handover_energy) << w << "x" << h;
+    EXPECT_EQ(st.coarse_energy, st.handover_energy) << w << "x" << h;
+    EXPECT_EQ(st.energy, sa.energy) << w << "x" << h;
+    EXPECT_TRUE(
+        std::equal(taken.depth.labels(), taken.depth.labels() + w * h, again.depth.labels()))
+        << w << "x" << h;
+    EXPECT_EQ(taken.disp, again.disp) << w << "x" << h;
+  }
+  EXPECT_GT(kept, 0) << "no pixel took the winner-take-all's D";
+  EXPECT_GT(computed, 0) << "no block changed its label in the coarse moves";
 }
 
 TEST(DepthStageTest, MoveResultBeatsEverySinglePixelSwitch) {
