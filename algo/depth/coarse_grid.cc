@@ -93,7 +93,8 @@ void DepthStage::CoarseWinnerTakeAll() {
                         ? reinterpret_cast<uint16_t*>(room + rings_at)
                         : nullptr;
   // The winners' pixel D and labels, after those: the coarse moves leave most blocks their
-  // label (about 90 % on handheld bursts and on teddy), so the hand-over finds their D here.
+  // label (89 % for the plane sweep on a handheld burst, 90 % on teddy, 58 % for the rectified
+  // shifts on that burst), so the hand-over finds their D here.
   const int32_t w = fine_.width, h = fine_.height;
   const size_t winners_at = Arena::RoundUp(rings_at + ring_bytes * coarse_labels);
   const size_t labels_at =

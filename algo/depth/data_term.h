@@ -84,12 +84,13 @@ class DataTerm {
   // ComputeRows, bit for bit.
   void ComputeRect(int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0, int32_t y1, uint16_t* out,
                    ptrdiff_t stride);
-  // ComputeRows on the caller's thread, its 3-sums kept in `ring` (CarriedRingSize() entries, the
-  // caller's): a call that `continues` the one before on the same ring (the same disparity or
-  // planes, its y0 that call's y1) takes that call's last two rows of 3-sums instead of
-  // computing them again. For callers that go down the image in bands, label by label (the
-  // winner-take-all): the bands stay short enough for the views' rows to stay in cache, and
-  // none pays the two rows a band's start otherwise costs.
+  // ComputeRows on the caller's thread (with worker 0's scratch: no task of this term may run
+  // meanwhile), its 3-sums kept in `ring` (CarriedRingSize() entries, the caller's): a call that
+  // `continues` the one before on the same ring (the same disparity or planes, its y0 that call's
+  // y1) takes that call's last two rows of 3-sums instead of computing them again. For callers that
+  // go down the image in bands, label by label (the winner-take-all): the bands stay short enough
+  // for the views' rows to stay in cache, and none pays the two rows a band's start otherwise
+  // costs.
   void ComputeRowsCarried(int32_t disp_q8, int32_t y0, int32_t y1, bool continues, uint16_t* ring,
                           uint16_t* out, ptrdiff_t stride);
   size_t CarriedRingSize() const { return static_cast<size_t>(3) * (views_ - 1) * width_; }
