@@ -40,15 +40,16 @@ void DepthStage::BlockWeights() {
 // D of `label` for the blocks of rectangle b into out (block grid), through the pixels' D in
 // fine_.cost_alpha (scratch until the fine moves). At most 4 * 2295.
 void DepthStage::BlockCosts(int32_t label, const Rect& b, uint16_t* out, uint16_t* ring,
-                            bool continues) {
+                            bool continues, int32_t worker) {
   const int32_t w = config_.width, h = config_.height, bw = coarse_.width;
   const int32_t x0 = 2 * b.x0, x1 = 2 * b.x1 < w ? 2 * b.x1 : w;
   const int32_t y0 = 2 * b.y0, y1 = 2 * b.y1 < h ? 2 * b.y1 : h;
-  UseLabelPlanes(label);
   uint16_t* d = fine_.cost_alpha;
   if (ring != nullptr) {
-    data_.ComputeRowsCarried(LabelDispQ8(label), y0, y1, continues, ring, d + y0 * w, w);
+    data_.ComputeRowsCarried(LabelDispQ8(label), LabelPlanes(label), y0, y1, continues, ring,
+                             d + y0 * w, w, worker);
   } else {
+    UseLabelPlanes(label);
     data_.ComputeRect(LabelDispQ8(label), x0, x1, y0, y1, d + y0 * w, w);
   }
   // Whole blocks in a loop that vectorizes; a last odd column or row holds half blocks.
@@ -86,36 +87,65 @@ void DepthStage::CoarseWinnerTakeAll() {
   uint8_t* room = maxflow_.Spare(g.width, g.height, &spare);
   const size_t block_bytes = sizeof(uint16_t) * static_cast<size_t>(n) * coarse_labels;
   block_costs_ = spare >= block_bytes ? reinterpret_cast<uint16_t*>(room) : nullptr;
-  // Each label's 3-sums carried from band to band, after them when there is room.
+  // Stripes of block rows, one per worker, each going down in bands of `band` block rows with
+  // its own ring of 3-sums per label carried from band to band (after the block costs, when
+  // there is room; with fewer stripes if that is what fits).
+  const int32_t band = Max(1, kBandPixels / config_.width / 2);  // block rows
   const size_t ring_bytes = sizeof(uint16_t) * data_.CarriedRingSize();
   const size_t rings_at = Arena::RoundUp(block_bytes);
-  uint16_t* rings = block_costs_ != nullptr && spare >= rings_at + ring_bytes * coarse_labels
+  int32_t stripes = Clamp(data_.runner().workers(), 1, Max(1, g.height / band));
+  while (stripes > 1 && spare < rings_at + ring_bytes * coarse_labels * stripes) --stripes;
+  const size_t rings_end = rings_at + ring_bytes * coarse_labels * stripes;
+  uint16_t* rings = block_costs_ != nullptr && spare >= rings_end
                         ? reinterpret_cast<uint16_t*>(room + rings_at)
                         : nullptr;
   // The winners' pixel D and labels, after those: the coarse moves leave most blocks their
   // label (89 % for the plane sweep on a handheld burst, 90 % on teddy, 58 % for the rectified
   // shifts on that burst), so the hand-over finds their D here.
   const int32_t w = fine_.width, h = fine_.height;
-  const size_t winners_at = Arena::RoundUp(rings_at + ring_bytes * coarse_labels);
+  const size_t winners_at = Arena::RoundUp(rings_end);
   const size_t labels_at =
       Arena::RoundUp(winners_at + sizeof(uint16_t) * static_cast<size_t>(w) * h);
   const bool winners =
       keep_winners_ && rings != nullptr && spare >= labels_at + static_cast<size_t>(n);
   winner_costs_ = winners ? reinterpret_cast<uint16_t*>(room + winners_at) : nullptr;
   winner_labels_ = winners ? room + labels_at : nullptr;
-  // Band by band, every label in turn: the views' rows of a band stay in cache from one label
-  // to the next (the data term streams every view once per call). Without rings, a band costs
-  // the data term two more rows, so bands are not too thin either. The labels still come in
-  // order per block.
-  const int32_t band = Max(1, kBandPixels / config_.width / 2);  // block rows
-  for (int32_t by0 = 0; by0 < g.height; by0 += band) {
-    const Rect rows{0, g.width, by0, Min(by0 + band, g.height)};
+  if (rings != nullptr) {
+    // Each stripe's blocks, pixels and rings are its own: the same bits for any number.
+    ParallelFor(data_.runner(), stripes, [&](int32_t s, int32_t worker) {
+      const Rect stripe{0, g.width, g.height * s / stripes, g.height * (s + 1) / stripes};
+      WinnersOfStripe(stripe, rings + data_.CarriedRingSize() * coarse_labels * s, worker);
+    });
+  } else {
+    // Band by band, every label in turn: the views' rows of a band stay in cache from one label
+    // to the next (the data term streams every view once per call). A band costs the data
+    // term two more rows, so bands are not too thin either. The labels come in order per block.
+    for (int32_t by0 = 0; by0 < g.height; by0 += band) {
+      const Rect rows{0, g.width, by0, Min(by0 + band, g.height)};
+      for (int32_t label = 0; label < config_.labels; label += config_.coarse_step) {
+        uint16_t* d = block_costs_ != nullptr ? CoarseCosts(label) : g.cost_alpha;
+        BlockCosts(label, rows, d);
+        for (int32_t p = rows.y0 * g.width; p < rows.y1 * g.width; ++p) {
+          if (d[p] < g.cost[p]) {
+            g.cost[p] = d[p];
+            g.labels[p] = static_cast<uint8_t>(label);
+          }
+        }
+      }
+    }
+  }
+  if (winner_labels_ != nullptr) memcpy(winner_labels_, g.labels, static_cast<size_t>(n));
+}
+
+void DepthStage::WinnersOfStripe(const Rect& stripe, uint16_t* rings, int32_t worker) {
+  Grid& g = coarse_;
+  const int32_t band = Max(1, kBandPixels / config_.width / 2);
+  for (int32_t by0 = stripe.y0; by0 < stripe.y1; by0 += band) {
+    const Rect rows{0, g.width, by0, Min(by0 + band, stripe.y1)};
     for (int32_t label = 0; label < config_.labels; label += config_.coarse_step) {
-      uint16_t* d = block_costs_ != nullptr ? CoarseCosts(label) : g.cost_alpha;
-      uint16_t* ring = rings != nullptr
-                           ? rings + data_.CarriedRingSize() * (label / config_.coarse_step)
-                           : nullptr;
-      BlockCosts(label, rows, d, ring, by0 > 0);
+      uint16_t* d = CoarseCosts(label);
+      uint16_t* ring = rings + data_.CarriedRingSize() * (label / config_.coarse_step);
+      BlockCosts(label, rows, d, ring, by0 > stripe.y0, worker);
       if (winner_costs_ != nullptr) KeepWinners(rows, d);
       for (int32_t p = rows.y0 * g.width; p < rows.y1 * g.width; ++p) {
         if (d[p] < g.cost[p]) {
@@ -125,7 +155,6 @@ void DepthStage::CoarseWinnerTakeAll() {
       }
     }
   }
-  if (winner_labels_ != nullptr) memcpy(winner_labels_, g.labels, static_cast<size_t>(n));
 }
 
 // Before the winner-take-all takes a label's block costs d over the band b: the pixels' D

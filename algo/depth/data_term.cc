@@ -98,30 +98,31 @@ void DataTerm::CensusOfView(const Scratch& s, int32_t v) {
   }
 }
 
-void DataTerm::PixelCostRow(int32_t view, int32_t y, int32_t x0, int32_t x1, uint8_t* out,
-                            const int32_t* ref_lanes) const {
+void DataTerm::PixelCostRow(const PlaneHomography* planes, int32_t view, int32_t y, int32_t x0,
+                            int32_t x1, uint8_t* out, const int32_t* ref_lanes) const {
   const WarpSource src{images_[reference_], images_[view], census_[reference_],
                        census_[view],       ref_lanes,     width_};
-  PlaneCostRow(planes_[view], src, y, params_, invalid_cost_, x0, x1, out, kernels_->plane,
+  PlaneCostRow(planes[view], src, y, params_, invalid_cost_, x0, x1, out, kernels_->plane,
                kernels_->plane_anchors);
 }
 
 // Horizontal 3-sum of the pixel costs of row y (borders replicated) for columns x0..x1-1:
 // 0..765.
-void DataTerm::WindowRow(const Scratch& s, int32_t view, int32_t y, int32_t x0, int32_t x1,
-                         uint16_t* hsum) const {
+void DataTerm::WindowRow(const Scratch& s, const PlaneHomography* planes, int32_t view, int32_t y,
+                         int32_t x0, int32_t x1, uint16_t* hsum) const {
   const int32_t w = width_;
   uint8_t* cost = s.pixel + 1;
   const int32_t c0 = x0 > 0 ? x0 - 1 : 0, c1 = x1 < w ? x1 + 1 : w;
   const bool lanes = kernels_->plane_lanes != nullptr;
-  PixelCostRow(view, Clamp(y, 0, height_ - 1), c0, c1, cost, lanes ? s.ref_lanes : nullptr);
+  PixelCostRow(planes, view, Clamp(y, 0, height_ - 1), c0, c1, cost, lanes ? s.ref_lanes : nullptr);
   if (x0 == 0) cost[-1] = cost[0];
   if (x1 == w) cost[w] = cost[w - 1];
   kernels_->hsum(cost, x0, x1, hsum);
 }
 
-void DataTerm::PrepareRefLanes(const Scratch& s, int32_t y, int32_t x0, int32_t x1) const {
-  if (planes_ == nullptr || kernels_->plane_lanes == nullptr) return;
+void DataTerm::PrepareRefLanes(const Scratch& s, const PlaneHomography* planes, int32_t y,
+                               int32_t x0, int32_t x1) const {
+  if (planes == nullptr || kernels_->plane_lanes == nullptr) return;
   const int32_t w = width_, row = Clamp(y, 0, height_ - 1);
   const int32_t c0 = x0 > 0 ? x0 - 1 : 0, c1 = x1 < w ? x1 + 1 : w;  // as WindowRow
   const int32_t a = RefLanesBegin(w, c0);  // s.ref_lanes is indexed by x: column a at + a
@@ -205,13 +206,15 @@ void DataTerm::StartRows(int32_t disp_q8, dtk::RectRow* row) const {
   }
 }
 
-void DataTerm::WindowRows(const Scratch& s, int32_t y, int32_t x0, int32_t x1,
-                          dtk::RectRow* row) const {
+void DataTerm::WindowRows(const Scratch& s, const PlaneHomography* planes, int32_t y, int32_t x0,
+                          int32_t x1, dtk::RectRow* row) const {
   const int32_t others = views_ - 1;
-  if (planes_ != nullptr) {
+  if (planes != nullptr) {
     // Row by row, so the plane sweep prepares each reference row once for every view.
-    PrepareRefLanes(s, y, x0, x1);
-    for (int32_t j = 0; j < others; ++j) WindowRow(s, OtherView(j), y, x0, x1, row->hsum[j]);
+    PrepareRefLanes(s, planes, y, x0, x1);
+    for (int32_t j = 0; j < others; ++j) {
+      WindowRow(s, planes, OtherView(j), y, x0, x1, row->hsum[j]);
+    }
     return;
   }
   const int32_t r = Clamp(y, 0, height_ - 1), w = width_;
@@ -243,20 +246,25 @@ void DataTerm::ComputeRect(int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0, 
   const int32_t rows = y1 - y0, cols = x1 - x0;
   const int32_t bands = Bands(rows, int64_t{rows} * cols);
   if (bands <= 1) {
-    ComputeBand(scratch_[0], scratch_[0].hsum, false, disp_q8, x0, x1, y0, y1, out, stride);
+    ComputeBand(scratch_[0], planes_, scratch_[0].hsum, false, disp_q8, x0, x1, y0, y1, out,
+                stride);
     return;
   }
   ParallelFor(*runner_, bands, [&](int32_t band, int32_t worker) {
     const int32_t b0 = y0 + static_cast<int32_t>(int64_t{rows} * band / bands);
     const int32_t b1 = y0 + static_cast<int32_t>(int64_t{rows} * (band + 1) / bands);
     const Scratch& s = scratch_[worker];
-    ComputeBand(s, s.hsum, false, disp_q8, x0, x1, b0, b1, out + (b0 - y0) * stride, stride);
+    ComputeBand(s, planes_, s.hsum, false, disp_q8, x0, x1, b0, b1, out + (b0 - y0) * stride,
+                stride);
   });
 }
 
-void DataTerm::ComputeRowsCarried(int32_t disp_q8, int32_t y0, int32_t y1, bool continues,
-                                  uint16_t* ring, uint16_t* out, ptrdiff_t stride) {
-  if (y0 < y1) ComputeBand(scratch_[0], ring, continues, disp_q8, 0, width_, y0, y1, out, stride);
+void DataTerm::ComputeRowsCarried(int32_t disp_q8, const PlaneHomography* planes, int32_t y0,
+                                  int32_t y1, bool continues, uint16_t* ring, uint16_t* out,
+                                  ptrdiff_t stride, int32_t worker) {
+  if (y0 >= y1) return;
+  ComputeBand(scratch_[Clamp(worker, 0, workers_ - 1)], planes, ring, continues, disp_q8, 0, width_,
+              y0, y1, out, stride);
 }
 
 void RowRuns::Add(int32_t lo, int32_t hi, int32_t width, int32_t join) {
@@ -371,7 +379,7 @@ void DataTerm::ComputeRunBand(const Scratch& s, int32_t disp_q8, const RowRuns* 
   const int32_t join = RunJoin();
   auto window_rows = [&](int32_t r, int32_t n) {
     for (int32_t j = 0; j < others; ++j) row.hsum[j] = ring(j, r);
-    for (int32_t i = 0; i < n; ++i) WindowRows(s, r, iv[2 * i], iv[2 * i + 1], &row);
+    for (int32_t i = 0; i < n; ++i) WindowRows(s, planes_, r, iv[2 * i], iv[2 * i + 1], &row);
   };
   for (int32_t r = y0 - 1; r <= y0; ++r) window_rows(r, NeededColumns(runs, r, y0, y1, join, iv));
   // The columns of row y + 1, found one row earlier for their prefetch.
@@ -389,9 +397,9 @@ void DataTerm::ComputeRunBand(const Scratch& s, int32_t disp_q8, const RowRuns* 
   }
 }
 
-void DataTerm::ComputeBand(const Scratch& s, uint16_t* hsum, bool continues, int32_t disp_q8,
-                           int32_t x0, int32_t x1, int32_t y0, int32_t y1, uint16_t* out,
-                           ptrdiff_t stride) const {
+void DataTerm::ComputeBand(const Scratch& s, const PlaneHomography* planes, uint16_t* hsum,
+                           bool continues, int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0,
+                           int32_t y1, uint16_t* out, ptrdiff_t stride) const {
   const int32_t w = width_;
   const int32_t others = views_ - 1;
   auto ring = [&](int32_t j, int32_t row) {  // row >= -1
@@ -401,7 +409,7 @@ void DataTerm::ComputeBand(const Scratch& s, uint16_t* hsum, bool continues, int
   StartRows(disp_q8, &row);
   auto window_rows = [&](int32_t r) {
     for (int32_t j = 0; j < others; ++j) row.hsum[j] = ring(j, r);
-    WindowRows(s, r, x0, x1, &row);
+    WindowRows(s, planes, r, x0, x1, &row);
   };
   if (!continues) {
     for (int32_t r = y0 - 1; r <= y0; ++r) window_rows(r);

@@ -69,6 +69,7 @@ class DataTerm {
   // Where Prepare and ComputeRect run their tasks (borrowed; nullptr: on the caller). At most
   // the carved number of workers.
   void SetRunner(TaskRunner* runner);
+  TaskRunner& runner() const { return *runner_; }
   // The SIMD kernels (when `on` and the CPU has them) or the C reference; returns which is used.
   bool UseSimd(bool on);
   void SetParams(const DataTermParams& params, int32_t reference);
@@ -91,8 +92,9 @@ class DataTerm {
   // go down the image in bands, label by label (the winner-take-all): the bands stay short enough
   // for the views' rows to stay in cache, and none pays the two rows a band's start otherwise
   // costs.
-  void ComputeRowsCarried(int32_t disp_q8, int32_t y0, int32_t y1, bool continues, uint16_t* ring,
-                          uint16_t* out, ptrdiff_t stride);
+  void ComputeRowsCarried(int32_t disp_q8, const PlaneHomography* planes, int32_t y0, int32_t y1,
+                          bool continues, uint16_t* ring, uint16_t* out, ptrdiff_t stride,
+                          int32_t worker = 0);
   size_t CarriedRingSize() const { return static_cast<size_t>(3) * (views_ - 1) * width_; }
   // Rows y0..y1-1, each over its own runs of columns (runs[y], indexed by absolute row), out
   // still pointing at (0, y0); the values of ComputeRows, bit for bit, and nothing written
@@ -127,28 +129,31 @@ class DataTerm {
   };
   // The plane sweep's pixel costs of columns x0..x1-1 of row y (out indexed by x).
   // ref_lanes: the prepared reference row (PrepareRefLanes), or nullptr.
-  void PixelCostRow(int32_t view, int32_t y, int32_t x0, int32_t x1, uint8_t* out,
-                    const int32_t* ref_lanes) const;
+  void PixelCostRow(const PlaneHomography* planes, int32_t view, int32_t y, int32_t x0, int32_t x1,
+                    uint8_t* out, const int32_t* ref_lanes) const;
   // The plane sweep: reference row y's lanes (warp_cost.h: RefLanes) into s.ref_lanes for the
   // columns every view's WindowRow(y, x0, x1) reads, when the kernel wants them.
-  void PrepareRefLanes(const Scratch& s, int32_t y, int32_t x0, int32_t x1) const;
+  void PrepareRefLanes(const Scratch& s, const PlaneHomography* planes, int32_t y, int32_t x0,
+                       int32_t x1) const;
   // Asks for the view rows that reference row y's columns x0..x1-1 will read.
   void PrefetchRow(int32_t y, int32_t x0, int32_t x1) const;
   // The plane sweep's 3-sums of one view's row y, columns x0..x1-1.
-  void WindowRow(const Scratch& s, int32_t view, int32_t y, int32_t x0, int32_t x1,
-                 uint16_t* hsum) const;
+  void WindowRow(const Scratch& s, const PlaneHomography* planes, int32_t view, int32_t y,
+                 int32_t x0, int32_t x1, uint16_t* hsum) const;
   // Every other view's 3-sums of row y (clamped to the image), columns x0..x1-1, into
   // row->hsum[j] (other view j): the plane sweep view by view, the rectified shifts by one kernel
   // call (Kernels::rect_row) with `row` set up by StartRows for the label.
   void StartRows(int32_t disp_q8, dtk::RectRow* row) const;
-  void WindowRows(const Scratch& s, int32_t y, int32_t x0, int32_t x1, dtk::RectRow* row) const;
+  void WindowRows(const Scratch& s, const PlaneHomography* planes, int32_t y, int32_t x0,
+                  int32_t x1, dtk::RectRow* row) const;
   // The view index of other view j (every view but the reference, in order).
   int32_t OtherView(int32_t j) const { return j < reference_ ? j : j + 1; }
   void CensusOfView(const Scratch& s, int32_t view);
   // ring: 3 rows of 3-sums per other view, row r in slot r mod 3; `continues`: rows y0 - 1 and
   // y0 are there already.
-  void ComputeBand(const Scratch& s, uint16_t* ring, bool continues, int32_t disp_q8, int32_t x0,
-                   int32_t x1, int32_t y0, int32_t y1, uint16_t* out, ptrdiff_t stride) const;
+  void ComputeBand(const Scratch& s, const PlaneHomography* planes, uint16_t* ring, bool continues,
+                   int32_t disp_q8, int32_t x0, int32_t x1, int32_t y0, int32_t y1, uint16_t* out,
+                   ptrdiff_t stride) const;
   void ComputeRunBand(const Scratch& s, int32_t disp_q8, const RowRuns* runs, int32_t y0,
                       int32_t y1, uint16_t* out, ptrdiff_t stride) const;
   // How many bands a request of `rows` rows and `pixels` pixels is cut into.

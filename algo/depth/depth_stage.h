@@ -175,6 +175,11 @@ class DepthStage {
     if (config_.geometry == ViewGeometry::kKnownPoses)
       data_.SetPlanes(planes_ + label * config_.views);
   }
+  // The planes of one label for a data term call that takes them (nullptr: rectified shifts).
+  const PlaneHomography* LabelPlanes(int32_t label) const {
+    return config_.geometry == ViewGeometry::kKnownPoses ? planes_ + label * config_.views
+                                                         : nullptr;
+  }
   void LabelCosts(int32_t label, uint16_t* out);  // D of one label for the whole image
   void WinnerTakeAll();
   // The coarse pass (coarse_grid.cc): block weights, block costs, the best coarse label of
@@ -182,10 +187,15 @@ class DepthStage {
   void BlockWeights();
   // ring: the label's carried 3-sums (DataTerm::ComputeRowsCarried) when `blocks` is a band of
   // whole block rows, `continues` when the band before it was the label's last call.
+  // With a ring it touches nothing shared but the data term's scratch of `worker`: the
+  // winner-take-all's stripes run it side by side.
   void BlockCosts(int32_t label, const Rect& blocks, uint16_t* out, uint16_t* ring = nullptr,
-                  bool continues = false);
+                  bool continues = false, int32_t worker = 0);
   void CoarseWinnerTakeAll();
   void KeepWinners(const Rect& blocks, const uint16_t* block_costs);
+  // The winner-take-all of the block rows of `stripe` (a band of rows after another), with
+  // rings; worker: the data term's scratch to use.
+  void WinnersOfStripe(const Rect& stripe, uint16_t* rings, int32_t worker);
   uint16_t* CoarseCosts(int32_t label) {
     return block_costs_ +
            static_cast<size_t>(label / config_.coarse_step) * coarse_.width * coarse_.height;

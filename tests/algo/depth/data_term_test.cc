@@ -183,7 +183,7 @@ TEST(DataTermTest, CarriedBandsEqualTheWholeImage) {
   int32_t y0 = 0;
   for (const int32_t rows : {7, 1, 2, 9, 5}) {
     for (int32_t i = 0; i < 2; ++i) {
-      f.term.ComputeRowsCarried(disps[i], y0, y0 + rows, y0 > 0, rings[i].data(),
+      f.term.ComputeRowsCarried(disps[i], nullptr, y0, y0 + rows, y0 > 0, rings[i].data(),
                                 bands[i].data() + y0 * w, w);
     }
     y0 += rows;
