@@ -93,7 +93,8 @@ void DepthStage::CoarseWinnerTakeAll() {
   const int32_t band = Max(1, kBandPixels / config_.width / 2);  // block rows
   const size_t ring_bytes = sizeof(uint16_t) * data_.CarriedRingSize();
   const size_t rings_at = Arena::RoundUp(block_bytes);
-  int32_t stripes = Clamp(data_.runner().workers(), 1, Max(1, g.height / band));
+  int32_t stripes =
+      striped_winners_ ? Clamp(data_.runner().workers(), 1, Max(1, g.height / band)) : 1;
   while (stripes > 1 && spare < rings_at + ring_bytes * coarse_labels * stripes) --stripes;
   const size_t rings_end = rings_at + ring_bytes * coarse_labels * stripes;
   uint16_t* rings = block_costs_ != nullptr && spare >= rings_end
@@ -110,6 +111,7 @@ void DepthStage::CoarseWinnerTakeAll() {
       keep_winners_ && rings != nullptr && spare >= labels_at + static_cast<size_t>(n);
   winner_costs_ = winners ? reinterpret_cast<uint16_t*>(room + winners_at) : nullptr;
   winner_labels_ = winners ? room + labels_at : nullptr;
+  winner_stripes_ = static_cast<int16_t>(rings != nullptr ? stripes : 0);
   if (rings != nullptr) {
     // Each stripe's blocks, pixels and rings are its own: the same bits for any number.
     ParallelFor(data_.runner(), stripes, [&](int32_t s, int32_t worker) {

@@ -267,8 +267,10 @@ class DepthStage {
   // (else nullptr): each block's label and its pixels' D at it (indexed as the fine grid).
   uint8_t* winner_labels_ = nullptr;
   uint16_t* winner_costs_ = nullptr;
-  bool keep_winners_ = true;   // off: the hand-over computes every D (DepthStageProbe)
-  int32_t handover_kept_ = 0;  // pixels whose D the last hand-over took from the winners
+  bool keep_winners_ = true;     // off: the hand-over computes every D (DepthStageProbe)
+  bool striped_winners_ = true;  // off: the winner-take-all in one stripe (DepthStageProbe)
+  int16_t winner_stripes_ = 0;   // the stripes the last winner-take-all took (<= kMaxWorkers)
+  int32_t handover_kept_ = 0;    // pixels whose D the last hand-over took from the winners
   enum : uint8_t { kFree = 0, kKeep = 1, kTake = 2 };
   // A pixel's D in fine_.cost_alpha or prev_alpha where its move did not compute it: no D is
   // this large (DataTerm::kMaxCost).
@@ -304,6 +306,10 @@ struct DepthStageProbe {
   // there is room to keep them), and how many pixels the last Compute's took.
   static void KeepWinners(DepthStage& stage, bool on) { stage.keep_winners_ = on; }
   static int32_t HandoverKept(const DepthStage& stage) { return stage.handover_kept_; }
+  // Whether the winner-take-all may take one stripe per worker (the same bits either way), and
+  // how many the last Compute's took (0 without carried rings).
+  static void StripedWinners(DepthStage& stage, bool on) { stage.striped_winners_ = on; }
+  static int32_t WinnerStripes(const DepthStage& stage) { return stage.winner_stripes_; }
   // Garbage in every max-flow node before the next move (GridMaxflowProbe::Poison).
   static void PoisonSolver(DepthStage& stage, uint8_t byte) {
     GridMaxflowProbe::Poison(stage.maxflow_, byte);

@@ -5,6 +5,8 @@
 // depth_planes_accuracy_test prints), in CPU time.
 //   build/host/tests/bench/depth/depth_bench --benchmark_counters_tabular=true
 // BM_TeddyOverSgbm and BM_HandheldPlanesOverRectified give the ratios, alternated call by call.
+// BM_HandheldPlanesTwoWorkers: the plane sweep with two workers, the winner-take-all striped
+// against one stripe.
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -13,6 +15,7 @@
 #include <vector>
 
 #include "algo/depth/depth_stage.h"
+#include "firmware/platform/worker_pool.h"
 #include "tests/algo/depth/handheld.h"
 #include "tests/algo/depth/middlebury.h"
 
@@ -204,6 +207,47 @@ void BM_HandheldPlanesOverRectified(benchmark::State& state) {
   state.counters["ratio"] = Median(ratios);
 }
 BENCHMARK(BM_HandheldPlanesOverRectified)->Unit(benchmark::kMillisecond)->MinTime(6.0);
+
+// The plane sweep on that burst with two workers (the board's pool), the winner-take-all in one
+// stripe of block rows per worker against all of it on one, by turns as above: wall times, the
+// counters each side's median and the median of the per-turn ratios (one stripe / striped).
+void BM_HandheldPlanesTwoWorkers(benchmark::State& state) {
+  const motiontest::Burst* made = HandheldBurst();
+  if (made == nullptr) return state.SkipWithError("no synthetic burst");
+  const motiontest::Burst& burst = *made;
+  const handheld::Labels l = handheld::HandheldLabels(burst, 0.1);
+  DepthConfig c = l.config;
+  c.geometry = ViewGeometry::kKnownPoses;
+  c.workers = 2;
+  WorkerPool pool;
+  if (!pool.Start(c.workers).ok()) return state.SkipWithError("no worker threads");
+  handheld::Stage striped, one;
+  if (!striped.Configure(c).ok() || !one.Configure(c).ok()) {
+    return state.SkipWithError("configure failed");
+  }
+  striped.depth.SetRunner(&pool);
+  one.depth.SetRunner(&pool);
+  DepthStageProbe::StripedWinners(one.depth, false);
+  const std::vector<PlaneHomography> homographies = handheld::Planes(burst, l);
+  std::vector<double> striped_ms, one_ms, ratios;
+  using Clock = std::chrono::steady_clock;
+  for (auto _ : state) {
+    const Clock::time_point t0 = Clock::now();
+    if (!striped.depth.SetPlanes(homographies.data()).ok()) state.SkipWithError("planes");
+    if (!striped.Compute(burst.views.data()).ok()) state.SkipWithError("compute failed");
+    const Clock::time_point t1 = Clock::now();
+    if (!one.depth.SetPlanes(homographies.data()).ok()) state.SkipWithError("planes");
+    if (!one.Compute(burst.views.data()).ok()) state.SkipWithError("compute failed");
+    const Clock::time_point t2 = Clock::now();
+    striped_ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+    one_ms.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
+    ratios.push_back(one_ms.back() / striped_ms.back());
+  }
+  state.counters["striped_ms"] = Median(striped_ms);
+  state.counters["one_stripe_ms"] = Median(one_ms);
+  state.counters["ratio"] = Median(ratios);
+}
+BENCHMARK(BM_HandheldPlanesTwoWorkers)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(6.0);
 
 #ifdef LB_HAVE_OPENCV
 // Dense output (no uniqueness, left-right or speckle rejection), so bad_pct scores every pixel
