@@ -14,6 +14,7 @@
 #include "tests/algo/depth/handheld.h"
 #include "tests/algo/depth/synthetic_views.h"
 #include "tests/support/alloc_counter.h"
+#include "tests/support/backwards_runner.h"
 
 namespace lb {
 namespace {
@@ -160,21 +161,6 @@ TEST(PlanesTest, HandheldBurstWithTruePoses) {
   EXPECT_LT(bad, 2.0);  // measured 0.19 %
 }
 
-// Runs a Run's tasks on the caller, last task first, as `workers` workers taking turns: tasks
-// that depended on their order, or shared a worker's scratch across workers, would give other
-// bits than one worker does.
-class ReverseRunner final : public TaskRunner {
- public:
-  explicit ReverseRunner(int32_t workers) : workers_(workers) {}
-  int32_t workers() const override { return workers_; }
-  void Run(int32_t tasks, TaskFn fn, void* context) override {
-    for (int32_t t = tasks - 1; t >= 0; --t) fn(context, t, t % workers_);
-  }
-
- private:
-  int32_t workers_;
-};
-
 // The winner-take-all in one stripe of block rows per worker (each with its own rings and the
 // labels' planes handed per call) gives the bits of one stripe, in both geometries.
 TEST(PlanesTest, WinnerStripesGiveTheBitsOfOne) {
@@ -187,7 +173,7 @@ TEST(PlanesTest, WinnerStripesGiveTheBitsOfOne) {
       DepthConfig c = l.config;
       c.geometry = geometry;
       c.workers = workers;
-      ReverseRunner runner(workers);
+      testing::BackwardsRunner runner(workers);
       Stage striped, one;
       ASSERT_TRUE(striped.Configure(c).ok());
       ASSERT_TRUE(one.Configure(c).ok());

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "tests/algo/motion/burst.h"
+#include "tests/support/backwards_runner.h"
 
 namespace lb {
 namespace {
@@ -22,7 +23,8 @@ struct Estimation {
   Status status;
 };
 
-void Estimate(Burst& b, Estimation* run, MotionConfig config = MotionConfig()) {
+void Estimate(Burst& b, Estimation* run, MotionConfig config = MotionConfig(),
+              TaskRunner* runner = nullptr) {
   for (size_t v = 0; v < b.views.size(); ++v) b.views[v].data = b.pixels[v].data();  // edited
   config.width = b.width;
   config.height = b.height;
@@ -32,6 +34,7 @@ void Estimate(Burst& b, Estimation* run, MotionConfig config = MotionConfig()) {
   run->memory.assign(bytes + Arena::kAlign, 0);
   Arena arena(run->memory.data(), run->memory.size());
   ASSERT_TRUE(run->stage.Configure(config, arena).ok());
+  run->stage.SetRunner(runner);
   run->status =
       run->stage.Estimate(b.views.data(), b.scene.reference(), b.intrinsics, &run->result);
 }
@@ -103,6 +106,44 @@ TEST(MotionStage, ARailThroughABarrelLensKeepsItsOrientation) {
       // Without the rail (measured: 0.062 degrees of turn) and without k1.
       EXPECT_FALSE(run.result.rail);
       EXPECT_EQ(run.result.k1, 0.0);
+    }
+  }
+}
+
+// The tracker's points split over workers, the tasks run backwards: the same poses, lens and
+// points, bit for bit, as on one worker, with k1 and the focal length estimated and without.
+TEST(MotionStage, TheResultDoesNotDependOnTheWorkers) {
+  SceneParams rail;
+  rail.seed = 4;
+  rail.geometry = ViewGeometry::kRectified;
+  Burst b;
+  ASSERT_TRUE(motiontest::MakeBurst(rail, 320, 240, 5, &b, 2));
+  ThroughLens(&b, -0.05);
+  for (const bool lens : {true, false}) {
+    MotionConfig config;
+    config.rail_off_axis = lens ? 0.05 : 0;
+    config.estimate_focal = lens;
+    Estimation one;
+    Estimate(b, &one, config);
+    ASSERT_TRUE(one.status.ok()) << one.status.message();
+    EXPECT_EQ(one.result.k1 != 0, lens);
+    for (int32_t workers = 2; workers <= 4; ++workers) {
+      config.workers = workers;
+      testing::BackwardsRunner runner(workers);
+      Estimation split;
+      Estimate(b, &split, config, &runner);
+      ASSERT_TRUE(split.status.ok()) << split.status.message();
+      EXPECT_EQ(split.result.k1, one.result.k1) << workers;
+      EXPECT_EQ(split.result.k0, one.result.k0) << workers;
+      EXPECT_EQ(split.result.rms_px, one.result.rms_px) << workers;
+      ASSERT_EQ(split.result.points, one.result.points) << workers;
+      EXPECT_EQ(0, memcmp(split.result.inv_depth, one.result.inv_depth,
+                          sizeof(double) * static_cast<size_t>(one.result.points)))
+          << workers;
+      for (int32_t v = 0; v < b.scene.views(); ++v) {
+        EXPECT_EQ(0, memcmp(&split.result.motion[v], &one.result.motion[v], sizeof(ViewMotion)))
+            << "view " << v << ", " << workers << " workers";
+      }
     }
   }
 }

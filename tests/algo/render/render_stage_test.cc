@@ -8,6 +8,7 @@
 
 #include "tests/algo/render/render_util.h"
 #include "tests/support/alloc_counter.h"
+#include "tests/support/backwards_runner.h"
 
 namespace lb {
 namespace {
@@ -370,22 +371,6 @@ TEST(RenderStage, OutputIsBitIdenticalAcrossPlatforms) {
   EXPECT_EQ(hash, 13335697872477751754ull);
 }
 
-// Runs a Run's tasks last to first, each on another worker than a pool would pick: a stage
-// whose tasks read what another task writes, or whose results depend on the worker's scratch
-// history, gives other bits here.
-class BackwardsRunner final : public TaskRunner {
- public:
-  explicit BackwardsRunner(int32_t workers) : workers_(workers) {}
-  int32_t workers() const override { return workers_; }
-  void Run(int32_t tasks, TaskFn fn, void* context) override {
-    for (int32_t t = tasks - 1; t >= 0; --t) fn(context, t, (t + runs_) % workers_);
-    ++runs_;
-  }
-
- private:
-  int32_t workers_, runs_ = 0;
-};
-
 // Strips of several workers at once, and the ring rows they read filled by several workers
 // (each with its own upsampler rows): the same bits as one worker.
 TEST(RenderStage, OutputDoesNotDependOnTheWorkers) {
@@ -399,7 +384,7 @@ TEST(RenderStage, OutputDoesNotDependOnTheWorkers) {
   ASSERT_TRUE(test::RenderAll(scene.Planar(), scene.WorkingDisp(), 4, setup, &one).ok());
   for (int32_t workers = 2; workers <= 4; ++workers) {
     SCOPED_TRACE(workers);
-    BackwardsRunner runner(workers);
+    testing::BackwardsRunner runner(workers);
     setup.workers = workers;
     setup.runner = &runner;
     test::Rendered many;

@@ -1,14 +1,18 @@
 // The motion stage on a synthetic handheld burst: 7 frames at the working resolution 640x480,
 // one thread (pyramids, corners, tracking, bundle adjustment and checks), and beside it the whole
 // pipeline on the same burst with auto geometry (ingest, motion, depth, render), so the motion
-// stage's share of a run is a ratio of two figures from one process.
+// stage's share of a run is a ratio of two figures from one process; and the stage on one
+// worker against two.
 //   build/host/tests/bench/motion/motion_bench
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <chrono>
 #include <vector>
 
 #include "algo/motion/motion_stage.h"
 #include "algo/pipeline/pipeline.h"
+#include "firmware/platform/worker_pool.h"
 #include "sim/synthetic/synthetic_sensor.h"
 #include "tests/algo/motion/burst.h"
 
@@ -42,6 +46,51 @@ void BM_MotionStage7x640x480(benchmark::State& state) {
   state.counters["arena_MB"] = static_cast<double>(memory.size()) / (1 << 20);
 }
 BENCHMARK(BM_MotionStage7x640x480)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+// The same stage on one worker and on two (the board's pool) by turns, wall times: the counters
+// are each side's median and the median of the per-turn ratios (one / two), the scaling.
+void BM_MotionStageTwoWorkers(benchmark::State& state) {
+  motiontest::Burst b;
+  if (!motiontest::MakeBurst(motiontest::Handheld(1), 640, 480, 7, &b)) {
+    return state.SkipWithError("scene");
+  }
+  MotionConfig config;
+  config.width = 640;
+  config.height = 480;
+  config.views = 7;
+  config.workers = 2;
+  WorkerPool pool;
+  if (!pool.Start(config.workers).ok()) return state.SkipWithError("no worker threads");
+  std::vector<uint8_t> memory[2];
+  MotionStage stage[2];
+  for (int32_t i = 0; i < 2; ++i) {
+    memory[i].resize(MotionStage::RequiredBytes(config));
+    Arena arena(memory[i].data(), memory[i].size());
+    if (!stage[i].Configure(config, arena).ok()) return state.SkipWithError("configure");
+  }
+  stage[1].SetRunner(&pool);
+  MotionResult r;
+  std::vector<double> ms[2], ratios;
+  using Clock = std::chrono::steady_clock;
+  for (auto _ : state) {
+    for (int32_t i = 0; i < 2; ++i) {
+      const Clock::time_point t0 = Clock::now();
+      const Status st = stage[i].Estimate(b.views.data(), b.scene.reference(), b.intrinsics, &r);
+      if (!st.ok()) state.SkipWithError(st.message());
+      benchmark::DoNotOptimize(r);
+      ms[i].push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+    }
+    ratios.push_back(ms[0].back() / ms[1].back());
+  }
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v[v.size() / 2];
+  };
+  state.counters["one_ms"] = median(ms[0]);
+  state.counters["two_ms"] = median(ms[1]);
+  state.counters["ratio"] = median(ratios);
+}
+BENCHMARK(BM_MotionStageTwoWorkers)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(4.0);
 
 // Whole run, 640x480 frames (working resolution = full resolution), 7 frames, 64 labels.
 void BM_PipelineAuto7x640x480(benchmark::State& state) {
