@@ -193,8 +193,9 @@ class DepthStage {
                   bool continues = false, int32_t worker = 0);
   void CoarseWinnerTakeAll();
   void KeepWinners(const Rect& blocks, const uint16_t* block_costs);
-  // The winner-take-all of the block rows of `stripe` (a band of rows after another), with
-  // rings; worker: the data term's scratch to use.
+  // The winner-take-all over the block rows of `stripe`, going down them in bands with its
+  // own rings (one per coarse label, carried from band to band); `worker`: whose data term
+  // scratch it uses.
   void WinnersOfStripe(const Rect& stripe, uint16_t* rings, int32_t worker);
   uint16_t* CoarseCosts(int32_t label) {
     return block_costs_ +
