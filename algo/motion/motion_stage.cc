@@ -235,6 +235,7 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
   // outlier_px): a coarser stop serves them as well (a fifth off the motion stage on a handheld
   // burst; every accuracy figure within 0.04 point).
   constexpr double kSeedGain = 1e-6;
+  const double final_gain = in.min_gain;
   // Far frames start from the near ones: from the identity, a frame many steps out (18 px on
   // barn1's ninth view) can send the first adjustment into a wrong minimum. The frames within
   // kNearSteps of the reference are adjusted first; each farther frame then starts from the
@@ -271,7 +272,7 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
     // free k0 can run off before the rotations have taken their share.
     const bool settled = round > 0 || c.bundle_rounds == 1;
     double* k0 = c.estimate_focal && settled ? &result->k0 : nullptr;
-    in.min_gain = round + 1 < c.bundle_rounds ? kSeedGain : BundleInput().min_gain;
+    in.min_gain = round + 1 < c.bundle_rounds ? kSeedGain : final_gain;
     LB_RETURN_IF_ERROR(bundle_.Solve(in, c.bundle_iterations, c.huber_px, result->motion,
                                      inv_depth_, nullptr, k0, &report));
     if (round + 1 == c.bundle_rounds) break;
