@@ -147,8 +147,9 @@ TEST(RefocusdProcessTest, SigtermWhileWaitingForTheCameraStopsAtOnce) {
 
 TEST(RefocusdProcessTest, SigtermLetsThePhotoInProgressFinish) {
   ScratchDir dir;
-  // Slow enough (half a second) that the signal lands while the photo is being taken.
-  RefocusdProcess d(dir.dir(), "resolution = 480x360\nlabels = 16\n");
+  // Slow enough (about a second in a release build; a 480x360 photo took 0.3 s, and the
+  // signal sometimes came after it) that the signal lands while the photo is being taken.
+  RefocusdProcess d(dir.dir(), "resolution = 1280x960\nlabels = 32\n");
   ASSERT_TRUE(d.Start());
   ASSERT_TRUE(d.WaitForLine("ready: sensor", kStartMs)) << d.log();
   d.Press();
@@ -161,7 +162,7 @@ TEST(RefocusdProcessTest, SigtermLetsThePhotoInProgressFinish) {
   ListPhotos(d.out_dir(), &photos, &temps);
   ASSERT_EQ(photos.size(), 1u) << d.log();
   EXPECT_TRUE(temps.empty());
-  ExpectWholeJpeg(d.out_dir() + "/" + photos[0], 480, 360);
+  ExpectWholeJpeg(d.out_dir() + "/" + photos[0], 1280, 960);
 }
 
 TEST(RefocusdProcessTest, KilledAtRandomMomentsLeavesWholePhotosOrNothing) {
