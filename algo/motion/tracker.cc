@@ -152,7 +152,11 @@ bool Tracker::TrackOne(const Window& w, const GreyPyramid& ref, const GreyPyrami
       const int32_t sty = RoundQ16(sy > lim ? lim : (sy < -lim ? -lim : sy));
       dx -= stx;
       dy -= sty;
-      if ((stx < 0 ? -stx : stx) + (sty < 0 ? -sty : sty) < 512) break;  // < 1/128 px
+      // Below 1/128 px at level 0. A coarse level only starts the next one, which doubles its
+      // residual and corrects it: 1/16 px there is well within that level's reach, and the
+      // iterations that would polish it further were a tenth of the motion stage's time.
+      const int32_t still = coarse ? 4096 : 512;
+      if ((stx < 0 ? -stx : stx) + (sty < 0 ? -sty : sty) < still) break;
     }
     if (level > 0) {
       dx *= 2;
