@@ -46,6 +46,12 @@ struct Layout {
   int bits = 8;
   int color = PNG_COLOR_TYPE_GRAY;
   bool srgb = false;  // an sRGB chunk, as libpng's simplified writer gives colour images
+  // zlib's fastest level and every row filtered against the one above, instead of libpng's
+  // level 6 trying all five filters per row: for a depth map (rows alike, smooth or flat
+  // between edges) that halves a 12 MP photo's XMP time (writing_bench: 67 -> 26 ms) for a
+  // larger depth image (+21 % on HCI antinous' ground truth at 16 bits, +88 % on Middlebury
+  // barn1's flat planes; tens of kB in a photo of megabytes).
+  bool fast = false;
   size_t row_bytes = 0;
 };
 
@@ -71,6 +77,10 @@ Status Encode(const char* name, const Layout& layout, const void* image, RowFn f
                static_cast<png_uint_32>(layout.height), layout.bits, layout.color,
                PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
   if (layout.srgb) png_set_sRGB(write, info, PNG_sRGB_INTENT_PERCEPTUAL);
+  if (layout.fast) {
+    png_set_compression_level(write, 1);
+    png_set_filter(write, PNG_FILTER_TYPE_BASE, PNG_FILTER_UP);
+  }
   png_write_info(write, info);
   for (int32_t y = 0; y < layout.height; ++y) {
     fill(image, y, row.data());
@@ -115,6 +125,7 @@ Status EncodeGrayPng(ConstImageU16 values, int bits, std::vector<uint8_t>* png) 
   layout.height = values.height;
   layout.bits = bits;
   layout.row_bytes = static_cast<size_t>(values.width) * static_cast<size_t>(bits / 8);
+  layout.fast = true;
   return Encode("depth png", layout, &values, bits == 8 ? GrayRow8 : GrayRow16, png);
 }
 
