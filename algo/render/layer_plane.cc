@@ -144,15 +144,23 @@ void LayerPlane::CommitRowShared(int32_t y, const uint16_t* layer_of, int32_t of
   for (int32_t x0 = 0, t = 0; x0 < width_; x0 += 1 << tile_shift_, ++t) {
     const int32_t x1 = Min(width_, x0 + (1 << tile_shift_));
     const uint64_t bit = uint64_t{1} << t;
+    // Neighbouring pixels mostly share their entry: only a change marks layers again (marking
+    // every pixel made a chain of loads and stores on the same word).
     const uint16_t e0 = layer_of[s[x0] + offset];
-    bool same = (e0 & 255) == 0;
-    for (int32_t x = x0; x < x1; ++x) {
+    tiles[e0 >> 8] |= bit;
+    if (e0 & 255) tiles[(e0 >> 8) + 1] |= bit;
+    uint16_t last = e0;
+    bool changed = false;
+    for (int32_t x = x0 + 1; x < x1; ++x) {
       const uint16_t e = layer_of[s[x] + offset];
-      same = same && e == e0;
+      if (e == last) continue;
+      changed = true;
+      last = e;
       tiles[e >> 8] |= bit;
       if (e & 255) tiles[(e >> 8) + 1] |= bit;
     }
-    if (same) pure[e0 >> 8] |= bit;  // every pixel of the tile wholly in one layer
+    // Every pixel of the tile wholly in one layer.
+    if (!changed && (e0 & 255) == 0) pure[e0 >> 8] |= bit;
   }
 }
 
