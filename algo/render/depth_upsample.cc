@@ -14,6 +14,7 @@ void DepthUpsampler::Carve(Arena& arena, int32_t width, int32_t height, int32_t 
     Cache& c = cache_[w];
     for (Guide& g : c.guide) g.yuv = arena.Allocate<uint8_t>(static_cast<size_t>(3) * ww_);
     c.uniform = arena.Allocate<uint8_t>(static_cast<size_t>(ww_));
+    c.sums = arena.Allocate<uint32_t>(static_cast<size_t>(width) + 2 * ((width + 1) / 2));
   }
   spatial_q8_ = arena.Allocate<uint16_t>(static_cast<size_t>(3) * scale_);
   range_q8_ = arena.Allocate<uint16_t>(766);
@@ -52,22 +53,34 @@ const uint8_t* DepthUpsampler::GuideRow(Cache& c, int32_t wy) {
   g.tag = wy;
   const int32_t s = scale_;
   const int32_t cw = ref_.planes[1].width, ch = ref_.planes[1].height;
+  // Each block's sum as the sum of its columns' sums: every row is added once, a whole row at
+  // a time (the same integers as adding the block pixel by pixel).
+  uint32_t* const col = c.sums;
+  const int32_t used = ww_ * s;  // the columns the blocks cover: at most width_ (RenderStage)
+  for (int32_t x = 0; x < used; ++x) col[x] = 0;
+  for (int32_t y = wy * s; y < wy * s + s; ++y) {
+    const uint8_t* row = ref_.planes[0].Row(y);
+    for (int32_t x = 0; x < used; ++x) col[x] += row[x];
+  }
+  const int32_t cy0 = wy * s / 2, cy1 = Min((wy * s + s - 1) / 2, ch - 1);
+  uint32_t* const ccol[2] = {col + width_, col + width_ + cw};
+  for (int32_t p = 1; p < 3; ++p) {
+    uint32_t* const sum = ccol[p - 1];
+    for (int32_t x = 0; x < cw; ++x) sum[x] = 0;
+    for (int32_t y = cy0; y <= cy1; ++y) {
+      const uint8_t* row = ref_.planes[p].Row(y);
+      for (int32_t x = 0; x < cw; ++x) sum[x] += row[x];
+    }
+  }
   for (int32_t wx = 0; wx < ww_; ++wx) {
     uint32_t sum = 0;
-    for (int32_t y = wy * s; y < wy * s + s; ++y) {
-      const uint8_t* row = ref_.planes[0].Row(y);
-      for (int32_t x = wx * s; x < wx * s + s; ++x) sum += row[x];
-    }
+    for (int32_t x = wx * s; x < wx * s + s; ++x) sum += col[x];
     g.yuv[wx] = static_cast<uint8_t>((sum + s * s / 2) / (s * s));
     const int32_t cx0 = wx * s / 2, cx1 = Min((wx * s + s - 1) / 2, cw - 1);
-    const int32_t cy0 = wy * s / 2, cy1 = Min((wy * s + s - 1) / 2, ch - 1);
     const uint32_t n = static_cast<uint32_t>((cx1 - cx0 + 1) * (cy1 - cy0 + 1));
     for (int32_t p = 1; p < 3; ++p) {
       uint32_t csum = 0;
-      for (int32_t y = cy0; y <= cy1; ++y) {
-        const uint8_t* row = ref_.planes[p].Row(y);
-        for (int32_t x = cx0; x <= cx1; ++x) csum += row[x];
-      }
+      for (int32_t x = cx0; x <= cx1; ++x) csum += ccol[p - 1][x];
       g.yuv[p * ww_ + wx] = static_cast<uint8_t>((csum + n / 2) / n);
     }
   }

@@ -42,6 +42,7 @@ class DepthUpsampler {
   struct Cache {
     Guide guide[4];
     uint8_t* uniform = nullptr;  // per working pixel of row uniform_tag: how its 3x3 agree
+    uint32_t* sums = nullptr;    // GuideRow's column sums: width luma, then 2 x chroma width
     int32_t uniform_tag = -1;
   };
   const uint8_t* GuideRow(Cache& c, int32_t wy);
