@@ -24,6 +24,13 @@ LB_CLONES_AVX2 void RadiusRow(const LensModel& lens, const uint16_t* disp, int32
   for (int32_t x = 0; x < n; ++x) s[x] = static_cast<int16_t>(lens.SignedRadiusQ4(disp[x]));
 }
 
+// The chroma radii: each the rounded mean of its 2x2 luma block's, for n whole blocks.
+LB_CLONES_AVX2 void MeanRadiusRow(const int16_t* s0, const int16_t* s1, int32_t n, int16_t* s) {
+  for (int32_t x = 0; x < n; ++x) {
+    s[x] = static_cast<int16_t>((s0[2 * x] + s0[2 * x + 1] + s1[2 * x] + s1[2 * x + 1] + 2) >> 2);
+  }
+}
+
 }  // namespace
 
 int32_t RenderStage::LayerRadiiQ4(int32_t max_radius, int32_t* out) {
@@ -255,9 +262,15 @@ void RenderStage::FillChromaRow(int32_t cy) {
   int16_t* vb = chroma_.ValueRow(cy, 0);
   int16_t* vr = chroma_.ValueRow(cy, 1);
   const int32_t cw = (config_.width + 1) / 2;
+  // Two loops, as FillLumaRow's: the radii's vectorise.
+  const int32_t pairs = config_.width / 2;  // chroma samples with two luma columns
+  MeanRadiusRow(s0, s1, pairs, s);
+  if (pairs < cw) {
+    const int32_t a = 2 * pairs;
+    s[pairs] = static_cast<int16_t>((2 * s0[a] + 2 * s1[a] + 2) >> 2);
+  }
   for (int32_t x = 0; x < cw; ++x) {
     const int32_t a = 2 * x, b = Min(2 * x + 1, config_.width - 1);
-    s[x] = static_cast<int16_t>((s0[a] + s0[b] + s1[a] + s1[b] + 2) >> 2);
     const int32_t gain = boost_q8_[(l0[a] + l0[b] + l1[a] + l1[b] + 2) >> 2];
     vb[x] = static_cast<int16_t>(((cb[x] - 128) * gain + 128) >> 8);
     vr[x] = static_cast<int16_t>(((cr[x] - 128) * gain + 128) >> 8);
