@@ -144,22 +144,25 @@ void LayerPlane::CommitRowShared(int32_t y, const uint16_t* layer_of, int32_t of
   for (int32_t x0 = 0, t = 0; x0 < width_; x0 += 1 << tile_shift_, ++t) {
     const int32_t x1 = Min(width_, x0 + (1 << tile_shift_));
     const uint64_t bit = uint64_t{1} << t;
-    // Neighbouring pixels mostly share their entry: only a change marks layers again (marking
-    // every pixel made a chain of loads and stores on the same word).
+    // The layers an entry marks: its first, and the next when it has weight there. Neighbouring
+    // pixels mostly mark the same (their weights differ, their layers seldom), so only a change
+    // marks again: marking every pixel made a chain of loads and stores on the same word.
+    auto marks = [](uint16_t e) { return ((e >> 8) << 1) | ((e & 255) != 0 ? 1 : 0); };
     const uint16_t e0 = layer_of[s[x0] + offset];
+    int32_t last = marks(e0);
     tiles[e0 >> 8] |= bit;
     if (e0 & 255) tiles[(e0 >> 8) + 1] |= bit;
-    uint16_t last = e0;
     bool changed = false;
     for (int32_t x = x0 + 1; x < x1; ++x) {
       const uint16_t e = layer_of[s[x] + offset];
-      if (e == last) continue;
+      const int32_t m = marks(e);
+      if (m == last) continue;
       changed = true;
-      last = e;
+      last = m;
       tiles[e >> 8] |= bit;
       if (e & 255) tiles[(e >> 8) + 1] |= bit;
     }
-    // Every pixel of the tile wholly in one layer.
+    // Every pixel of the tile wholly in one layer: all mark e0's layer alone.
     if (!changed && (e0 & 255) == 0) pure[e0 >> 8] |= bit;
   }
 }
