@@ -149,21 +149,18 @@ void LayerPlane::CommitRowShared(int32_t y, const uint16_t* layer_of, int32_t of
     // marks again: marking every pixel made a chain of loads and stores on the same word.
     auto marks = [](uint16_t e) { return ((e >> 8) << 1) | ((e & 255) != 0 ? 1 : 0); };
     const uint16_t e0 = layer_of[s[x0] + offset];
-    int32_t last = marks(e0);
-    tiles[e0 >> 8] |= bit;
-    if (e0 & 255) tiles[(e0 >> 8) + 1] |= bit;
-    bool changed = false;
-    for (int32_t x = x0 + 1; x < x1; ++x) {
+    int32_t last = -1, runs = 0;
+    for (int32_t x = x0; x < x1; ++x) {
       const uint16_t e = layer_of[s[x] + offset];
       const int32_t m = marks(e);
       if (m == last) continue;
-      changed = true;
+      ++runs;
       last = m;
       tiles[e >> 8] |= bit;
       if (e & 255) tiles[(e >> 8) + 1] |= bit;
     }
     // Every pixel of the tile wholly in one layer: all mark e0's layer alone.
-    if (!changed && (e0 & 255) == 0) pure[e0 >> 8] |= bit;
+    if (runs == 1 && (e0 & 255) == 0) pure[e0 >> 8] |= bit;
   }
 }
 
