@@ -298,17 +298,22 @@ int64_t DepthStageProbe::Energy(DepthStage& s, const uint8_t* labels) {
 void DepthStage::Refine(ImageU16 disp_q8) {
   const int32_t w = config_.width, h = config_.height;
   const int32_t bias = MapBiasQ8(config_);
+  // Each label's disparity and half its neighbours' span, once, not three 64-bit divisions a
+  // pixel.
+  int32_t disp[DepthConfig::kMaxLabels], half_span[DepthConfig::kMaxLabels];
+  for (int32_t l = 0; l < config_.labels; ++l) disp[l] = LabelDispQ8(l);
+  for (int32_t l = 1; l + 1 < config_.labels; ++l) half_span[l] = (disp[l + 1] - disp[l - 1]) / 2;
   for (int32_t y = 0; y < h; ++y) {
     uint16_t* out = disp_q8.Row(y);
     for (int32_t x = 0; x < w; ++x) {
       const int32_t p = y * w + x;
       const int32_t f = fine_.labels[p];
-      int32_t d_q8 = LabelDispQ8(f);
+      int32_t d_q8 = disp[f];
       if (config_.subpixel && f > 0 && f + 1 < config_.labels) {
         const int32_t cm = below_[p], c0 = fine_.cost[p], cp = above_[p];
         const int32_t curvature = cm + cp - 2 * c0;
         if (cm != 0xffff && cp != 0xffff && c0 <= cm && c0 <= cp && curvature > 0) {
-          const int32_t step_q8 = (LabelDispQ8(f + 1) - LabelDispQ8(f - 1)) / 2;
+          const int32_t step_q8 = half_span[f];
           // Vertex at (cm - cp) / (2 * curvature) labels; |cm - cp| <= curvature keeps it
           // within half a label. Truncating division, the same on every target.
           d_q8 += ((cm - cp) * step_q8) / (2 * curvature);
