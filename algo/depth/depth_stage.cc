@@ -11,8 +11,10 @@
 namespace lb {
 
 int32_t DepthStage::LabelDispQ8(const DepthConfig& c, int32_t label) {
+  // Validate asks for 2 labels or more; a config of one (never configured) gets label 0's.
+  const int32_t steps = c.labels > 1 ? c.labels - 1 : 1;
   return c.disp_min_q8 +
-         static_cast<int32_t>((int64_t{c.disp_max_q8 - c.disp_min_q8} * label) / (c.labels - 1));
+         static_cast<int32_t>((int64_t{c.disp_max_q8 - c.disp_min_q8} * label) / steps);
 }
 
 Status DepthStage::Validate(const DepthConfig& c) {
