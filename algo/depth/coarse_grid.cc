@@ -15,18 +15,17 @@ namespace {
 // Pixels per band of the coarse start: the views' rows of a band (9 views of 450 px: 0.6 MB with
 // their census) fit a board's L2 cache.
 constexpr int32_t kBandPixels = 16384;
+}  // namespace
 
-// The winner-take-all's step: where d is below the best so far, d and `label` become the best.
 // Without branches, so that it vectorizes (a block's winner is a coin toss to a predictor).
-LB_CLONES_AVX2 void TakeBetter(const uint16_t* __restrict d, int32_t n, uint8_t label,
-                               uint16_t* __restrict cost, uint8_t* __restrict labels) {
+LB_CLONES_AVX2 void DepthStage::TakeBetter(const uint16_t* __restrict d, int32_t n, uint8_t label,
+                                           uint16_t* __restrict cost, uint8_t* __restrict labels) {
   for (int32_t p = 0; p < n; ++p) {
     const bool better = d[p] < cost[p];
     cost[p] = better ? d[p] : cost[p];
     labels[p] = better ? label : labels[p];
   }
 }
-}  // namespace
 
 void DepthStage::BlockWeights() {
   const int32_t w = config_.width, h = config_.height, bw = coarse_.width, bh = coarse_.height;

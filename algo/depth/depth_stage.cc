@@ -271,12 +271,7 @@ void DepthStage::WinnerTakeAll() {
   const int32_t step = config_.max_cycles > 0 ? config_.coarse_step : 1;
   for (int32_t label = 0; label < config_.labels; label += step) {
     LabelCosts(label, fine_.cost_alpha);
-    for (int32_t p = 0; p < n; ++p) {
-      if (fine_.cost_alpha[p] < cost[p]) {
-        cost[p] = fine_.cost_alpha[p];
-        labels[p] = static_cast<uint8_t>(label);
-      }
-    }
+    TakeBetter(fine_.cost_alpha, n, static_cast<uint8_t>(label), cost, labels);
   }
 }
 

@@ -220,6 +220,10 @@ class DepthStage {
   }
   void CutRect(int32_t alpha, const Rect& r);
   int32_t ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1, int32_t e0, int32_t e1);
+  // The winner-take-all's step: where d is below the best so far (cost), d and `label` become
+  // the best (coarse_grid.cc).
+  static void TakeBetter(const uint16_t* d, int32_t n, uint8_t label, uint16_t* cost,
+                         uint8_t* labels);
   static uint8_t StatesRow(const uint8_t* f, const uint16_t* wr, const uint16_t* wd,
                            const uint16_t* wu, const int32_t* er, const int32_t* ed,
                            const int32_t* eu, const uint16_t* ca, const uint16_t* cc,
