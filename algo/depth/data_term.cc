@@ -133,19 +133,28 @@ void DataTerm::PrepareRefLanes(const Scratch& s, const PlaneHomography* planes, 
 
 // The views' next rows are far apart (a whole view each), so the hardware prefetcher misses their
 // starts; asking early hides the cache misses behind the other views. Rectified shifts read row
-// y of each view and of its three census planes. The plane sweep samples view v near
-// H_v(x, y), rows away from y and along a slanted line: per chunk of columns, the rows and
+// y of each view and of its three census planes, at the label's shift. The plane sweep samples view
+// v near H_v(x, y), rows away from y and along a slanted line: per chunk of columns, the rows and
 // columns between the chunk's two ends (and the row below, for the bilinear taps). On the
 // handheld burst this cut the restricted moves' data term by a quarter.
-LB_KEEP_CALLS void DataTerm::PrefetchRow(int32_t y, int32_t x0, int32_t x1) const {
+LB_KEEP_CALLS void DataTerm::PrefetchRow(int32_t y, int32_t x0, int32_t x1,
+                                         const dtk::RectRow& shifts) const {
   const int32_t w = width_, h = height_, others = views_ - 1;
   const int32_t row = Clamp(y, 0, h - 1);
+  // The reference's own row: a restricted run starts anywhere in it, so no stream finds it.
+  const size_t cols = static_cast<size_t>(x1 - x0);
+  PrefetchLines(images_[reference_].Row(row) + 3 * x0, 3 * cols);
+  const uint8_t* ref_census = census_[reference_] + static_cast<ptrdiff_t>(row) * 3 * w + x0;
+  for (int32_t k = 0; k < 3; ++k) PrefetchLines(ref_census + k * w, cols);
   if (planes_ == nullptr) {
-    const size_t n = static_cast<size_t>(x1 - x0);
     for (int32_t j = 0; j < others; ++j) {
-      PrefetchLines(images_[OtherView(j)].Row(row) + 3 * x0, 3 * n);
-      const uint8_t* census = census_[OtherView(j)] + static_cast<ptrdiff_t>(row) * 3 * w + x0;
-      for (int32_t k = 0; k < 3; ++k) PrefetchLines(census + k * w, n);
+      // The columns the run's costs sample (one more each side for the 3-sums), at the shift.
+      const int32_t off = shifts.shift_q8[j] >> 8;
+      const int32_t c0 = Clamp(x0 - 1 + off, 0, w - 1), c1 = Clamp(x1 + 2 + off, c0 + 1, w);
+      const size_t m = static_cast<size_t>(c1 - c0);
+      PrefetchLines(images_[OtherView(j)].Row(row) + 3 * c0, 3 * m);
+      const uint8_t* census = census_[OtherView(j)] + static_cast<ptrdiff_t>(row) * 3 * w + c0;
+      for (int32_t k = 0; k < 3; ++k) PrefetchLines(census + k * w, m);
     }
     return;
   }
@@ -388,7 +397,7 @@ void DataTerm::ComputeRunBand(const Scratch& s, int32_t disp_q8, const RowRuns* 
     window_rows(y + 1, n);
     // As ComputeBand: ask early for the views' next rows, which the prefetcher misses.
     n = NeededColumns(runs, y + 2, y0, y1, join, iv);
-    for (int32_t i = 0; i < n; ++i) PrefetchRow(y + 2, iv[2 * i], iv[2 * i + 1]);
+    for (int32_t i = 0; i < n; ++i) PrefetchRow(y + 2, iv[2 * i], iv[2 * i + 1], row);
     // The ring's three rows of each view are y - 1 .. y + 1.
     for (int32_t k = 0; k < runs[y].count; ++k) {
       const int32_t x0 = runs[y].x[2 * k], x1 = runs[y].x[2 * k + 1];

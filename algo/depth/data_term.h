@@ -135,8 +135,9 @@ class DataTerm {
   // columns every view's WindowRow(y, x0, x1) reads, when the kernel wants them.
   void PrepareRefLanes(const Scratch& s, const PlaneHomography* planes, int32_t y, int32_t x0,
                        int32_t x1) const;
-  // Asks for the view rows that reference row y's columns x0..x1-1 will read.
-  void PrefetchRow(int32_t y, int32_t x0, int32_t x1) const;
+  // Asks for the view rows that reference row y's columns x0..x1-1 will read; the rectified
+  // shifts' sample columns from `shifts` (StartRows), which the plane sweep does not read.
+  void PrefetchRow(int32_t y, int32_t x0, int32_t x1, const dtk::RectRow& shifts) const;
   // The plane sweep's 3-sums of one view's row y, columns x0..x1-1.
   void WindowRow(const Scratch& s, const PlaneHomography* planes, int32_t view, int32_t y,
                  int32_t x0, int32_t x1, uint16_t* hsum) const;
