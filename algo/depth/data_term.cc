@@ -14,7 +14,9 @@ constexpr int32_t kLumaPad = 2;   // the census reaches 2 pixels left and right
 constexpr int32_t kLumaRows = 5;  // and 2 rows up and down
 
 // GCC counts a function whose only effect is __builtin_prefetch as pure, and drops the calls whose
-// (void) result goes unused: this keeps them.
+// (void) result goes unused: this keeps them. A helper of PrefetchRow's would be dropped too,
+// even when marked always_inline (PrefetchRow compiled to a bare return), so it spells its
+// requests out.
 #if defined(__GNUC__) && !defined(__clang__)
 #define LB_KEEP_CALLS __attribute__((noipa))
 #else
