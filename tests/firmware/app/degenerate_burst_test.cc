@@ -14,6 +14,7 @@
 #include "sim/files/file_sensor.h"
 #include "tests/algo/motion/burst.h"
 #include "tests/firmware/codecs/test_images.h"
+#include "tests/support/remove_tree.h"
 
 namespace lb {
 namespace {
@@ -52,7 +53,7 @@ class DegenerateBurst : public ::testing::Test {
     ASSERT_NE(mkdtemp(tmpl), nullptr);
     dir_ = tmpl;
   }
-  void TearDown() override { (void)system(("rm -rf " + dir_).c_str()); }
+  void TearDown() override { (void)lb::test::RemoveTree(dir_); }
 
   // Writes the burst's frames as PPM files.
   std::vector<std::string> Write(const motiontest::Burst& b) {

@@ -8,6 +8,7 @@
 
 #include "firmware/app/job.h"
 #include "sim/synthetic/synthetic_sensor.h"
+#include "tests/support/remove_tree.h"
 
 namespace lb {
 namespace {
@@ -56,7 +57,7 @@ TEST(RefocusableExiftool, ReadsGDepthGImageAndGFocus) {
   const std::string image =
       Capture("exiftool -b -XMP-GImage:ImageData '" + path + "' | head -c 2 | od -An -tx1");
   EXPECT_NE(image.find("ff d8"), std::string::npos) << image;  // JPEG SOI
-  (void)system((std::string("rm -rf ") + tmpl).c_str());
+  (void)lb::test::RemoveTree(tmpl);
 }
 
 }  // namespace

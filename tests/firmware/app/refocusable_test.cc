@@ -15,6 +15,7 @@
 #include "firmware/app/job.h"
 #include "firmware/app/rerender.h"
 #include "sim/synthetic/synthetic_sensor.h"
+#include "tests/support/remove_tree.h"
 
 namespace lb {
 namespace {
@@ -61,7 +62,7 @@ class Refocusable : public ::testing::Test {
     Status s = job_.Run(Path("run.jpg").c_str(), nullptr, &run_);
     ASSERT_TRUE(s.ok()) << s.message();
   }
-  void TearDown() override { (void)system(("rm -rf " + dir_).c_str()); }
+  void TearDown() override { (void)lb::test::RemoveTree(dir_); }
   std::string Path(const char* name) const { return dir_ + "/" + name; }
 
   std::string dir_;

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "tests/firmware/codecs/test_images.h"
+#include "tests/support/remove_tree.h"
 
 namespace lb::clitest {
 
@@ -44,7 +45,7 @@ class Cli : public ::testing::Test {
     out_dir_ = dir_ + "/out";
     ASSERT_EQ(mkdir(out_dir_.c_str(), 0755), 0);
   }
-  void TearDown() override { (void)system(("rm -rf " + dir_).c_str()); }
+  void TearDown() override { (void)lb::test::RemoveTree(dir_); }
 
   Result Run(const std::vector<std::string>& args) {
     std::string cmd = REFOCUS_BIN;

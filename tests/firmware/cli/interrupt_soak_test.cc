@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "tests/support/remove_tree.h"
+
 namespace lb {
 namespace {
 
@@ -116,7 +118,7 @@ TEST(InterruptSoak, NoTemporaryLeftAndTheOldPhotoIntact) {
   printf("50 runs: %d interrupted (run %.2f s, rerender %.2f s uninterrupted)\n", interrupted,
          run_s, rerender_s);
   EXPECT_GT(interrupted, 25) << "most signals should land inside a run";
-  ASSERT_EQ(system(("rm -rf '" + dir + "'").c_str()), 0);
+  ASSERT_TRUE(lb::test::RemoveTree(dir)) << dir;
 }
 
 }  // namespace

@@ -1,7 +1,6 @@
 #include "tests/firmware/codecs/jpeg_test_util.h"
 
 #include <dirent.h>
-#include <ftw.h>
 #include <stdlib.h>
 #include <sys/wait.h>
 
@@ -12,6 +11,8 @@
 
 #include <cmath>
 #include <csetjmp>
+
+#include "tests/support/remove_tree.h"
 
 namespace lb::test {
 
@@ -132,17 +133,11 @@ ScratchDir::ScratchDir() {
   if (mkdtemp(tmpl) != nullptr) dir_ = tmpl;
 }
 
-namespace {
-int RemoveEntry(const char* path, const struct stat*, int, struct FTW*) { return remove(path); }
-}  // namespace
-
-// Without a shell: under qemu-user, the child of a fork right after a test's threads ended once
-// hung on a lock (the aarch64 daemon test, in CI), and the whole run with it.
+// Without a shell (RemoveTree): under qemu-user, the child of a fork right after a test's threads
+// ended once hung on a lock (the aarch64 daemon test, in CI), and the whole run with it.
 ScratchDir::~ScratchDir() {
   if (dir_.empty()) return;
-  if (nftw(dir_.c_str(), RemoveEntry, 16, FTW_DEPTH | FTW_PHYS) != 0) {
-    fprintf(stderr, "could not remove %s\n", dir_.c_str());
-  }
+  if (!RemoveTree(dir_)) fprintf(stderr, "could not remove %s\n", dir_.c_str());
 }
 
 std::vector<std::string> ScratchDir::Entries() const {

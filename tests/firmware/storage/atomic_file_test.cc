@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "firmware/storage/temp_registry.h"
+#include "tests/support/remove_tree.h"
 
 namespace lb {
 namespace {
@@ -27,10 +28,7 @@ class AtomicFileTest : public ::testing::Test {
     ASSERT_NE(mkdtemp(tmpl), nullptr);
     dir_ = tmpl;
   }
-  void TearDown() override {
-    const std::string cmd = "rm -rf '" + dir_ + "'";
-    ASSERT_EQ(system(cmd.c_str()), 0);
-  }
+  void TearDown() override { ASSERT_TRUE(lb::test::RemoveTree(dir_)) << dir_; }
   std::string Path(const char* name) const { return dir_ + "/" + name; }
   std::vector<std::string> Entries() const {
     std::vector<std::string> names;

@@ -16,6 +16,7 @@
 
 #include "firmware/storage/atomic_file.h"
 #include "firmware/storage/temp_registry.h"
+#include "tests/support/remove_tree.h"
 
 namespace lb {
 namespace {
@@ -27,7 +28,7 @@ class OutputTargetTest : public ::testing::Test {
     ASSERT_NE(mkdtemp(tmpl), nullptr);
     dir_ = tmpl;
   }
-  void TearDown() override { ASSERT_EQ(system(("rm -rf '" + dir_ + "'").c_str()), 0); }
+  void TearDown() override { ASSERT_TRUE(lb::test::RemoveTree(dir_)) << dir_; }
   std::string Path(const char* name) const { return dir_ + "/" + name; }
   void Touch(const std::string& path, const char* text = "old") {
     FILE* f = fopen(path.c_str(), "wb");
