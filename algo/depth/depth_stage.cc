@@ -44,8 +44,8 @@ Status DepthStage::Validate(const DepthConfig& c) {
     return Status(Code::kInvalidArgument, "depth: disparity range %d..%d (Q8) is empty or too wide",
                   c.disp_min_q8, c.disp_max_q8);
   }
-  // These bounds keep every node's terminal balance and arc capacity far below
-  // GridMaxflow::kMaxCapacity: |balance| <= 2295 + 8 * 4096 * 64.
+  // These bounds keep every node's terminal balance far below GridMaxflow::kMaxCapacity:
+  // |balance| <= 2295 + 8 * 4096 * 64.
   if (c.color_trunc < 1 || c.color_trunc > 765 || c.census_weight < 0 || c.census_weight > 10 ||
       c.smooth_weight < 0 || c.smooth_weight > 4096 || c.smooth_trunc < 1 || c.smooth_trunc > 64 ||
       c.edge_threshold < 0 || c.edge_threshold > 255 || c.edge_weight_q8 < 0 ||
@@ -60,6 +60,13 @@ Status DepthStage::Validate(const DepthConfig& c) {
   if (c.geometry != ViewGeometry::kRectified && c.geometry != ViewGeometry::kKnownPoses) {
     return Status(Code::kInvalidArgument, "depth: geometry %d is neither rectified nor known poses",
                   static_cast<int>(c.geometry));
+  }
+  // An arc of a move's graph carries at most w_pq * 2 * smooth_trunc, and a block pair's weight
+  // on the coarse grid is two pixel pairs': within the solver's 16-bit arcs.
+  if (4 * c.smooth_weight * c.smooth_trunc > GridMaxflow::kMaxArc) {
+    return Status(Code::kInvalidArgument,
+                  "depth: smoothness %d x truncation %d is over %d (the graph's arcs are 16 bits)",
+                  c.smooth_weight, c.smooth_trunc, GridMaxflow::kMaxArc / 4);
   }
   return Status::Ok();
 }

@@ -50,7 +50,7 @@ struct DepthConfig {
   // Potts when smooth_trunc is 1. w_pq is smooth_weight where the reference is flat and
   // smooth_weight * edge_weight_q8 / 256 across a colour edge (largest channel step above
   // edge_threshold), so label changes prefer image edges.
-  int32_t smooth_weight = 96;   // 0..4096
+  int32_t smooth_weight = 96;   // 0..4096, times smooth_trunc at most 16383
   int32_t smooth_trunc = 8;     // 1..64
   int32_t edge_threshold = 16;  // 0..255
   int32_t edge_weight_q8 = 64;  // 0..256

@@ -26,7 +26,7 @@ void GridMaxflow::Carve(Arena& arena, int32_t max_width, int32_t max_height) {
   max_nodes_ = max_width * max_height;
   max_width_ = max_width;
   storage_ =
-      arena.Allocate<Node>(static_cast<size_t>(max_nodes_) + 2 * static_cast<size_t>(max_width));
+      arena.Allocate<Node>(static_cast<size_t>(max_nodes_) + 3 * static_cast<size_t>(max_width));
   orphans_ = arena.Allocate<int32_t>(static_cast<size_t>(max_nodes_));
   queue_ = arena.Allocate<int32_t>(static_cast<size_t>(max_nodes_));
   live_ = arena.Allocate<int32_t>(2 * static_cast<size_t>(max_height));
@@ -37,8 +37,8 @@ void GridMaxflow::Carve(Arena& arena, int32_t max_width, int32_t max_height) {
 }
 
 uint8_t* GridMaxflow::Spare(int32_t width, int32_t height, size_t* bytes) const {
-  const int64_t used = int64_t{width} * height + 2 * int64_t{width};
-  const int64_t total = int64_t{max_nodes_} + 2 * int64_t{max_width_};
+  const int64_t used = int64_t{width} * height + 3 * int64_t{width};
+  const int64_t total = int64_t{max_nodes_} + 3 * int64_t{max_width_};
   *bytes =
       storage_ != nullptr && used < total ? sizeof(Node) * static_cast<size_t>(total - used) : 0;
   return *bytes > 0 ? reinterpret_cast<uint8_t*>(storage_ + used) : nullptr;
@@ -61,7 +61,7 @@ void GridMaxflow::Begin(int32_t width, int32_t height) {
   Start(width, height);
   // The padding row above; the one below is written when the staged rows are spent (Prepare).
   memset(static_cast<void*>(storage_), 0, sizeof(Node) * static_cast<size_t>(width));
-  const size_t stage_at = 16 * static_cast<size_t>(count_) + 64 * static_cast<size_t>(width);
+  const size_t stage_at = 48 * static_cast<size_t>(width);
   stage_base_ = reinterpret_cast<int32_t*>(reinterpret_cast<uint8_t*>(storage_) + stage_at);
   stage_ = stage_base_;
   stage_width_ = width;
@@ -86,8 +86,8 @@ void GridMaxflowProbe::Reset(GridMaxflow& mf, int32_t width, int32_t height) {
 
 void GridMaxflow::Activate(int32_t p) {
   Node& n = nodes_[p];
-  if (n.queued) return;
-  n.queued = 1;
+  if (n.bits & kQueuedBit) return;
+  n.bits |= kQueuedBit;
   int32_t slot = queue_head_ + queue_count_;
   if (slot >= max_nodes_) slot -= max_nodes_;
   queue_[slot] = p;
@@ -110,14 +110,14 @@ int32_t GridMaxflow::NextActive() {
     queue_head_ = queue_head_ + 1 == max_nodes_ ? 0 : queue_head_ + 1;
     --queue_count_;
     Node& n = nodes_[p];
-    n.queued = 0;
-    if (n.tree != kFree) return p;
+    n.bits &= static_cast<uint8_t>(~kQueuedBit);
+    if (TreeOf(n) != kFree) return p;
   }
   return kNotActive;
 }
 
 void GridMaxflow::PushOrphan(int32_t p) {
-  nodes_[p].parent = kOrphan;
+  SetParent(nodes_[p], kOrphan);
   int32_t slot = orphan_head_ + orphan_count_;
   if (slot >= max_nodes_) slot -= max_nodes_;
   orphans_[slot] = p;
@@ -134,11 +134,12 @@ void GridMaxflow::Augment(int32_t s_node, int dir) {
   int32_t s_len = 0, p = s_node;
   for (;;) {
     const Node& n = nodes_[p];
-    if (n.parent == kTerminal) break;
+    const uint8_t np = ParentOf(n);
+    if (np == kTerminal) break;
     path_[s_len < kPath ? s_len : kPath] = p;
     ++s_len;
-    const int32_t parent = p + offset_[n.parent];
-    const int32_t c = nodes_[parent].cap[n.parent ^ 1];
+    const int32_t parent = p + offset_[np];
+    const int32_t c = nodes_[parent].cap[np ^ 1];
     bottleneck = c < bottleneck ? c : bottleneck;
     p = parent;
   }
@@ -149,24 +150,25 @@ void GridMaxflow::Augment(int32_t s_node, int dir) {
   int32_t t_len = 0;
   for (p = t_node;;) {
     const Node& n = nodes_[p];
-    if (n.parent == kTerminal) break;
+    const uint8_t np = ParentOf(n);
+    if (np == kTerminal) break;
     t_path[t_len < kPath ? t_len : kPath] = p;
     ++t_len;
-    const int32_t c = n.cap[n.parent];
+    const int32_t c = n.cap[np];
     bottleneck = c < bottleneck ? c : bottleneck;
-    p += offset_[n.parent];
+    p += offset_[np];
   }
   const int32_t t_root = p;
   bottleneck = -nodes_[t_root].tcap < bottleneck ? -nodes_[t_root].tcap : bottleneck;
 
-  nodes_[s_node].cap[dir] -= bottleneck;
-  nodes_[t_node].cap[dir ^ 1] += bottleneck;
+  nodes_[s_node].cap[dir] = static_cast<uint16_t>(nodes_[s_node].cap[dir] - bottleneck);
+  nodes_[t_node].cap[dir ^ 1] = static_cast<uint16_t>(nodes_[t_node].cap[dir ^ 1] + bottleneck);
   // Paths longer than the record go on by walking.
   auto source_step = [&](int32_t q) {
     Node& n = nodes_[q];
-    const int d = n.parent;
+    const int d = ParentOf(n);
     const int32_t parent = q + offset_[d];
-    n.cap[d] += bottleneck;
+    n.cap[d] = static_cast<uint16_t>(n.cap[d] + bottleneck);
     if ((nodes_[parent].cap[d ^ 1] -= bottleneck) == 0) PushOrphan(q);
     return parent;
   };
@@ -176,9 +178,9 @@ void GridMaxflow::Augment(int32_t s_node, int dir) {
   if ((nodes_[s_root].tcap -= bottleneck) == 0) PushOrphan(s_root);
   auto sink_step = [&](int32_t q) {
     Node& n = nodes_[q];
-    const int d = n.parent;
+    const int d = ParentOf(n);
     const int32_t parent = q + offset_[d];
-    nodes_[parent].cap[d ^ 1] += bottleneck;
+    nodes_[parent].cap[d ^ 1] = static_cast<uint16_t>(nodes_[parent].cap[d ^ 1] + bottleneck);
     if ((n.cap[d] -= bottleneck) == 0) PushOrphan(q);
     return parent;
   };
@@ -199,29 +201,31 @@ void GridMaxflow::Adopt(int32_t p) {
   for (int dir = 0; dir < 4; ++dir) {
     const int32_t q = p + offset_[dir];
     Node& first = nodes_[q];
-    if (first.tree != tree) continue;
+    if (TreeOf(first) != tree) continue;
     // The arc that would carry flow from the new parent: q->p in the source tree, p->q in the sink.
     const int32_t c = kSource ? first.cap[dir ^ 1] : n.cap[dir];
     if (c <= 0) continue;
     // Walk up from q: does it reach the terminal without passing through an orphan?
     uint32_t d = 0;
     bool valid = false;
+    const uint16_t now = static_cast<uint16_t>(time_);
     for (int32_t j = q;;) {
       Node& m = nodes_[j];
-      if (m.ts == time_) {
+      if (m.ts == now) {
         d += m.dist;
         valid = true;
         break;
       }
       ++d;
-      if (m.parent == kTerminal) {
-        m.ts = time_;
+      const uint8_t mp = ParentOf(m);
+      if (mp == kTerminal) {
+        m.ts = now;
         m.dist = 1;
         valid = true;
         break;
       }
-      if (m.parent == kOrphan) break;
-      j += offset_[m.parent];
+      if (mp == kOrphan) break;
+      j += offset_[mp];
     }
     if (!valid) continue;
     if (d < best_dist) {
@@ -229,18 +233,18 @@ void GridMaxflow::Adopt(int32_t p) {
       best_dir = dir;
     }
     // Record the verified distances along the path so later walks stop early.
-    for (int32_t j = q; nodes_[j].ts != time_;) {
+    for (int32_t j = q; nodes_[j].ts != now;) {
       Node& m = nodes_[j];
-      m.ts = time_;
-      m.dist = static_cast<uint16_t>(d > 0xffff ? 0xffff : d);
+      m.ts = now;
+      m.dist = static_cast<uint8_t>(d > 0xff ? 0xff : d);
       --d;
-      j += offset_[m.parent];
+      j += offset_[ParentOf(m)];
     }
   }
   if (best_dir >= 0) {
-    n.parent = static_cast<uint8_t>(best_dir);
-    n.ts = time_;
-    n.dist = static_cast<uint16_t>(best_dist + 1 > 0xffff ? 0xffff : best_dist + 1);
+    SetParent(n, static_cast<uint8_t>(best_dir));
+    n.ts = static_cast<uint16_t>(time_);
+    n.dist = static_cast<uint8_t>(best_dist + 1 > 0xff ? 0xff : best_dist + 1);
     return;
   }
   // No parent: p leaves its tree. Neighbours that could feed it become active again, and its
@@ -248,12 +252,12 @@ void GridMaxflow::Adopt(int32_t p) {
   for (int dir = 0; dir < 4; ++dir) {
     const int32_t q = p + offset_[dir];
     Node& m = nodes_[q];
-    if (m.tree != tree) continue;
+    if (TreeOf(m) != tree) continue;
     const int32_t c = kSource ? m.cap[dir ^ 1] : n.cap[dir];
     if (c > 0) Activate(q);
-    if (m.parent == (dir ^ 1)) PushOrphan(q);
+    if (ParentOf(m) == (dir ^ 1)) PushOrphan(q);
   }
-  n.tree = kFree;
+  n.bits = static_cast<uint8_t>(n.bits & ~0x18);
 }
 
 namespace {
@@ -388,8 +392,8 @@ struct GridMaxflowRows {
   const int32_t* down_tcap;
 };
 
-// Node words as InitRow writes them: cap[4], then tcap, queued, ts and (little-endian) dist,
-// parent, tree in one word.
+// Node words as InitRow writes them (little-endian): the arcs right and left, down and up, as
+// two words of two 16-bit halves, then tcap, then ts, dist and bits in one word.
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__);
 
 namespace {
@@ -400,8 +404,9 @@ __attribute__((always_inline)) inline void LoadTo(V* v, const int32_t* p) {
   memcpy(v, p, sizeof(V));
 }
 
-// Lanes x.. of a row's nodes: their caps (right, left, down, up), balance, queued flag and last
-// word. V holds int32 lanes, U the same as uint32.
+// Lanes x.. of a row's nodes: their caps (right, left, down, up; then right | left << 16 in
+// right and down | up << 16 in down), balance, queued flag and last word. V holds int32 lanes,
+// U the same as uint32.
 template <typename V, typename U>
 struct NodeLanes {
   V right, left, down, up, tcap, queued, last;
@@ -435,9 +440,13 @@ __attribute__((always_inline)) inline void ComputeLanes(const GridMaxflowRows& i
                        ((0u - U(flow_out)) & ~td) | ((0u - U(up_down)) & ~tu);
   n->queued = V((((0u - t) & source_grows) | (t & sink_grows)) >> 31);
   const V source = n->tcap > 0, sink = n->tcap < 0;
-  // dist 1; parent kTerminal (4) on a root, else kOrphan (5); tree 1 or 2 on a root, else 0.
-  constexpr int32_t kOrphanWord = 1 | (5 << 16), kSourceWord = 1 << 24, kSinkWord = 2 << 24;
-  n->last = kOrphanWord + ((source | sink) << 16) + ((source & kSourceWord) | (sink & kSinkWord));
+  // ts 0, dist 1; parent kTerminal (4) on a root, else kOrphan (5); tree 1 or 2 on a root,
+  // else 0; the queued bit.
+  constexpr int32_t kOrphanWord = (1 << 16) | (5 << 24), kSourceWord = 1 << 27, kSinkWord = 2 << 27;
+  n->last = kOrphanWord + ((source | sink) << 24) + ((source & kSourceWord) | (sink & kSinkWord)) +
+            (n->queued << 29);
+  n->right = n->right | (n->left << 16);
+  n->down = n->down | (n->up << 16);
 }
 
 typedef int32_t Lanes4 __attribute__((vector_size(16)));
@@ -447,26 +456,19 @@ typedef uint32_t ULanes4 __attribute__((vector_size(16)));
 // appended to queue[*count] (index base + x).
 int32_t InitLanes4(const GridMaxflowRows& in, uint8_t* row, int32_t x, int32_t x1, int32_t base,
                    int32_t* queue, int32_t* count) {
-  const Lanes4 zero = {0, 0, 0, 0};
   for (; x + 4 <= x1; x += 4) {
     NodeLanes<Lanes4, ULanes4> n;
     ComputeLanes(in, x, &n);
-    // Transposed to nodes: (right, left, down, up) and (tcap, queued, ts = 0, last) per node.
-    const Lanes4 a0 = __builtin_shufflevector(n.right, n.left, 0, 4, 1, 5);
-    const Lanes4 a1 = __builtin_shufflevector(n.right, n.left, 2, 6, 3, 7);
-    const Lanes4 b0 = __builtin_shufflevector(n.down, n.up, 0, 4, 1, 5);
-    const Lanes4 b1 = __builtin_shufflevector(n.down, n.up, 2, 6, 3, 7);
-    const Lanes4 c0 = __builtin_shufflevector(n.tcap, n.queued, 0, 4, 1, 5);
-    const Lanes4 c1 = __builtin_shufflevector(n.tcap, n.queued, 2, 6, 3, 7);
-    const Lanes4 d0 = __builtin_shufflevector(zero, n.last, 0, 4, 1, 5);
-    const Lanes4 d1 = __builtin_shufflevector(zero, n.last, 2, 6, 3, 7);
-    const Lanes4 words[8] = {
-        __builtin_shufflevector(a0, b0, 0, 1, 4, 5), __builtin_shufflevector(c0, d0, 0, 1, 4, 5),
-        __builtin_shufflevector(a0, b0, 2, 3, 6, 7), __builtin_shufflevector(c0, d0, 2, 3, 6, 7),
-        __builtin_shufflevector(a1, b1, 0, 1, 4, 5), __builtin_shufflevector(c1, d1, 0, 1, 4, 5),
-        __builtin_shufflevector(a1, b1, 2, 3, 6, 7), __builtin_shufflevector(c1, d1, 2, 3, 6, 7)};
-    uint8_t* const out = row + 32 * static_cast<ptrdiff_t>(x);
-    for (int k = 0; k < 8; ++k) memcpy(out + 16 * k, &words[k], sizeof(Lanes4));
+    // Transposed to nodes: (right | left, down | up, tcap, last) per node.
+    const Lanes4 t0 = __builtin_shufflevector(n.right, n.down, 0, 4, 1, 5);
+    const Lanes4 t1 = __builtin_shufflevector(n.right, n.down, 2, 6, 3, 7);
+    const Lanes4 t2 = __builtin_shufflevector(n.tcap, n.last, 0, 4, 1, 5);
+    const Lanes4 t3 = __builtin_shufflevector(n.tcap, n.last, 2, 6, 3, 7);
+    const Lanes4 words[4] = {
+        __builtin_shufflevector(t0, t2, 0, 1, 4, 5), __builtin_shufflevector(t0, t2, 2, 3, 6, 7),
+        __builtin_shufflevector(t1, t3, 0, 1, 4, 5), __builtin_shufflevector(t1, t3, 2, 3, 6, 7)};
+    uint8_t* const out = row + 16 * static_cast<ptrdiff_t>(x);
+    for (int k = 0; k < 4; ++k) memcpy(out + 16 * k, &words[k], sizeof(Lanes4));
     const Lanes4 any = n.queued | __builtin_shufflevector(n.queued, n.queued, 2, 3, 0, 1);
     if ((any[0] | any[1]) != 0) {
       for (int32_t i = 0; i < 4; ++i) {
@@ -487,37 +489,19 @@ __attribute__((target("avx2"), noinline)) int32_t InitLanes8(const GridMaxflowRo
                                                              uint8_t* row, int32_t x, int32_t x1,
                                                              int32_t base, int32_t* queue,
                                                              int32_t* count) {
-  const Lanes8 zero = {};
   for (; x + 8 <= x1; x += 8) {
     NodeLanes<Lanes8, ULanes8> n;
     ComputeLanes(in, x, &n);
-    // Within each 128-bit half as InitLanes4 (nodes 0-3 and 4-7 side by side), then each
-    // node's two halves joined.
-    const Lanes8 a0 = __builtin_shufflevector(n.right, n.left, 0, 8, 1, 9, 4, 12, 5, 13);
-    const Lanes8 a1 = __builtin_shufflevector(n.right, n.left, 2, 10, 3, 11, 6, 14, 7, 15);
-    const Lanes8 b0 = __builtin_shufflevector(n.down, n.up, 0, 8, 1, 9, 4, 12, 5, 13);
-    const Lanes8 b1 = __builtin_shufflevector(n.down, n.up, 2, 10, 3, 11, 6, 14, 7, 15);
-    const Lanes8 c0 = __builtin_shufflevector(n.tcap, n.queued, 0, 8, 1, 9, 4, 12, 5, 13);
-    const Lanes8 c1 = __builtin_shufflevector(n.tcap, n.queued, 2, 10, 3, 11, 6, 14, 7, 15);
-    const Lanes8 d0 = __builtin_shufflevector(zero, n.last, 0, 8, 1, 9, 4, 12, 5, 13);
-    const Lanes8 d1 = __builtin_shufflevector(zero, n.last, 2, 10, 3, 11, 6, 14, 7, 15);
-    const Lanes8 caps[4] = {__builtin_shufflevector(a0, b0, 0, 1, 8, 9, 4, 5, 12, 13),
-                            __builtin_shufflevector(a0, b0, 2, 3, 10, 11, 6, 7, 14, 15),
-                            __builtin_shufflevector(a1, b1, 0, 1, 8, 9, 4, 5, 12, 13),
-                            __builtin_shufflevector(a1, b1, 2, 3, 10, 11, 6, 7, 14, 15)};
-    const Lanes8 rest[4] = {__builtin_shufflevector(c0, d0, 0, 1, 8, 9, 4, 5, 12, 13),
-                            __builtin_shufflevector(c0, d0, 2, 3, 10, 11, 6, 7, 14, 15),
-                            __builtin_shufflevector(c1, d1, 0, 1, 8, 9, 4, 5, 12, 13),
-                            __builtin_shufflevector(c1, d1, 2, 3, 10, 11, 6, 7, 14, 15)};
-    uint8_t* const out = row + 32 * static_cast<ptrdiff_t>(x);
-    for (int k = 0; k < 4; ++k) {
-      const Lanes8 low =
-          __builtin_shufflevector(caps[k], rest[k], 0, 1, 2, 3, 8, 9, 10, 11);  // node k
-      const Lanes8 high =
-          __builtin_shufflevector(caps[k], rest[k], 4, 5, 6, 7, 12, 13, 14, 15);  // node k + 4
-      memcpy(out + 32 * k, &low, sizeof(Lanes8));
-      memcpy(out + 32 * (k + 4), &high, sizeof(Lanes8));
-    }
+    const Lanes8 t0 = __builtin_shufflevector(n.right, n.down, 0, 8, 1, 9, 4, 12, 5, 13);
+    const Lanes8 t1 = __builtin_shufflevector(n.right, n.down, 2, 10, 3, 11, 6, 14, 7, 15);
+    const Lanes8 t2 = __builtin_shufflevector(n.tcap, n.last, 0, 8, 1, 9, 4, 12, 5, 13);
+    const Lanes8 t3 = __builtin_shufflevector(n.tcap, n.last, 2, 10, 3, 11, 6, 14, 7, 15);
+    const Lanes8 pairs[4] = {__builtin_shufflevector(t0, t2, 0, 1, 8, 9, 2, 3, 10, 11),
+                             __builtin_shufflevector(t1, t3, 0, 1, 8, 9, 2, 3, 10, 11),
+                             __builtin_shufflevector(t0, t2, 4, 5, 12, 13, 6, 7, 14, 15),
+                             __builtin_shufflevector(t1, t3, 4, 5, 12, 13, 6, 7, 14, 15)};
+    uint8_t* const out = row + 16 * static_cast<ptrdiff_t>(x);
+    for (int k = 0; k < 4; ++k) memcpy(out + 32 * k, &pairs[k], sizeof(Lanes8));
     if (!_mm256_testz_si256(__m256i(n.queued), __m256i(n.queued))) {
       for (int32_t i = 0; i < 8; ++i) {
         if (n.queued[i] != 0) queue[(*count)++] = base + x + i;
@@ -536,10 +520,9 @@ __attribute__((target("avx2"), noinline)) int32_t InitLanes8(const GridMaxflowRo
 // a neighbour leaves their tree (Adopt activates them). Eight or four nodes at a time, the first
 // live node alone (its left neighbour is not live: no arc carries anything there).
 void GridMaxflow::InitRow(int32_t y, const GridMaxflowRows& in) {
-  static_assert(sizeof(Node) == 8 * sizeof(int32_t) && offsetof(Node, tcap) == 16 &&
-                offsetof(Node, queued) == 20 && offsetof(Node, ts) == 24 &&
-                offsetof(Node, dist) == 28 && offsetof(Node, parent) == 30 &&
-                offsetof(Node, tree) == 31);
+  static_assert(sizeof(Node) == 4 * sizeof(int32_t) && offsetof(Node, tcap) == 8 &&
+                offsetof(Node, ts) == 12 && offsetof(Node, dist) == 14 &&
+                offsetof(Node, bits) == 15);
   const int32_t w = width_;
   const int32_t x0 = live_[2 * y], x1 = live_[2 * y + 1];
   Node* const row = nodes_ + y * w;
@@ -558,11 +541,11 @@ void GridMaxflow::InitRow(int32_t y, const GridMaxflowRows& in) {
   hi = hi < w ? hi : w;
   // Elsewhere only what InSource reads: such a node has no arc and no balance, so it is on the
   // sink side.
-  uint8_t* const tree = reinterpret_cast<uint8_t*>(row) + offsetof(Node, tree);
+  uint8_t* const tree = reinterpret_cast<uint8_t*>(row) + offsetof(Node, bits);
 #pragma GCC unroll 4
-  for (int32_t x = 0; x < lo; ++x) tree[32 * x] = kFree;
+  for (int32_t x = 0; x < lo; ++x) tree[16 * x] = kOrphan;
 #pragma GCC unroll 4
-  for (int32_t x = hi; x < w; ++x) tree[32 * x] = kFree;
+  for (int32_t x = hi; x < w; ++x) tree[16 * x] = kOrphan;
   if (x1 <= x0) {
     for (int32_t x = lo; x < hi; ++x) row[x] = Node{};
     return;
@@ -574,33 +557,30 @@ void GridMaxflow::InitRow(int32_t y, const GridMaxflowRows& in) {
     Node& n = row[x];
     const int32_t t = in.tcap[x], right = in.cap_right[x], down = in.cap_down[x];
     const int32_t up = in.flow_in[x];
-    n.cap[kRight] = right;
-    n.cap[kLeft] = left_flow;
-    n.cap[kDown] = down;
-    n.cap[kUp] = up;
+    n.cap[kRight] = static_cast<uint16_t>(right);
+    n.cap[kLeft] = static_cast<uint16_t>(left_flow);
+    n.cap[kDown] = static_cast<uint16_t>(down);
+    n.cap[kUp] = static_cast<uint16_t>(up);
     n.tcap = t;
-    n.queued = 0;
     n.ts = 0;
     n.dist = 1;
     if (t == 0) {
-      n.tree = kFree;
-      n.parent = kOrphan;
+      n.bits = kOrphan;
       return;
     }
-    n.parent = kTerminal;
     bool grows;
     if (t > 0) {
-      n.tree = kSourceTree;
+      n.bits = kTerminal | (kSourceTree << 3);
       grows = (right > 0 && in.tcap[x + 1] <= 0) || (left_flow > 0 && left_tcap <= 0) ||
               (down > 0 && in.down_tcap[x] <= 0) || (up > 0 && in.up_tcap[x] <= 0);
     } else {
-      n.tree = kSinkTree;
+      n.bits = kTerminal | (kSinkTree << 3);
       grows = (in.flow_right[x] > 0 && in.tcap[x + 1] >= 0) || (left_right > 0 && left_tcap >= 0) ||
               (in.flow_out[x] > 0 && in.down_tcap[x] >= 0) ||
               (in.up_cap_down[x] > 0 && in.up_tcap[x] >= 0);
     }
     if (grows) {
-      n.queued = 1;
+      n.bits |= kQueuedBit;
       queue_[count++] = y * w + x;  // the queue is empty before the search: no wrap
     }
   };
@@ -621,11 +601,11 @@ void GridMaxflow::InitNodeRow(int32_t y) {
   Node* row = nodes_ + y * w;
   for (int32_t x = 0; x < w; ++x) {
     Node& n = row[x];
-    n.queued = 0;
     n.ts = 0;
     n.dist = 1;
-    n.parent = n.tcap == 0 ? kOrphan : kTerminal;
-    n.tree = n.tcap == 0 ? kFree : (n.tcap > 0 ? kSourceTree : kSinkTree);
+    n.bits = n.tcap == 0
+                 ? kOrphan
+                 : static_cast<uint8_t>(kTerminal | ((n.tcap > 0 ? kSourceTree : kSinkTree) << 3));
     if (n.tcap != 0) Activate(y * w + x);
   }
 }
@@ -767,13 +747,13 @@ bool GridMaxflow::Grow(int32_t p, int32_t* s_node, int* s_dir) {
     Node& m = nodes_[q];
     const int32_t c = kSource ? n.cap[dir] : m.cap[dir ^ 1];
     if (c <= 0) continue;
-    if (m.tree == kFree) {
-      m.tree = tree;
-      m.parent = static_cast<uint8_t>(dir ^ 1);
+    const uint8_t mt = TreeOf(m);
+    if (mt == kFree) {
+      m.bits = static_cast<uint8_t>((m.bits & kQueuedBit) | (tree << 3) | (dir ^ 1));
       m.ts = n.ts;
-      m.dist = static_cast<uint16_t>(n.dist == 0xffff ? 0xffff : n.dist + 1);
+      m.dist = static_cast<uint8_t>(n.dist == 0xff ? 0xff : n.dist + 1);
       Activate(q);
-    } else if (m.tree != tree) {
+    } else if (mt != tree) {
       *s_node = kSource ? p : q;
       *s_dir = kSource ? dir : (dir ^ 1);
       return true;
@@ -787,28 +767,32 @@ bool GridMaxflow::Grow(int32_t p, int32_t* s_node, int* s_dir) {
 int64_t GridMaxflow::Solve() {
   Prepare();
   orphan_head_ = orphan_count_ = 0;
-  time_ = 0;
+  time_ = first_time_;
 
   int32_t current = kNotActive;
   for (;;) {
-    if (current == kNotActive || nodes_[current].tree == kFree) current = NextActive();
+    if (current == kNotActive || TreeOf(nodes_[current]) == kFree) current = NextActive();
     if (current == kNotActive) break;
     const int32_t p = current;
     int32_t touch_s = 0;
     int touch_dir = 0;
-    const bool touched = nodes_[p].tree == kSourceTree ? Grow<true>(p, &touch_s, &touch_dir)
-                                                       : Grow<false>(p, &touch_s, &touch_dir);
+    const bool touched = TreeOf(nodes_[p]) == kSourceTree ? Grow<true>(p, &touch_s, &touch_dir)
+                                                          : Grow<false>(p, &touch_s, &touch_dir);
     if (!touched) {
       current = kNotActive;
       continue;
     }
-    ++time_;
+    if (++time_ == 0x10000) {
+      // The stamps are 16 bits: none may match a new time by chance.
+      for (int32_t i = 0; i < count_; ++i) nodes_[i].ts = 0;
+      time_ = 1;
+    }
     Augment(touch_s, touch_dir);
     while (orphan_count_ > 0) {
       const int32_t o = orphans_[orphan_head_];
       orphan_head_ = orphan_head_ + 1 == max_nodes_ ? 0 : orphan_head_ + 1;
       --orphan_count_;
-      if (nodes_[o].tree == kSourceTree) {
+      if (TreeOf(nodes_[o]) == kSourceTree) {
         Adopt<true>(o);
       } else {
         Adopt<false>(o);

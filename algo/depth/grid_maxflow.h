@@ -5,8 +5,10 @@
 // (the last node of a row and the first of the next see each other through them), let every
 // visit look at all four neighbours without a boundary test.
 //
-// Capacities are int32 and must stay within kMaxCapacity so that the residual of an arc (its own
-// capacity plus its sister's) and a node's terminal balance cannot overflow; flow totals are int64.
+// A node is 16 bytes, so that a cache line holds four and the search's neighbour visits miss
+// half as often: arcs are 16 bits, and an arc's capacity plus its sister's must stay within
+// kMaxArc (a residual never exceeds that sum); terminal balances are int32 within kMaxCapacity;
+// flow totals are int64.
 #pragma once
 
 #include <cstddef>
@@ -22,6 +24,7 @@ struct GridMaxflowRows;  // what InitRow reads (grid_maxflow.cc)
 class GridMaxflow {
  public:
   static constexpr int32_t kMaxCapacity = 1 << 28;
+  static constexpr int32_t kMaxArc = 0xffff;
   // Arc directions; the sister of arc (p, d) is (neighbour(p, d), d ^ 1).
   enum Dir : uint8_t { kRight = 0, kLeft = 1, kDown = 2, kUp = 3 };
 
@@ -70,7 +73,7 @@ class GridMaxflow {
   int64_t Solve();
 
   // After Solve: true when p is on the source side of the minimum cut.
-  bool InSource(int32_t p) const { return nodes_[p].tree == kSourceTree; }
+  bool InSource(int32_t p) const { return TreeOf(nodes_[p]) == kSourceTree; }
 
   // Node storage that graphs of at most width x height nodes never touch, lent to the caller
   // until a larger graph begins: its size in bytes, and where it starts (nullptr when none).
@@ -86,15 +89,20 @@ class GridMaxflow {
   static constexpr int32_t kNotActive = -1;
 
   struct Node {
-    int32_t cap[4] = {};       // residual capacity of the arc to each neighbour
-    int32_t tcap = 0;          // residual terminal capacity: > 0 from the source, < 0 to the sink
-    int32_t queued = 0;        // 1 while in the active queue
-    int32_t ts = 0;            // time stamp of the last verified distance to a terminal
-    uint16_t dist = 1;         // distance to the terminal (saturating; only a heuristic)
-    uint8_t parent = kOrphan;  // a Dir, kTerminal or kOrphan
-    uint8_t tree = kFree;      // kFree, kSourceTree or kSinkTree
+    uint16_t cap[4] = {};  // residual capacity of the arc to each neighbour
+    int32_t tcap = 0;      // residual terminal capacity: > 0 from the source, < 0 to the sink
+    uint16_t ts = 0;       // time stamp of the last verified distance to a terminal
+    uint8_t dist = 1;      // distance to the terminal (saturating; only a heuristic)
+    uint8_t bits =
+        kOrphan;  // parent (bits 0-2: a Dir, kTerminal or kOrphan), tree (3-4), queued (5)
   };
-  static_assert(sizeof(Node) == 32);
+  static_assert(sizeof(Node) == 16);
+  static constexpr uint8_t kQueuedBit = 0x20;  // in bits: in the active queue
+  static uint8_t ParentOf(const Node& n) { return n.bits & 7; }
+  static uint8_t TreeOf(const Node& n) { return (n.bits >> 3) & 3; }
+  static void SetParent(Node& n, uint8_t parent) {
+    n.bits = static_cast<uint8_t>((n.bits & ~7) | parent);
+  }
 
   void Start(int32_t width, int32_t height);
   int32_t* StageRow(int32_t y) const {
@@ -124,11 +132,11 @@ class GridMaxflow {
   int32_t* queue_ = nullptr;
   int32_t* live_ = nullptr;  // per row, the columns x0, x1 Prepare looks at (RowDone)
   // Until Prepare, a graph's nodes are staged as 4 dense rows of width int32 per node row:
-  // balance, cap right, cap down, and the column pass's demand (then the flow it sent down).
-  // Their block lies in the upper half of the graph's own node storage, from byte
-  // 16 * width * height + 64 * width (Begin's height) to the end of its padding row: node row y
-  // ends at byte 32 * width * (y + 2), at or before the start of staged row y - 1, the first one
-  // Prepare still reads when it writes node row y. Spare is not touched.
+  // balance, cap right, cap down, and the column pass's demand (then the flow it sent down), as
+  // many bytes as its node row. They lie in the graph's own node storage three rows on, from
+  // byte 48 * width: node row y ends at byte 16 * width * (y + 2), the start of staged row
+  // y - 1, the first one Prepare still reads when it writes node row y. So a graph takes its
+  // nodes and three rows more; Spare starts after them.
   int32_t* stage_base_ = nullptr;
   int32_t* stage_ = nullptr;  // stage_base_ shifted so that stage_[p] is node p's balance
   // width_ again, in a type the staging stores cannot alias: SetNode's callers keep it in a
@@ -146,15 +154,16 @@ class GridMaxflow {
   int32_t queue_head_ = 0, queue_count_ = 0;
   int32_t orphan_head_ = 0, orphan_count_ = 0;
   int32_t time_ = 0;
+  int32_t first_time_ = 0;  // what time_ starts from (GridMaxflowProbe::StartTime)
   int64_t flow_ = 0;
 };
 
 // Graphs the depth stage never builds, for the solver's tests (tests/algo/depth/maxflow_test.cc):
-// arcs in both directions of a pair and terminal capacities on both sides of a node, set in any
-// order. Reset starts a graph of width x height nodes, all capacities 0; AddTerminal adds
-// source->p and p->sink (both >= 0, their common part routed at once and counted by Solve);
-// AddEdge adds to the arc p->q and its sister q->p, q the neighbour of p in direction `dir`
-// (inside the grid).
+// arcs in both directions of a pair (together within kMaxArc) and terminal capacities on both
+// sides of a node, set in any order. Reset starts a graph of width x height nodes, all capacities
+// 0; AddTerminal adds source->p and p->sink (both >= 0, their common part routed at once and
+// counted by Solve); AddEdge adds to the arc p->q and its sister q->p, q the neighbour of p in
+// direction `dir` (inside the grid).
 struct GridMaxflowProbe {
   static void Reset(GridMaxflow& mf, int32_t width, int32_t height);
   static void AddTerminal(GridMaxflow& mf, int32_t p, int32_t cap_source, int32_t cap_sink) {
@@ -163,13 +172,19 @@ struct GridMaxflowProbe {
   }
   static void AddEdge(GridMaxflow& mf, int32_t p, GridMaxflow::Dir dir, int32_t cap_pq,
                       int32_t cap_qp) {
-    mf.nodes_[p].cap[dir] += cap_pq;
-    mf.nodes_[p + mf.offset_[dir]].cap[dir ^ 1] += cap_qp;
+    uint16_t& pq = mf.nodes_[p].cap[dir];
+    uint16_t& qp = mf.nodes_[p + mf.offset_[dir]].cap[dir ^ 1];
+    pq = static_cast<uint16_t>(pq + cap_pq);
+    qp = static_cast<uint16_t>(qp + cap_qp);
   }
   // After Solve: the residual capacity of the arc from p in direction `dir`.
   static int32_t Residual(const GridMaxflow& mf, int32_t p, GridMaxflow::Dir dir) {
     return mf.nodes_[p].cap[dir];
   }
+  // The time stamp the next Solve starts from (0 in the product): near 0xffff, the stamps wrap
+  // within a small graph's search.
+  static void StartTime(GridMaxflow& mf, int32_t time) { mf.first_time_ = time; }
+  static int32_t Time(const GridMaxflow& mf) { return mf.time_; }
   // Whether the passes before the search may use their eight-lane copy (when the CPU has it):
   // off, they take the four-lane one, which must give the same nodes.
   static void UseEightLanes(GridMaxflow& mf, bool on) { mf.avx2_ = on && mf.cpu_avx2_; }
@@ -178,7 +193,7 @@ struct GridMaxflowProbe {
   static void Poison(GridMaxflow& mf, uint8_t byte) {
     memset(static_cast<void*>(mf.storage_), byte,
            sizeof(GridMaxflow::Node) *
-               (static_cast<size_t>(mf.max_nodes_) + 2 * static_cast<size_t>(mf.max_width_)));
+               (static_cast<size_t>(mf.max_nodes_) + 3 * static_cast<size_t>(mf.max_width_)));
   }
 };
 

@@ -42,7 +42,7 @@ const char kUsage[] =
     "  --disparity MIN,MAX    label range in px per view step, signed for a converged rig\n"
     "                         (rectified default 0 and (N-1)/4: quarter-pixel labels; auto:\n"
     "                         from the tracked points)\n"
-    "  --smoothness W         smoothness weight, 0..4096 (default %d)\n"
+    "  --smoothness W         smoothness weight, 0..%d (default %d)\n"
     "  --cycles N             expansion cycle cap, 0..32 (default %d)\n"
     "  --subpixel             write the sub-label refinement the renderer uses (default: the\n"
     "                         labels' disparities, which score best against whole-pixel truth)\n";
@@ -64,11 +64,17 @@ enum Opt {
   kDisparity
 };
 
+// The largest weight the stage takes at the default truncation (DepthStage::Validate).
+int32_t MaxSmoothness() {
+  const DepthConfig defaults;
+  return GridMaxflow::kMaxArc / (4 * defaults.smooth_trunc);
+}
+
 int Usage(const std::string& problem) { return UsageError("depth", problem); }
 
 int Help() {
   const DepthConfig defaults;
-  printf(kUsage, defaults.smooth_weight, defaults.max_cycles);
+  printf(kUsage, MaxSmoothness(), defaults.smooth_weight, defaults.max_cycles);
   return 0;
 }
 
@@ -187,7 +193,7 @@ int DepthCommand(int argc, char** argv) {
         ok = ParseWholeNumber(arg, 0, DepthConfig::kMaxViews - 1, &ref, &error);
         break;
       case kSmoothness:
-        ok = ParseWholeNumber(arg, 0, 4096, &c.smooth_weight, &error);
+        ok = ParseWholeNumber(arg, 0, MaxSmoothness(), &c.smooth_weight, &error);
         break;
       case kCycles:
         ok = ParseWholeNumber(arg, 0, 32, &c.max_cycles, &error);

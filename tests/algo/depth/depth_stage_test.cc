@@ -341,6 +341,13 @@ TEST(DepthStageTest, RefusesBadConfigurationsAndInputs) {
   bad = c;
   bad.smooth_weight = 100000;
   EXPECT_EQ(DepthStage::Validate(bad).code(), Code::kInvalidArgument);
+  // The solver's arcs are 16 bits: smoothness x truncation at most 16383.
+  bad = c;
+  bad.smooth_weight = 2048;
+  bad.smooth_trunc = 8;
+  EXPECT_EQ(DepthStage::Validate(bad).code(), Code::kInvalidArgument);
+  bad.smooth_weight = 2047;
+  EXPECT_TRUE(DepthStage::Validate(bad).ok());
   bad = c;
   bad.reference = 3;
   EXPECT_EQ(DepthStage::Validate(bad).code(), Code::kInvalidArgument);

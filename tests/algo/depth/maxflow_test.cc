@@ -19,17 +19,20 @@ struct Graph {
   std::vector<int32_t> right_fwd, right_bwd, down_fwd, down_bwd;
 };
 
+// Terminal capacities up to max_cap, arcs up to max_cap too but a pair's two within
+// GridMaxflow::kMaxArc.
 Graph RandomGraph(std::mt19937& rng, int32_t w, int32_t h, int32_t max_cap) {
   Graph g;
   g.w = w;
   g.h = h;
   const size_t n = static_cast<size_t>(w * h);
   std::uniform_int_distribution<int32_t> cap(0, max_cap);
+  std::uniform_int_distribution<int32_t> arc(0, std::min(max_cap, GridMaxflow::kMaxArc / 2));
   std::bernoulli_distribution zero(0.3);
-  auto draw = [&] { return zero(rng) ? 0 : cap(rng); };
   for (auto* v : {&g.source, &g.sink, &g.right_fwd, &g.right_bwd, &g.down_fwd, &g.down_bwd}) {
+    const bool terminal = v == &g.source || v == &g.sink;
     v->resize(n);
-    for (auto& c : *v) c = draw();
+    for (auto& c : *v) c = zero(rng) ? 0 : (terminal ? cap(rng) : arc(rng));
   }
   return g;
 }
@@ -454,6 +457,26 @@ TEST_F(MaxflowTest, LongWindingPathAgrees) {
       ASSERT_EQ(TextbookMaxflow(g), expected);
     }
   }
+}
+
+// The 16-bit time stamps wrap within a search that starts just below the wrap: no stale stamp
+// may pass for a fresh one.
+TEST_F(MaxflowTest, TimeStampsWrapWithinASearch) {
+  std::mt19937 rng(31);
+  std::uniform_int_distribution<int32_t> side(4, 24);
+  int64_t searches_over_wrap = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const int32_t w = side(rng), h = side(rng);
+    const Graph g = RandomGraph(rng, w, h, trial % 2 ? 40 : 3000);
+    GridMaxflowProbe::StartTime(mf_, 0xffff - trial % 8);
+    std::vector<bool> reachable;
+    const int64_t expected = TextbookMaxflow(g, &reachable);
+    ASSERT_EQ(Solve(g, mf_), expected) << "trial " << trial;
+    searches_over_wrap += GridMaxflowProbe::Time(mf_) < 0xffff - trial % 8;
+    for (int32_t p = 0; p < w * h; ++p) ASSERT_EQ(mf_.InSource(p), reachable[p]) << trial;
+  }
+  GridMaxflowProbe::StartTime(mf_, 0);
+  EXPECT_GT(searches_over_wrap, 100);  // most searches augment more than 8 paths
 }
 
 TEST_F(MaxflowTest, LargeCapacitiesDoNotOverflow) {
