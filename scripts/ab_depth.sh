@@ -1,7 +1,8 @@
 #!/bin/bash
 # The depth stage of this working tree against another revision's, one compute of each by turns
-# in one process (tests/bench/depth/ab/ab_main.cc): teddy and a synthetic handheld burst, each
-# side's median time, the median of the per-turn ratios and whether the maps are the same.
+# in one process (tests/bench/depth/ab/ab_main.cc): teddy and a synthetic handheld burst (plane
+# sweep and rectified shifts), each side's median time, the median of the per-turn ratios and
+# whether the maps are the same.
 #   scripts/ab_depth.sh REV [TURNS]      e.g. scripts/ab_depth.sh HEAD~1 150
 # Builds REV's algo/ in build/ab-ref (its symbols renamed by -Dlb=lbref) and ab_depth in
 # build/ab (Release). Run it on a quiet host; it asks for a real-time priority when allowed.
