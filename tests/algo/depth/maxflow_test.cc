@@ -19,20 +19,24 @@ struct Graph {
   std::vector<int32_t> right_fwd, right_bwd, down_fwd, down_bwd;
 };
 
-// Terminal capacities up to max_cap, arcs up to max_cap too but a pair's two within
-// GridMaxflow::kMaxArc.
+// Terminal capacities up to max_cap, arcs up to max_cap too but a pair's two together within
+// GridMaxflow::kMaxArc (the arc back takes what is left when the arc forth took more).
 Graph RandomGraph(std::mt19937& rng, int32_t w, int32_t h, int32_t max_cap) {
   Graph g;
   g.w = w;
   g.h = h;
   const size_t n = static_cast<size_t>(w * h);
   std::uniform_int_distribution<int32_t> cap(0, max_cap);
-  std::uniform_int_distribution<int32_t> arc(0, std::min(max_cap, GridMaxflow::kMaxArc / 2));
+  std::uniform_int_distribution<int32_t> arc(0, std::min(max_cap, GridMaxflow::kMaxArc));
   std::bernoulli_distribution zero(0.3);
   for (auto* v : {&g.source, &g.sink, &g.right_fwd, &g.right_bwd, &g.down_fwd, &g.down_bwd}) {
     const bool terminal = v == &g.source || v == &g.sink;
     v->resize(n);
     for (auto& c : *v) c = zero(rng) ? 0 : (terminal ? cap(rng) : arc(rng));
+  }
+  for (size_t i = 0; i < n; ++i) {
+    g.right_bwd[i] = std::min(g.right_bwd[i], GridMaxflow::kMaxArc - g.right_fwd[i]);
+    g.down_bwd[i] = std::min(g.down_bwd[i], GridMaxflow::kMaxArc - g.down_fwd[i]);
   }
   return g;
 }
