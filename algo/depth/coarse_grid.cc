@@ -84,6 +84,27 @@ void DepthStage::BlockCosts(int32_t label, const Rect& b, uint16_t* out, uint16_
   }
 }
 
+DepthStage::CoarseRoom DepthStage::CoarseLayout(int32_t stripes) const {
+  const int32_t w = config_.width, h = config_.height;
+  const size_t n = static_cast<size_t>((w + 1) / 2) * ((h + 1) / 2);  // the coarse grid
+  const size_t coarse_labels =
+      static_cast<size_t>((config_.labels + config_.coarse_step - 1) / config_.coarse_step);
+  CoarseRoom r;
+  r.block_bytes = sizeof(uint16_t) * n * coarse_labels;
+  r.rings_at = Arena::RoundUp(r.block_bytes);
+  r.rings_end = r.rings_at + sizeof(uint16_t) * data_.CarriedRingSize() * coarse_labels *
+                                 static_cast<size_t>(stripes);
+  r.winners_at = Arena::RoundUp(r.rings_end);
+  r.labels_at = Arena::RoundUp(r.winners_at + sizeof(uint16_t) * static_cast<size_t>(w) * h);
+  r.end = r.labels_at + n;
+  return r;
+}
+
+int32_t DepthStage::CoarseStripes(int32_t workers) const {
+  const int32_t band = Max(1, kBandPixels / config_.width / 2);  // block rows
+  return Clamp(workers, 1, Max(1, (config_.height + 1) / 2 / band));
+}
+
 void DepthStage::CoarseWinnerTakeAll() {
   Grid& g = coarse_;
   const int32_t n = g.width * g.height;
@@ -91,36 +112,27 @@ void DepthStage::CoarseWinnerTakeAll() {
     g.cost[p] = 0xffff;
     g.labels[p] = 0;
   }
-  // The moves would compute these costs again, label by label: kept when there is room.
+  // The moves would compute these costs again, label by label: kept when there is room (Carve
+  // makes it).
   const int32_t coarse_labels = (config_.labels + config_.coarse_step - 1) / config_.coarse_step;
   size_t spare = 0;
   uint8_t* room = maxflow_.Spare(g.width, g.height, &spare);
-  const size_t block_bytes = sizeof(uint16_t) * static_cast<size_t>(n) * coarse_labels;
-  block_costs_ = spare >= block_bytes ? reinterpret_cast<uint16_t*>(room) : nullptr;
+  block_costs_ = spare >= CoarseLayout(1).block_bytes ? reinterpret_cast<uint16_t*>(room) : nullptr;
   // Stripes of block rows, one per worker, each going down in bands of `band` block rows with
   // its own ring of 3-sums per label carried from band to band (after the block costs, when
   // there is room; with fewer stripes if that is what fits).
-  const int32_t band = Max(1, kBandPixels / config_.width / 2);  // block rows
-  const size_t ring_bytes = sizeof(uint16_t) * data_.CarriedRingSize();
-  const size_t rings_at = Arena::RoundUp(block_bytes);
-  int32_t stripes =
-      striped_winners_ ? Clamp(data_.runner().workers(), 1, Max(1, g.height / band)) : 1;
-  while (stripes > 1 && spare < rings_at + ring_bytes * coarse_labels * stripes) --stripes;
-  const size_t rings_end = rings_at + ring_bytes * coarse_labels * stripes;
-  uint16_t* rings = block_costs_ != nullptr && spare >= rings_end
-                        ? reinterpret_cast<uint16_t*>(room + rings_at)
+  int32_t stripes = striped_winners_ ? CoarseStripes(data_.runner().workers()) : 1;
+  while (stripes > 1 && spare < CoarseLayout(stripes).rings_end) --stripes;
+  const CoarseRoom at = CoarseLayout(stripes);
+  uint16_t* rings = block_costs_ != nullptr && spare >= at.rings_end
+                        ? reinterpret_cast<uint16_t*>(room + at.rings_at)
                         : nullptr;
   // The winners' pixel D and labels, after those: the coarse moves leave most blocks their
   // label (89 % for the plane sweep on a handheld burst, 90 % on teddy, 58 % for the rectified
   // shifts on that burst), so the hand-over finds their D here.
-  const int32_t w = fine_.width, h = fine_.height;
-  const size_t winners_at = Arena::RoundUp(rings_end);
-  const size_t labels_at =
-      Arena::RoundUp(winners_at + sizeof(uint16_t) * static_cast<size_t>(w) * h);
-  const bool winners =
-      keep_winners_ && rings != nullptr && spare >= labels_at + static_cast<size_t>(n);
-  winner_costs_ = winners ? reinterpret_cast<uint16_t*>(room + winners_at) : nullptr;
-  winner_labels_ = winners ? room + labels_at : nullptr;
+  const bool winners = keep_winners_ && rings != nullptr && spare >= at.end;
+  winner_costs_ = winners ? reinterpret_cast<uint16_t*>(room + at.winners_at) : nullptr;
+  winner_labels_ = winners ? room + at.labels_at : nullptr;
   winner_stripes_ = static_cast<int16_t>(rings != nullptr ? stripes : 0);
   if (rings != nullptr) {
     // Each stripe's blocks, pixels and rings are its own: the same bits for any number.
@@ -132,6 +144,7 @@ void DepthStage::CoarseWinnerTakeAll() {
     // Band by band, every label in turn: the views' rows of a band stay in cache from one label
     // to the next (the data term streams every view once per call). A band costs the data
     // term two more rows, so bands are not too thin either. The labels come in order per block.
+    const int32_t band = Max(1, kBandPixels / config_.width / 2);  // block rows
     for (int32_t by0 = 0; by0 < g.height; by0 += band) {
       const Rect rows{0, g.width, by0, Min(by0 + band, g.height)};
       for (int32_t label = 0; label < config_.labels; label += config_.coarse_step) {

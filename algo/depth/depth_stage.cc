@@ -112,7 +112,11 @@ Status DepthStage::Carve(Arena& arena) {
   const int32_t w = config_.width, h = config_.height;
   const size_t n = static_cast<size_t>(w) * h;
   data_.Carve(arena, w, h, config_.views, config_.workers);
-  maxflow_.Carve(arena, w, h);
+  // The coarse pass's costs, rings and winners ride in the solver's spare (CoarseLayout): room
+  // for them whatever the labels and workers, or the pass computes the costs again per move.
+  const bool coarse = config_.coarse_step > 1 && config_.max_cycles > 0 && config_.coarse_blocks;
+  const size_t room = coarse ? CoarseLayout(CoarseStripes(config_.workers)).end : 0;
+  maxflow_.Carve(arena, w, h, room, (w + 1) / 2, (h + 1) / 2);
   CarveGrid(arena, fine_, w, h, true);
   move_rows_ = arena.Allocate<int32_t>(11 * static_cast<size_t>(w));
   keep_row_ = arena.Allocate<uint8_t>(static_cast<size_t>(w));

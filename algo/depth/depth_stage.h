@@ -192,6 +192,15 @@ class DepthStage {
   void BlockCosts(int32_t label, const Rect& blocks, uint16_t* out, uint16_t* ring = nullptr,
                   bool continues = false, int32_t worker = 0);
   void CoarseWinnerTakeAll();
+  // Where the coarse pass keeps, in the max-flow's spare, each coarse label's block D, `stripes`
+  // winner-take-all rings per coarse label, and the winners' pixel D and labels (byte offsets;
+  // end: all of it). Carve makes that much room for the most stripes the workers can take.
+  struct CoarseRoom {
+    size_t block_bytes, rings_at, rings_end, winners_at, labels_at, end;
+  };
+  CoarseRoom CoarseLayout(int32_t stripes) const;
+  // The most stripes of block rows the winner-take-all may take with `workers` workers.
+  int32_t CoarseStripes(int32_t workers) const;
   void KeepWinners(const Rect& blocks, const uint16_t* block_costs);
   // The winner-take-all over the block rows of `stripe`, going down them in bands with its
   // own rings (one per coarse label, carried from band to band); `worker`: whose data term

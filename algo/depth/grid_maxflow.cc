@@ -22,11 +22,17 @@
 
 namespace lb {
 
-void GridMaxflow::Carve(Arena& arena, int32_t max_width, int32_t max_height) {
+void GridMaxflow::Carve(Arena& arena, int32_t max_width, int32_t max_height, size_t spare_bytes,
+                        int32_t spare_width, int32_t spare_height) {
   max_nodes_ = max_width * max_height;
   max_width_ = max_width;
-  storage_ =
-      arena.Allocate<Node>(static_cast<size_t>(max_nodes_) + 3 * static_cast<size_t>(max_width));
+  // A graph takes its nodes and three rows (Begin: the padding rows and the staged rows' lead).
+  const size_t own = static_cast<size_t>(max_nodes_) + 3 * static_cast<size_t>(max_width);
+  const size_t lent = static_cast<size_t>(spare_width) * spare_height +
+                      3 * static_cast<size_t>(spare_width) +
+                      (spare_bytes + sizeof(Node) - 1) / sizeof(Node);
+  storage_nodes_ = spare_bytes > 0 && lent > own ? lent : own;
+  storage_ = arena.Allocate<Node>(storage_nodes_);
   orphans_ = arena.Allocate<int32_t>(static_cast<size_t>(max_nodes_));
   queue_ = arena.Allocate<int32_t>(static_cast<size_t>(max_nodes_));
   live_ = arena.Allocate<int32_t>(2 * static_cast<size_t>(max_height));
@@ -38,7 +44,7 @@ void GridMaxflow::Carve(Arena& arena, int32_t max_width, int32_t max_height) {
 
 uint8_t* GridMaxflow::Spare(int32_t width, int32_t height, size_t* bytes) const {
   const int64_t used = int64_t{width} * height + 3 * int64_t{width};
-  const int64_t total = int64_t{max_nodes_} + 3 * int64_t{max_width_};
+  const int64_t total = static_cast<int64_t>(storage_nodes_);
   *bytes =
       storage_ != nullptr && used < total ? sizeof(Node) * static_cast<size_t>(total - used) : 0;
   return *bytes > 0 ? reinterpret_cast<uint8_t*>(storage_ + used) : nullptr;

@@ -28,8 +28,10 @@ class GridMaxflow {
   // Arc directions; the sister of arc (p, d) is (neighbour(p, d), d ^ 1).
   enum Dir : uint8_t { kRight = 0, kLeft = 1, kDown = 2, kUp = 3 };
 
-  // Carves node storage for grids of up to max_width x max_height nodes.
-  void Carve(Arena& arena, int32_t max_width, int32_t max_height);
+  // Carves node storage for grids of up to max_width x max_height nodes, and enough more that
+  // graphs of at most spare_width x spare_height nodes leave spare_bytes of it Spare.
+  void Carve(Arena& arena, int32_t max_width, int32_t max_height, size_t spare_bytes = 0,
+             int32_t spare_width = 0, int32_t spare_height = 0);
 
   // Starts a new graph of width x height nodes whose every node the caller then sets once with
   // SetNode, row by row, calling RowDone after each row (no clearing pass).
@@ -149,6 +151,7 @@ class GridMaxflow {
   static constexpr int32_t kPath = 255;
   int32_t path_[2 * (kPath + 1)] = {};
   int32_t max_nodes_ = 0, max_width_ = 0;
+  size_t storage_nodes_ = 0;  // what Carve allocated, in nodes
   int32_t width_ = 0, height_ = 0, count_ = 0;
   int32_t offset_[4] = {};  // node index step in each direction
   int32_t queue_head_ = 0, queue_count_ = 0;
@@ -191,9 +194,7 @@ struct GridMaxflowProbe {
   // Fills all node storage with `byte`, as if another graph had left garbage everywhere: a caller
   // that sets only the nodes its graph can reach must then still get the same cut.
   static void Poison(GridMaxflow& mf, uint8_t byte) {
-    memset(static_cast<void*>(mf.storage_), byte,
-           sizeof(GridMaxflow::Node) *
-               (static_cast<size_t>(mf.max_nodes_) + 3 * static_cast<size_t>(mf.max_width_)));
+    memset(static_cast<void*>(mf.storage_), byte, sizeof(GridMaxflow::Node) * mf.storage_nodes_);
   }
 };
 

@@ -178,6 +178,21 @@ TEST(DepthStageTest, HandoverFromTheWinnersIsExact) {
   EXPECT_GT(computed, 0) << "no block changed its label in the coarse moves";
 }
 
+// The coarse pass keeps its block D, rings and winners in the solver's spare whatever the label
+// count: Carve makes the room, else the hand-over takes nothing and the moves compute the
+// blocks' D again (slower, the same bits).
+TEST(DepthStageTest, CoarsePassHasRoomForItsCostsAtAnyLabelCount) {
+  const synth::Burst b = synth::MakeBurst(48, 32, 5, 2, 1, 6, 16, 32, 8, 16, 5u);
+  for (const int32_t labels : {16, 64, 128, 256}) {
+    const DepthConfig c = SmallConfig(b, labels, 16);
+    Stage s;
+    ASSERT_TRUE(s.Configure(c).ok());
+    ASSERT_TRUE(s.Compute(b).ok());
+    EXPECT_GT(DepthStageProbe::HandoverKept(s.depth), 0) << labels << " labels";
+    EXPECT_EQ(DepthStageProbe::WinnerStripes(s.depth), 1) << labels << " labels";
+  }
+}
+
 TEST(DepthStageTest, MoveResultBeatsEverySinglePixelSwitch) {
   const synth::Burst b = synth::MakeBurst(16, 12, 3, 1, 1, 2, 4, 11, 2, 9, 9u);
   DepthConfig c = SmallConfig(b, 5, 128);
