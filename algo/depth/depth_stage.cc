@@ -61,12 +61,10 @@ Status DepthStage::Validate(const DepthConfig& c) {
     return Status(Code::kInvalidArgument, "depth: geometry %d is neither rectified nor known poses",
                   static_cast<int>(c.geometry));
   }
-  // An arc of a move's graph carries at most w_pq * 2 * smooth_trunc, and a block pair's weight
-  // on the coarse grid is two pixel pairs': within the solver's 16-bit arcs.
-  if (4 * c.smooth_weight * c.smooth_trunc > GridMaxflow::kMaxArc) {
+  if (c.smooth_weight > MaxSmoothWeight(c.smooth_trunc)) {
     return Status(Code::kInvalidArgument,
-                  "depth: smoothness %d x truncation %d is over %d (the graph's arcs are 16 bits)",
-                  c.smooth_weight, c.smooth_trunc, GridMaxflow::kMaxArc / 4);
+                  "depth: smoothness %d is over %d at truncation %d (the graph's arcs are 16 bits)",
+                  c.smooth_weight, MaxSmoothWeight(c.smooth_trunc), c.smooth_trunc);
   }
   return Status::Ok();
 }

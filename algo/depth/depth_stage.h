@@ -93,6 +93,13 @@ class DepthStage {
   static Status Validate(const DepthConfig& config);
   // Bytes of arena that Configure will carve for this configuration.
   static size_t RequiredBytes(const DepthConfig& config);
+  // The largest smooth_weight Validate takes with this smooth_trunc (at most 4096): an arc of a
+  // move's graph carries at most w_pq * 2 * smooth_trunc, and a block pair's weight on the coarse
+  // grid is two pixel pairs', within the solver's 16-bit arcs.
+  static int32_t MaxSmoothWeight(int32_t smooth_trunc) {
+    const int32_t arcs = GridMaxflow::kMaxArc / (4 * (smooth_trunc > 0 ? smooth_trunc : 1));
+    return arcs < 4096 ? arcs : 4096;
+  }
 
   Status Configure(const DepthConfig& config, Arena& arena);
   // Where the data term runs its tasks (borrowed; nullptr: on the caller), with at most

@@ -95,8 +95,8 @@ class GridMaxflow {
     int32_t tcap = 0;      // residual terminal capacity: > 0 from the source, < 0 to the sink
     uint16_t ts = 0;       // time stamp of the last verified distance to a terminal
     uint8_t dist = 1;      // distance to the terminal (saturating; only a heuristic)
-    uint8_t bits =
-        kOrphan;  // parent (bits 0-2: a Dir, kTerminal or kOrphan), tree (3-4), queued (5)
+    // Parent (bits 0-2: a Dir, kTerminal or kOrphan), tree (3-4), queued (5).
+    uint8_t bits = kOrphan;
   };
   static_assert(sizeof(Node) == 16);
   static constexpr uint8_t kQueuedBit = 0x20;  // in bits: in the active queue

@@ -64,11 +64,8 @@ enum Opt {
   kDisparity
 };
 
-// The largest weight the stage takes at the default truncation (DepthStage::Validate).
-int32_t MaxSmoothness() {
-  const DepthConfig defaults;
-  return GridMaxflow::kMaxArc / (4 * defaults.smooth_trunc);
-}
+// The largest weight the stage takes at the default truncation.
+int32_t MaxSmoothness() { return DepthStage::MaxSmoothWeight(DepthConfig{}.smooth_trunc); }
 
 int Usage(const std::string& problem) { return UsageError("depth", problem); }
 
