@@ -34,7 +34,7 @@ void GridMaxflow::Carve(Arena& arena, int32_t max_width, int32_t max_height, siz
   storage_nodes_ = spare_bytes > 0 && lent > own ? lent : own;
   storage_ = arena.Allocate<Node>(storage_nodes_);
   orphans_ = arena.Allocate<int32_t>(static_cast<size_t>(max_nodes_));
-  queue_ = arena.Allocate<int32_t>(static_cast<size_t>(max_nodes_));
+  queue_ = arena.Allocate<int32_t>(static_cast<size_t>(max_nodes_) + kQueueSlack);
   live_ = arena.Allocate<int32_t>(2 * static_cast<size_t>(max_height));
 #ifdef LB_HAVE_LANES8
   cpu_avx2_ = CurrentCpu().avx2;  // what the kernel tables are picked from
@@ -490,6 +490,20 @@ int32_t InitLanes4(const GridMaxflowRows& in, uint8_t* row, int32_t x, int32_t x
 typedef int32_t Lanes8 __attribute__((vector_size(32)));
 typedef uint32_t ULanes8 __attribute__((vector_size(32)));
 
+// For each 8-bit mask, the indices of its set bits in order, then zeros.
+struct QueueOrder {
+  uint8_t lanes[256 * 8];
+  constexpr QueueOrder() : lanes() {
+    for (int32_t m = 0; m < 256; ++m) {
+      int32_t k = 0;
+      for (int32_t i = 0; i < 8; ++i) {
+        if ((m >> i) & 1) lanes[8 * m + k++] = static_cast<uint8_t>(i);
+      }
+    }
+  }
+};
+constexpr QueueOrder kQueueOrder;
+
 // InitLanes4 eight at a time, for CPUs with AVX2 (GridMaxflow::Carve asks the CPU once).
 __attribute__((target("avx2"), noinline)) int32_t InitLanes8(const GridMaxflowRows& in,
                                                              uint8_t* row, int32_t x, int32_t x1,
@@ -506,12 +520,17 @@ __attribute__((target("avx2"), noinline)) int32_t InitLanes8(const GridMaxflowRo
                              __builtin_shufflevector(t1, t3, 0, 1, 8, 9, 2, 3, 10, 11),
                              __builtin_shufflevector(t0, t2, 4, 5, 12, 13, 6, 7, 14, 15),
                              __builtin_shufflevector(t1, t3, 4, 5, 12, 13, 6, 7, 14, 15)};
-    uint8_t* const out = row + 16 * static_cast<ptrdiff_t>(x);
-    for (int k = 0; k < 4; ++k) memcpy(out + 32 * k, &pairs[k], sizeof(Lanes8));
-    if (!_mm256_testz_si256(__m256i(n.queued), __m256i(n.queued))) {
-      for (int32_t i = 0; i < 8; ++i) {
-        if (n.queued[i] != 0) queue[(*count)++] = base + x + i;
-      }
+    __m256i* const out = reinterpret_cast<__m256i*>(row + 16 * static_cast<ptrdiff_t>(x));
+    for (int k = 0; k < 4; ++k) _mm256_storeu_si256(out + k, __m256i(pairs[k]));
+    // The queued lanes' indices packed to the front and stored whole (the queue has room for 8
+    // past its end); the count moves on by how many there were.
+    const int32_t mask = _mm256_movemask_ps(_mm256_castsi256_ps(__m256i(-n.queued)));
+    if (mask != 0) {
+      const __m256i order = _mm256_cvtepu8_epi32(_mm_loadl_epi64(
+          reinterpret_cast<const __m128i*>(kQueueOrder.lanes + static_cast<ptrdiff_t>(8) * mask)));
+      const __m256i index = _mm256_add_epi32(_mm256_set1_epi32(base + x), order);
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(queue + *count), index);
+      *count += __builtin_popcount(static_cast<uint32_t>(mask));
     }
   }
   return x;

@@ -89,6 +89,7 @@ class GridMaxflow {
   static constexpr uint8_t kFree = 0, kSourceTree = 1, kSinkTree = 2;
   static constexpr uint8_t kTerminal = 4, kOrphan = 5;  // parent values besides a Dir
   static constexpr int32_t kNotActive = -1;
+  static constexpr int32_t kQueueSlack = 8;  // entries past max_nodes_ (InitRow's whole stores)
 
   struct Node {
     uint16_t cap[4] = {};  // residual capacity of the arc to each neighbour
