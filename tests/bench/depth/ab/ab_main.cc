@@ -5,7 +5,7 @@
 // sides of a turn alike, so the median of the per-turn ratios shows 1 % changes that separate
 // benchmark runs do not. Prints each side's median time, that ratio and whether the maps are
 // the same bit for bit.
-//   ab_depth [turns]
+//   ab_depth [turns [scene]]   (scene: teddy, handheld or handheld-r alone, e.g. under callgrind)
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -24,8 +24,11 @@ double Median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+const char* g_only = nullptr;  // the one scene to run, or nullptr for all
+
 // Returns false when either side refuses the scene or a compute fails.
 bool Compare(const char* name, const AbScene& scene, int turns) {
+  if (g_only != nullptr && std::string(g_only) != name) return true;
   void* current = AbMakeCurrent(scene);
   void* reference = AbMakeReference(scene);
   if (current == nullptr || reference == nullptr) {
@@ -64,6 +67,7 @@ bool Compare(const char* name, const AbScene& scene, int turns) {
 int main(int argc, char** argv) {
   const int turns = argc > 1 ? atoi(argv[1]) : 100;
   if (turns < 1) return 2;
+  g_only = argc > 2 ? argv[2] : nullptr;
   bool ok = true;
   lb::middlebury::Set teddy;
   const std::string dir = lb::middlebury::DataDir();
