@@ -119,6 +119,7 @@ Status DepthStage::Carve(Arena& arena) {
   move_rows_ = arena.Allocate<int32_t>(11 * static_cast<size_t>(w));
   keep_row_ = arena.Allocate<uint8_t>(static_cast<size_t>(w));
   free_span_ = arena.Allocate<int32_t>(2 * static_cast<size_t>(h));
+  want_span_ = arena.Allocate<int32_t>(2 * static_cast<size_t>(h));
   split_ = arena.Allocate<uint8_t>(static_cast<size_t>(w > h ? w : h) + 2);
   runs_ = arena.Allocate<RowRuns>(static_cast<size_t>(h));
   run_marks_ = arena.Allocate<uint8_t>(2 * (static_cast<size_t>(w) + 2));
@@ -362,6 +363,10 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
   for (int32_t x = 0; x < w; ++x) keep_row_[x] = kKeep;
   for (int32_t x = 0; x < w; ++x) move_rows_[9 * w + x] = 0;  // ZeroRow
   prev_label_ = -1;
+  for (int32_t y = 0; y < h; ++y) {
+    want_span_[2 * y] = w;
+    want_span_[2 * y + 1] = 0;
+  }
   stats_.cycles = 0;
   stats_.moves = 0;
   stats_.cut_pixels = 0;

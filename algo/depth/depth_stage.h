@@ -158,7 +158,7 @@ class DepthStage {
     int32_t* span = nullptr;
     int32_t* prev_span = nullptr;
     // Per row, the columns from the first to the last label within the window of the move in
-    // progress or one above it ([x0, x1) as two entries, x0 >= x1 when none): ComputeNear.
+    // progress ([x0, x1) as two entries, x0 >= x1 when none): ComputeNear and pass 1.
     int32_t* near_span = nullptr;
     // The rectangles of the move in progress (move_rects.cc), at most rect_capacity; their cut
     // is exact however they are split.
@@ -296,7 +296,10 @@ class DepthStage {
   // A pixel's D in fine_.cost_alpha or prev_alpha where its move did not compute it: no D is
   // this large (DataTerm::kMaxCost).
   static constexpr uint16_t kNotComputed = 0xffff;
-  uint16_t CostAt(int32_t label, int32_t x, int32_t y);
+  // In below_ during Record: D(f - 1) is wanted from PastCosts.
+  static constexpr uint16_t kWanted = 0xfffe;
+  void PastCosts(int32_t label);
+  int32_t* want_span_ = nullptr;  // per row, the columns where below_ holds kWanted ([w, 0): none)
   int32_t* move_rows_ = nullptr;  // the moves' row ring and rows (expansion_move.cc)
   uint8_t* keep_row_ = nullptr;   // width x kKeep: the state of the rows around a rectangle
   int32_t* free_span_ = nullptr;  // per row, the free pixels of the rectangle being cut (FreeSpan)
@@ -305,7 +308,7 @@ class DepthStage {
   RowRuns* runs_ = nullptr;
   uint8_t* run_marks_ = nullptr;  // 2 * (width + 2) bytes: the columns those runs hold
   // The labels near alpha that a restricted move computes D next to (MoveRects).
-  int32_t near_lo_ = 0, near_top_ = 0;
+  int32_t near_lo_ = 0, near_hi_ = 0;
   int32_t smooth_[DepthConfig::kMaxLabels] = {};  // min(d, smooth_trunc) for a label distance d
   int32_t prev_label_ = -1;
   uint16_t* below_ = nullptr;  // D_p(f_p - 1), 0xffff when not seen
@@ -341,6 +344,13 @@ struct DepthStageProbe {
     return stage.Expand(alpha);
   }
   static int64_t Energy(DepthStage& stage, const uint8_t* labels);
+  // What the last move kept for the next one's sub-label fit: the D of its label (*label; -1:
+  // none) per pixel, kNotComputed where it has none.
+  static const uint16_t* KeptCosts(const DepthStage& stage, int32_t* label) {
+    *label = stage.prev_label_;
+    return stage.fine_.prev_alpha;
+  }
+  static constexpr uint16_t kNotComputed = DepthStage::kNotComputed;
   // D of one label for every pixel (row stride = width), from scratch.
   static void Costs(DepthStage& stage, int32_t label, uint16_t* out) {
     stage.LabelCosts(label, out);

@@ -379,20 +379,20 @@ bool DepthStage::Expand(int32_t alpha) {
 }
 
 // A restricted move needs D only at the pixels it may free: next to a label within the window of
-// alpha or, for the sub-label fit, one above it (near_lo_..near_top_), in the row or the rows
-// either side. Per row, the runs of such columns (RowRuns: joined where close, at most a few),
-// over the whole image in one pass of the data term (its ring covers every row's runs, the image
-// pays its 2 starting rows once, and each view row is read once: the move's rectangles may share
-// rows). The others keep kNotComputed, which pass 1 never reads (they are fixed as far from alpha
-// whatever their D), and a pixel that takes alpha + 1 next lies next to such a label, so the
-// sub-label fit mostly finds its D(alpha) at hand (Record computes the rest). Written records a
-// rectangle per run of rows with the same single run, or each run, exactly where D was computed.
+// alpha (near_lo_..near_hi_), in the row or the rows either side. Per row, the runs of such
+// columns (RowRuns: joined where close, at most a few), over the whole image in one pass of the
+// data term (its ring covers every row's runs, the image pays its 2 starting rows once, and each
+// view row is read once: the move's rectangles may share rows). The others keep kNotComputed,
+// which pass 1 never reads (they are fixed as far from alpha whatever their D); the sub-label
+// fit mostly finds its D(alpha) at hand, and Record has the rest computed (PastCosts). Written
+// records a rectangle per run of rows with the same single run, or each run, exactly where D
+// was computed.
 LB_CLONES_AVX2 void DepthStage::ComputeNear(int32_t disp_q8) {
   const Grid& g = fine_;
   const int32_t w = g.width, h = g.height;
   const Rect whole{0, w, 0, h};
   const uint8_t base = static_cast<uint8_t>(near_lo_);
-  const uint8_t width = static_cast<uint8_t>(near_top_ - near_lo_);
+  const uint8_t width = static_cast<uint8_t>(near_hi_ - near_lo_);
   uint8_t* const near = run_marks_ + 1;      // near[-1 .. w]: a label near in the column
   uint8_t* const mark = run_marks_ + w + 3;  // mark[x]: one next to column x
   for (int32_t y = 0; y < h; ++y) {
@@ -451,9 +451,11 @@ LB_CLONES_AVX2 void DepthStage::RecordNeighbours(int32_t alpha, const uint8_t* _
 // just took alpha saw D(alpha - 1) in the move before (kept in prev_alpha) when it lay in the
 // columns that move's run of rows looked at (prev_span), and will see D(alpha + 1) in the next.
 // A restricted move looks at every pixel within its window, so at every pixel of label alpha - 1
-// and alpha + 1. The move before computed D only on its split rectangles (move_rects.cc); a
-// pixel of its columns outside them that now took alpha gets its D(alpha - 1) here (CostAt),
-// so the fit does not depend on how the rectangles were split.
+// and alpha + 1. The move before computed D only next to labels within its window (and on its
+// split rectangles, move_rects.cc); a pixel of its columns that now took alpha without one gets
+// its D(alpha - 1) here, all such pixels of the move in one pass of the data term
+// (PastCosts), so the fit depends neither on how the rectangles were split nor on where the
+// move before looked.
 //
 // Returns the energy change: each switching pixel's D, and its pairs with the neighbours that
 // keep their labels; a pair of two switching pixels goes from V(fp, fq) to 0 and is counted once,
@@ -499,7 +501,13 @@ int64_t DepthStage::Record(int32_t alpha) {
         if (!refine) continue;
         below_[p] = kNotComputed;
         if (x >= px0 && x < px1) {
-          below_[p] = g.prev_alpha[p] != kNotComputed ? g.prev_alpha[p] : CostAt(alpha - 1, x, y);
+          below_[p] = g.prev_alpha[p];
+          if (below_[p] == kNotComputed) {  // PastCosts fills it in
+            below_[p] = kWanted;
+            int32_t* want = want_span_ + 2 * y;
+            want[0] = x < want[0] ? x : want[0];
+            want[1] = x + 1 > want[1] ? x + 1 : want[1];
+          }
         }
         above_[p] = kNotComputed;
       }
@@ -510,6 +518,7 @@ int64_t DepthStage::Record(int32_t alpha) {
       g.row_took[y] = 0;
     }
   }
+  if (have_prev) PastCosts(alpha - 1);
   if (refine) {
     uint16_t* t = g.prev_alpha;
     g.prev_alpha = g.cost_alpha;
@@ -525,13 +534,51 @@ int64_t DepthStage::Record(int32_t alpha) {
   return delta;
 }
 
-// D of one pixel for one label, from the data term's own rows (the same bits as a whole row).
-// Written through below_, whose entry at (x, y) the caller then sets anyway.
-uint16_t DepthStage::CostAt(int32_t label, int32_t x, int32_t y) {
-  const int32_t w = config_.width;
+// The D(label) that Record wanted (kWanted in below_, over want_span_): the rows' runs of them
+// in one pass of the data term, into prev_alpha, which holds D(label) (the same bits as any
+// other pass: a pixel's D depends only on the views around it); the columns the runs join
+// across get D(label) too, and prev_alpha's record of where it holds D grows by the runs, so
+// that MoveRects clears them in turn.
+void DepthStage::PastCosts(int32_t label) {
+  Grid& g = fine_;
+  const int32_t w = g.width, h = g.height;
+  uint8_t* const mark = run_marks_ + w + 3;
+  int32_t y0 = h, y1 = 0;
+  for (int32_t y = 0; y < h; ++y) {
+    int32_t* want = want_span_ + 2 * y;
+    if (want[0] >= want[1]) {
+      runs_[y].count = 0;
+      continue;
+    }
+    const uint16_t* b = below_ + y * w;
+    for (int32_t x = want[0]; x < want[1]; ++x) mark[x] = b[x] == kWanted ? 1 : 0;
+    runs_[y].FromMarks(mark, want[0], want[1], w, data_.RunJoin());
+    y0 = y < y0 ? y : y0;
+    y1 = y + 1;
+  }
+  if (y0 >= y1) return;
   UseLabelPlanes(label);
-  data_.ComputeRect(LabelDispQ8(label), x, x + 1, y, y + 1, below_ + y * w, w);
-  return below_[y * w + x];
+  data_.ComputeRuns(LabelDispQ8(label), runs_, y0, y1, g.prev_alpha + y0 * w, w);
+  for (int32_t y = y0; y < y1; ++y) {
+    int32_t* want = want_span_ + 2 * y;
+    uint16_t* b = below_ + y * w;
+    const uint16_t* d = g.prev_alpha + y * w;
+    for (int32_t x = want[0]; x < want[1]; ++x) b[x] = b[x] == kWanted ? d[x] : b[x];
+    want[0] = w;
+    want[1] = 0;
+    const RowRuns& r = runs_[y];
+    for (int32_t k = 0; k < r.count; ++k) {
+      const int32_t x0 = r.x[2 * k], x1 = r.x[2 * k + 1];
+      Rect* last = g.prev_written_count > 0 ? g.prev_written + g.prev_written_count - 1 : nullptr;
+      if (last != nullptr && last->y1 == y && last->x0 == x0 && last->x1 == x1) {
+        last->y1 = y + 1;  // the same run as the row above's
+      } else if (g.prev_written_count >= 0 && g.prev_written_count < g.written_capacity) {
+        g.prev_written[g.prev_written_count++] = Rect{x0, x1, y, y + 1};
+      } else {
+        g.prev_written_count = -1;  // MoveRects clears all of it
+      }
+    }
+  }
 }
 
 }  // namespace lb

@@ -76,36 +76,20 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
   const int32_t hi = alpha + window_ < config_.labels - 1 ? alpha + window_ : config_.labels - 1;
   uint64_t want[4] = {};
   for (int32_t l = lo; l <= hi; ++l) want[l >> 6] |= uint64_t{1} << (l & 63);
-  // Each row's own columns with such a label: [w, 0) when none.
+  // Each row's own columns with such a label: [w, 0) when none. Also where the move computes D
+  // (ComputeNear: next to such a label). The sub-label fit wants D(alpha) of the pixels that take
+  // alpha + 1 in the next move too, which may lie next to none (with a label of alpha + 3): Record
+  // has those computed afterwards, far fewer than the pixels next to a label of alpha + 3.
+  near_lo_ = lo;
+  near_hi_ = hi;
   for (int32_t y = 0; y < h; ++y) {
     const uint64_t* m = g.row_labels + 4 * y;
     int32_t x0 = w, x1 = 0;
     if (((m[0] & want[0]) | (m[1] & want[1]) | (m[2] & want[2]) | (m[3] & want[3])) != 0) {
       LabelsIn(g.labels + y * w, w, lo, hi, &x0, &x1);  // the row holds one
     }
-    span[2 * y] = x0;
-    span[2 * y + 1] = x1;
-  }
-  // Where the move computes D (ComputeNear): next to a label within the window or, for the
-  // sub-label fit (config_.subpixel), one above it.
-  // A pixel that takes alpha + 1 in the next move is next to a label within the window of
-  // alpha + 1 after this move, so next to one in lo..hi + 1 now or to a pixel that takes alpha
-  // now; either way its D(alpha) for the sub-label fit is then mostly at hand (Record).
-  {
-    const int32_t top = config_.subpixel && hi + 1 < config_.labels ? hi + 1 : hi;
-    near_lo_ = lo;
-    near_top_ = top;
-    uint64_t more[4] = {want[0], want[1], want[2], want[3]};
-    more[top >> 6] |= uint64_t{1} << (top & 63);
-    for (int32_t y = 0; y < h; ++y) {
-      const uint64_t* m = g.row_labels + 4 * y;
-      int32_t x0 = w, x1 = 0;
-      if (((m[0] & more[0]) | (m[1] & more[1]) | (m[2] & more[2]) | (m[3] & more[3])) != 0) {
-        LabelsIn(g.labels + y * w, w, lo, top, &x0, &x1);
-      }
-      g.near_span[2 * y] = x0;
-      g.near_span[2 * y + 1] = x1;
-    }
+    span[2 * y] = g.near_span[2 * y] = x0;
+    span[2 * y + 1] = g.near_span[2 * y + 1] = x1;
   }
   // Runs of rows next to one, over the columns next to one.
   auto row_near = [&](int32_t y) {

@@ -9,6 +9,7 @@
 #include <tuple>
 #include <vector>
 
+#include "algo/core/progress.h"
 #include "algo/depth/depth_stage.h"
 #include "algo/depth/planes.h"
 #include "tests/algo/depth/handheld.h"
@@ -194,6 +195,79 @@ TEST(PlanesTest, WinnerStripesGiveTheBitsOfOne) {
       EXPECT_EQ(striped.depth.stats().energy, one.depth.stats().energy) << at;
       EXPECT_EQ(striped.disp, one.disp) << at;
     }
+  }
+}
+
+// What a move keeps for the next one's sub-label fit (prev_alpha) must be, after every move, the
+// true D of its label or "not computed": the moves compute D next to labels near their own,
+// Record has the rest the fit wants computed afterwards (PastCosts: handheld bursts have pixels
+// that jump two labels), and each buffer is cleared wherever it was written before it is used
+// again. In both geometries.
+TEST(PlanesTest, KeptCostsAreTrueAfterEveryMove) {
+  motiontest::Burst b;
+  ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(3), 320, 120, 5, &b));
+  const handheld::Labels l = handheld::HandheldLabels(b, 0.1);
+  const std::vector<PlaneHomography> planes = handheld::Planes(b, l);
+  for (const ViewGeometry geometry : {ViewGeometry::kKnownPoses, ViewGeometry::kRectified}) {
+    DepthConfig c = l.config;
+    c.geometry = geometry;
+    const bool sweep = geometry == ViewGeometry::kKnownPoses;
+    const size_t n = static_cast<size_t>(c.width) * c.height;
+    std::vector<std::vector<uint16_t>> d(static_cast<size_t>(c.labels), std::vector<uint16_t>(n));
+    Stage truth;  // Costs reads the views a Compute prepared
+    ASSERT_TRUE(truth.Configure(c).ok());
+    if (sweep) {
+      ASSERT_TRUE(truth.depth.SetPlanes(planes.data()).ok());
+    }
+    ASSERT_TRUE(truth.Compute(b.views.data()).ok());
+    for (int32_t k = 0; k < c.labels; ++k) DepthStageProbe::Costs(truth.depth, k, d[k].data());
+    struct Check : ProgressSink {
+      const DepthStage* stage = nullptr;
+      const std::vector<std::vector<uint16_t>>* d = nullptr;
+      int64_t kept = 0, wrong = 0;
+      int32_t moves = 0;
+      void Report(int32_t, int32_t) override {
+        int32_t label = -1;
+        const uint16_t* costs = DepthStageProbe::KeptCosts(*stage, &label);
+        if (label < 0) return;
+        ++moves;
+        const std::vector<uint16_t>& want = (*d)[static_cast<size_t>(label)];
+        for (size_t p = 0; p < want.size(); ++p) {
+          if (costs[p] == DepthStageProbe::kNotComputed) continue;
+          ++kept;
+          wrong += costs[p] != want[p];
+        }
+      }
+    } check;
+    Stage s;
+    ASSERT_TRUE(s.Configure(c).ok());
+    check.stage = &s.depth;
+    check.d = &d;
+    s.depth.SetProgress(&check);
+    if (sweep) {
+      ASSERT_TRUE(s.depth.SetPlanes(planes.data()).ok());
+    }
+    ASSERT_TRUE(s.Compute(b.views.data()).ok());
+    const char* at = sweep ? "planes" : "rectified";
+    EXPECT_EQ(check.wrong, 0) << at << ", of " << check.kept;
+    EXPECT_GE(check.moves, c.labels - 1) << at;
+    EXPECT_GT(check.kept, 0) << at;
+    EXPECT_EQ(s.disp, truth.disp) << at;
+    // And the fit drew its parabolas through them wherever it moved a pixel off its label.
+    int32_t fitted = 0;
+    for (size_t p = 0; p < n; ++p) {
+      const int32_t f = s.depth.labels()[p];
+      const int32_t label_q8 = s.depth.LabelDispQ8(f) + DepthStage::MapBiasQ8(c);
+      if (f == 0 || f + 1 == c.labels || s.disp[p] == label_q8) continue;
+      ++fitted;
+      const int32_t cm = d[f - 1][p], c0 = d[f][p], cp = d[f + 1][p];
+      const int32_t curvature = cm + cp - 2 * c0;
+      ASSERT_TRUE(c0 <= cm && c0 <= cp && curvature > 0) << at << " pixel " << p;
+      const int32_t step_q8 = (s.depth.LabelDispQ8(f + 1) - s.depth.LabelDispQ8(f - 1)) / 2;
+      ASSERT_EQ(s.disp[p], label_q8 + ((cm - cp) * step_q8) / (2 * curvature))
+          << at << " pixel " << p;
+    }
+    EXPECT_GT(fitted, static_cast<int32_t>(n / 8)) << at;
   }
 }
 
