@@ -541,7 +541,8 @@ LB_AVX2 inline __m256i AtMost(__m256i v, __m256i max) {
 // What the run's band spans need, 8 spans at once (BandOf's tests, lane by lane): a span of
 // kAnchorStep pixels (the row's short last span is not one), both anchors inside the view, its
 // tap rows and census rows each within two neighbouring rows, and the positions advancing at
-// most 9/8 px per pixel; not the row's last span when its end column is wanted. For each: its
+// most 9/8 px per pixel; not the row's last span when its end column is wanted, nor one the
+// wanted columns cut (AnySpan steps only their wanted part). For each: its
 // upper tap row and census row (and their offsets), its x and y change over the span (Q16), and
 // kind bits (kInBand, kTwoRows, kTwoCensus, kRising).
 enum : int32_t { kInBand = 1, kTwoRows = 2, kTwoCensus = 4, kRising = 8 };
@@ -561,8 +562,9 @@ LB_AVX2 void BandsOfRun(const WarpRow& r, const WarpRun& run, int32_t first, int
   const __m256i q8_half = _mm256_set1_epi32(128), one = _mm256_set1_epi32(1);
   const __m256i reach = _mm256_set1_epi32(kAnchorStep * 73728);
   // The row's last span, when its end anchor's column is wanted too (a 17th), is not stepped
-  // as one of the band.
+  // as one of the band, nor is a span the wanted columns lo..hi-1 cut.
   const __m256i last = _mm256_set1_epi32(run.hi > run.last ? run.last - 1 : run.last);
+  const __m256i lo = _mm256_set1_epi32(run.lo), hi = _mm256_set1_epi32(run.hi);
   const __m256i stride = _mm256_set1_epi32(static_cast<int32_t>(r.stride));
   const __m256i census_row = _mm256_set1_epi32(3 * r.width);
   for (int32_t g = first; g < end; g += kLanes) {
@@ -574,7 +576,10 @@ LB_AVX2 void BandsOfRun(const WarpRow& r, const WarpRun& run, int32_t first, int
     // The span's end column x0 + kAnchorStep (k + 1) must be an anchor: not past `last`.
     const __m256i span_end = _mm256_add_epi32(_mm256_set1_epi32(run.x0 + kAnchorStep * (g + 1)),
                                               _mm256_slli_epi32(iota, 4));  // kAnchorStep = 16
-    __m256i bad = _mm256_cmpgt_epi32(span_end, last);
+    __m256i bad =
+        _mm256_or_si256(_mm256_cmpgt_epi32(span_end, last), _mm256_cmpgt_epi32(span_end, hi));
+    bad = _mm256_or_si256(
+        bad, _mm256_cmpgt_epi32(lo, _mm256_sub_epi32(span_end, _mm256_set1_epi32(kAnchorStep))));
     const __m256i dx = _mm256_sub_epi32(bx, ax), dy = _mm256_sub_epi32(by, ay);
     bad = _mm256_or_si256(bad, _mm256_cmpgt_epi32(_mm256_abs_epi32(dx), reach));
     const __m256i xa = _mm256_srai_epi32(_mm256_add_epi32(ax, q8_half), 8);
@@ -779,6 +784,14 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpRun& run, uint8_t* out) 
       PlaneLanesAvx2(r.ref, r.cref, r.width, rl.lanes_x0, RefLanesEnd(r.width, hi), local,
                      kLocalLanes);
     }
+    // Locals: the stores through `out` may alias the structs' fields, which would be read again
+    // for every span.
+    const int32_t* const xs = run.x_q16;
+    const int32_t* const ys = run.y_q16;
+    const int32_t x0 = run.x0;
+    const uint8_t* const view = r.view;
+    const uint8_t* const census_view = r.census_view;
+    const ptrdiff_t lanes_stride = rl.lanes_stride;
     for (int32_t s = base; s < stop; ++s) {
       const int32_t i = s - base, kind = bands.kind[i];
       if ((kind & kInBand) == 0) {
@@ -786,21 +799,21 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpRun& run, uint8_t* out) 
         if (job.lo < job.hi) AnySpan(rl, k, &job, out);
         continue;
       }
-      const int32_t x = run.x0 + kAnchorStep * s;
-      const Band band{r.view + bands.row[i],
-                      r.census_view + bands.crow[i],
+      const int32_t x = x0 + kAnchorStep * s;
+      const Band band{view + bands.row[i],
+                      census_view + bands.crow[i],
                       bands.y[i],
                       bands.cy[i],
                       (kind & kTwoRows) != 0,
                       (kind & kTwoCensus) != 0,
                       (kind & kRising) != 0,
-                      rl.lanes_stride};
+                      lanes_stride};
       const __m256i dx = _mm256_set1_epi32(bands.dx[i]), dy = _mm256_set1_epi32(bands.dy[i]);
       const __m256i tx = _mm256_add_epi32(_mm256_mullo_epi32(iota, dx), eight);
       const __m256i ty = _mm256_add_epi32(_mm256_mullo_epi32(iota, dy), eight);
       // Plus BandStep's rounding half: (a + 128) + t for a + t + 128, exact in int32.
-      const __m256i ax = _mm256_set1_epi32(run.x_q16[s] + 128);
-      const __m256i ay = _mm256_set1_epi32(run.y_q16[s] + 128);
+      const __m256i ax = _mm256_set1_epi32(xs[s] + 128);
+      const __m256i ay = _mm256_set1_epi32(ys[s] + 128);
       const __m256i q[4] = {
           _mm256_add_epi32(ax, _mm256_srai_epi32(tx, 4)),
           _mm256_add_epi32(ay, _mm256_srai_epi32(ty, 4)),
@@ -808,11 +821,7 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpRun& run, uint8_t* out) 
                            _mm256_srai_epi32(_mm256_add_epi32(tx, _mm256_slli_epi32(dx, 3)), 4)),
           _mm256_add_epi32(ay,
                            _mm256_srai_epi32(_mm256_add_epi32(ty, _mm256_slli_epi32(dy, 3)), 4))};
-      const int32_t lo = Max(x, run.lo), hi = Min(x + kAnchorStep, run.hi);
-      // A span cut by the wanted columns goes whole into a buffer, the wanted part copied.
-      const bool whole = lo == x && hi == x + kAnchorStep;
-      uint8_t costs[kAnchorStep];
-      uint8_t* const dst = whole ? out + x : costs;
+      uint8_t* const dst = out + x;
       switch (kind & (kTwoRows | kTwoCensus)) {
         case 0:
           BandSpan<false, false>(rl, k, band, x, q, dst);
@@ -826,9 +835,6 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpRun& run, uint8_t* out) 
         default:
           BandSpan<true, true>(rl, k, band, x, q, dst);
           break;
-      }
-      if (!whole && lo < hi) {
-        std::memcpy(out + lo, costs + (lo - x), static_cast<size_t>(hi - lo));
       }
     }
   }
