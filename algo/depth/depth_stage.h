@@ -225,14 +225,22 @@ class DepthStage {
   int32_t MoveRects(int32_t alpha);
   int32_t SplitRect(int32_t i, int32_t count, int32_t lo, int32_t hi);
   void ComputeNear(int32_t disp_q8);
-  // Notes that the fine grid's cost_alpha holds D over r (MoveRects clears it two moves on).
-  void Written(const Rect& r) {
-    Grid& g = fine_;
-    if (g.written_count >= 0 && g.written_count < g.written_capacity) {
-      g.written[g.written_count++] = r;
+  // Notes in a D buffer's record (list, *count of capacity; -1: anywhere) that it holds D over r:
+  // MoveRects clears it there before the buffer is used again. A rectangle over the columns of
+  // the last one, right below it, extends that one.
+  static void NoteWritten(Rect* list, int32_t* count, int32_t capacity, const Rect& r) {
+    Rect* last = *count > 0 ? list + *count - 1 : nullptr;
+    if (last != nullptr && last->y1 == r.y0 && last->x0 == r.x0 && last->x1 == r.x1) {
+      last->y1 = r.y1;
+    } else if (list != nullptr && *count >= 0 && *count < capacity) {
+      list[(*count)++] = r;
     } else {
-      g.written_count = -1;
+      *count = -1;
     }
+  }
+  // Notes that the fine grid's cost_alpha holds D over r.
+  void Written(const Rect& r) {
+    NoteWritten(fine_.written, &fine_.written_count, fine_.written_capacity, r);
   }
   void CutRect(int32_t alpha, const Rect& r);
   int32_t ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1, int32_t e0, int32_t e1);

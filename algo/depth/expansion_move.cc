@@ -568,16 +568,8 @@ void DepthStage::PastCosts(int32_t label) {
     want[1] = 0;
     const RowRuns& r = runs_[y];
     for (int32_t k = 0; k < r.count; ++k) {
-      const int32_t x0 = r.x[2 * k], x1 = r.x[2 * k + 1];
-      Rect* last = g.prev_written_count > 0 ? g.prev_written + g.prev_written_count - 1 : nullptr;
-      if (last != nullptr && last->y1 == y && last->x0 == x0 && last->x1 == x1) {
-        last->y1 = y + 1;  // the same run as the row above's
-      } else if (g.prev_written != nullptr && g.prev_written_count >= 0 &&
-                 g.prev_written_count < g.written_capacity) {
-        g.prev_written[g.prev_written_count++] = Rect{x0, x1, y, y + 1};
-      } else {
-        g.prev_written_count = -1;  // MoveRects clears all of it
-      }
+      NoteWritten(g.prev_written, &g.prev_written_count, g.written_capacity,
+                  Rect{r.x[2 * k], r.x[2 * k + 1], y, y + 1});
     }
   }
 }
