@@ -8,7 +8,7 @@ SUDO=""
 APT="$SUDO env DEBIAN_FRONTEND=noninteractive apt-get -o DPkg::Lock::Timeout=600 -y -q"
 
 host_pkgs=(
-  cmake ninja-build g++ pkg-config git
+  cmake ninja-build g++ pkg-config git mmdebstrap
   libjpeg62-turbo-dev libpng-dev libexif-dev libeigen3-dev libmd-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   clang-14 libclang-rt-14-dev clang-format clang-tidy

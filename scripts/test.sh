@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Every check CI runs: set-up, format, host tests under ASan+UBSan, the Middlebury accuracy tests
-# in Release, short fuzz runs, clang-tidy on algo/, and the ARM builds with their unit tests under
-# qemu-user. Ends with one line "tests: N passed, M failed".
+# in Release, short fuzz runs, clang-tidy on algo/, the ARM builds with their unit tests under
+# qemu-user, the board packages for Debian 12 and 13, and the libcamera backend against the
+# newest libcamera. Ends with one line "tests: N passed, M failed".
 set -uo pipefail
 cd "$(dirname "$0")/.."
 top=$(pwd)
@@ -35,6 +36,11 @@ step "set-up"
 bash scripts/setup.sh || die "set-up failed"
 bash scripts/cross-sysroot.sh arm64 || die "arm64 sysroot failed"
 bash scripts/cross-sysroot.sh armhf || die "armhf sysroot failed"
+# The Debian roots of the last steps download while the first ones compile.
+prefetch=$log/prefetch.log
+{ bash scripts/package.sh --root-only bookworm arm64 && bash scripts/package.sh --root-only trixie arm64 &&
+  bash scripts/libcamera-compat.sh --root-only trixie-backports; } >"$prefetch" 2>&1 &
+prefetch_pid=$!
 
 step "format (clang-format)"
 mapfile -t sources < <(git ls-files '*.h' '*.cc')
@@ -80,8 +86,24 @@ for arch in aarch64 armhf; do
   run_ctest "$arch" --preset "$arch"
 done
 
-step "aarch64: the board's .deb (cpack, dpkg-deb -c, packaged refocusd --version under qemu)"
-run_ctest aarch64-deb --test-dir build/aarch64 -L deb
+wait "$prefetch_pid" || { cat "$prefetch"; die "making the Debian roots failed"; }
+for suite in bookworm trixie; do
+  step "$suite arm64: the board's package built in the release's root, and checked"
+  if deb=$(bash scripts/package.sh "$suite" arm64 | tail -n1) &&
+     bash tests/firmware/daemon/check_deb.sh "$deb" "build/roots/$suite-cross-arm64"; then
+    passed=$((passed + 1))
+  else
+    failed=$((failed + 1)); echo "test: the $suite arm64 package failed"
+  fi
+done
+
+step "libcamera 0.7.1 (trixie-backports): the backend built with -Werror, its unit tests"
+bash scripts/libcamera-compat.sh trixie-backports 2>&1 | tee "$log/compat.log" | tail -n 30
+if ! grep -q '^libcamera-compat: 1 passed, 0 failed$' "$log/compat.log"; then
+  failed=$((failed + 1)); echo "test: the libcamera backend failed against libcamera 0.7.1"
+else
+  passed=$((passed + $(sed -n 's/^\[  PASSED  \] \([0-9]*\) tests\?\..*/\1/p' "$log/compat.log" | tail -n1)))
+fi
 
 echo
 echo "tests: $passed passed, $failed failed, $skipped skipped"

@@ -26,16 +26,25 @@ elseif(CMAKE_SYSTEM_PROCESSOR MATCHES "^(x86_64|AMD64)$")
   set(CPACK_DEBIAN_PACKAGE_ARCHITECTURE amd64)
 endif()
 
-# Written by hand: dpkg-shlibdeps needs the target's libraries installed as packages, which a
-# cross sysroot is not. tests/firmware/daemon/check_deb.sh checks every library the binaries
-# link is covered. Bookworm's versions.
-set(lb_deb_depends "libc6 (>= 2.36), libgcc-s1 (>= 3.0), libstdc++6 (>= 12)"
-    "libjpeg62-turbo (>= 1:2.1)" "libpng16-16 (>= 1.6.2)" "libexif12 (>= 0.6.21)"
-    "libmd0 (>= 1.0)" "libmicrohttpd12 (>= 0.9.75)")
-if(TARGET lb_libcamera)
-  list(APPEND lb_deb_depends "libcamera0.0.3")
+# The release the package is built for: its version says so (0.1.0+deb12, 0.1.0+deb13), since
+# each release's package links that release's libraries (libcamera's soname differs in each).
+set(LB_DEB_RELEASE "" CACHE STRING "Debian release the package is built against (deb12, deb13)")
+if(LB_DEB_RELEASE)
+  set(CPACK_DEBIAN_PACKAGE_VERSION ${PROJECT_VERSION}+${LB_DEB_RELEASE})
 endif()
-string(JOIN ", " CPACK_DEBIAN_PACKAGE_DEPENDS ${lb_deb_depends})
+# dpkg-shlibdeps states the dependencies from the libraries the programs link, as the release's
+# packages declare them. It needs those libraries installed as packages: a native build, or a
+# cross build against multiarch packages (scripts/package.sh). A cross build against the private
+# sysroot of the unit tests makes no package.
+set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+# Cameras behind an ISP (Raspberry Pi, Rockchip, Intel IPU3) need libcamera's image-processing
+# modules; Debian 12's libcamera only suggests them.
+if(TARGET lb_libcamera)
+  set(CPACK_DEBIAN_PACKAGE_RECOMMENDS libcamera-ipa)
+endif()
+if(CMAKE_CROSSCOMPILING AND NOT LB_MULTIARCH)
+  return()
+endif()
 
 set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA
     ${CMAKE_CURRENT_SOURCE_DIR}/deb/conffiles ${CMAKE_CURRENT_SOURCE_DIR}/deb/postinst

@@ -1,47 +1,44 @@
 #!/bin/bash
-# Builds the board's Debian package in a cross build tree and checks it as an installer and the
-# board would see it: the four files at their places, the conffile, the architecture, a
-# dependency for every library the programs link, and the packaged refocusd running under
-# qemu-user: --version, and --check-config, which checks the camera, the button and the photo
-# folder besides the file. The packaged configuration must read (no line of it is refused), and
-# with its camera, button and folder pointed at ones this machine has (the synthetic camera, a
-# FIFO, a new folder) it must pass; where the machine lacks /dev/video0 and /var/lib/refocusd (the
-# usual build host) it must name both.
+# Checks a board package made by scripts/package.sh as an installer and the board would see it:
+# the files at their places, the conffile, the architecture and release in the version, a
+# dependency for every library the programs link (each library's package looked up in ROOT, the
+# release's own root that the package was built in), and the packaged refocusd running under
+# qemu-user with ROOT's libraries: --version lists the libcamera backend, and --check-config
+# checks the camera, the button and the photo folder besides the file. The packaged
+# configuration must read (no line of it is refused), and with its camera, button and folder
+# pointed at ones this machine has (the synthetic camera, a FIFO, a new folder) it must pass;
+# where the machine lacks /dev/video0 and /var/lib/refocusd (the usual build host) it must name
+# both.
 #
-#   check_deb.sh BUILD_DIR [EMULATOR ARGS...]
+#   check_deb.sh DEB ROOT
 #
-# EMULATOR defaults to qemu-aarch64-static with the libraries of build/sysroot/arm64. Exit 0 when
-# every check passes, 1 otherwise, 77 (skip) without cpack, dpkg-deb or the emulator.
+# Exit 0 when every check passes, 1 otherwise, 77 (skip) without dpkg-deb or qemu-user.
 set -euo pipefail
-build=$(cd "${1:?usage: check_deb.sh BUILD_DIR [EMULATOR ARGS...]}" && pwd)
-shift
-emulator=("$@")
+deb=$(realpath "${1:?usage: check_deb.sh DEB ROOT}")
+root=$(realpath "${2:?usage: check_deb.sh DEB ROOT}")
+source_dir=$(cd "$(dirname "$0")/../../.." && pwd)
 
 fail() { echo "check_deb: $*" >&2; exit 1; }
-cache_value() { sed -n "s/^$1:[A-Z]*=//p" "$build/CMakeCache.txt"; }
 
-for tool in cpack dpkg-deb; do
-  command -v "$tool" >/dev/null || { echo "SKIP: $tool not installed"; exit 77; }
-done
-version=$(cache_value CMAKE_PROJECT_VERSION)
-source_dir=$(cache_value lensblur_SOURCE_DIR)
-[[ -n $version && -n $source_dir ]] || fail "$build is not a configured build tree"
-if ((${#emulator[@]} == 0)); then
-  sysroot=$source_dir/build/sysroot/arm64
-  emulator=(qemu-aarch64-static -L /usr/aarch64-linux-gnu -E
-            "LD_LIBRARY_PATH=$sysroot/usr/lib/aarch64-linux-gnu:$sysroot/lib/aarch64-linux-gnu")
-fi
-command -v "${emulator[0]}" >/dev/null || { echo "SKIP: ${emulator[0]} not installed"; exit 77; }
+command -v dpkg-deb >/dev/null || { echo "SKIP: dpkg-deb not installed"; exit 77; }
+field() { dpkg-deb -f "$deb" "$1"; }
+arch=$(field Architecture)
+case $arch in
+  arm64) qemu=qemu-aarch64-static machine=AArch64 triple=aarch64-linux-gnu ;;
+  armhf) qemu=qemu-arm-static machine=ARM triple=arm-linux-gnueabihf ;;
+  *) fail "architecture $arch, not arm64 or armhf" ;;
+esac
+command -v "$qemu" >/dev/null || { echo "SKIP: $qemu not installed"; exit 77; }
+emulator=("$qemu" -L "$root")
+version=$(sed -n 's/^project(lensblur VERSION \([0-9.]*\).*/\1/p' "$source_dir/CMakeLists.txt")
+[[ -n $version ]] || fail "cannot read the project's version"
+[[ -d $root/var/lib/dpkg ]] || fail "$root is not a Debian root"
+release=$(sed -n 's/^VERSION_ID="\([0-9]*\)"/\1/p' "$root/etc/os-release")
+[[ -n $release ]] || fail "cannot tell the release of $root"
 
-work=$build/deb-check
-rm -rf "$work" && mkdir -p "$work"
-(cd "$build" && cpack -G DEB -B "$work" >"$work/cpack.log" 2>&1) ||
-  { cat "$work/cpack.log"; fail "cpack failed"; }
-debs=("$work"/*.deb)
-((${#debs[@]} == 1)) || fail "expected one .deb in $work, found ${#debs[@]}"
-deb=${debs[0]}
-echo "check_deb: $(basename "$deb")"
-
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+echo "check_deb: $(basename "$deb") against Debian $release"
 dpkg-deb -c "$deb" >"$work/contents.txt"
 cat "$work/contents.txt"
 for entry in "-rwxr-xr-x ./usr/bin/refocusd" "-rwxr-xr-x ./usr/bin/refocus" \
@@ -52,10 +49,9 @@ for entry in "-rwxr-xr-x ./usr/bin/refocusd" "-rwxr-xr-x ./usr/bin/refocus" \
     fail "the package lacks $path with mode $mode owned by root"
 done
 
-field() { dpkg-deb -f "$deb" "$1"; }
 [[ $(field Package) == refocusd ]] || fail "package name $(field Package), not refocusd"
-[[ $(field Architecture) == arm64 ]] || fail "architecture $(field Architecture), not arm64"
-[[ $(field Version) == "$version" ]] || fail "version $(field Version), not $version"
+[[ $(field Version) == "$version+deb$release" ]] ||
+  fail "version $(field Version), not $version+deb$release"
 dpkg-deb --ctrl-tarfile "$deb" | tar -xO ./conffiles | grep -qx /etc/refocusd.conf ||
   fail "/etc/refocusd.conf is not a conffile"
 # The web page: every file of the source's www/ is in the package (the page that web_root's
@@ -74,31 +70,28 @@ depends=$(field Depends)
 echo "check_deb: Depends: $depends"
 
 dpkg-deb -x "$deb" "$work/root"
-readelf=$(command -v aarch64-linux-gnu-readelf || command -v readelf)
+# The package of the release that ships a library, as ROOT's dpkg database says.
+owner() {
+  dpkg --admindir="$root/var/lib/dpkg" -S "*/$1" 2>/dev/null |
+    sed -n "s|^\([^:]*\):$arch: .*/$1\$|\1|p" | head -n1
+}
+camera_linked=0
 for program in refocusd refocus; do
   file=$work/root/usr/bin/$program
-  "$readelf" -h "$file" | grep -q 'Machine: *AArch64' || fail "$program is not an AArch64 program"
-  for lib in $("$readelf" -d "$file" | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p'); do
-    case $lib in
-      libc.so.6 | libm.so.6 | ld-linux-aarch64.so.1) pkg=libc6 ;;
-      libstdc++.so.6) pkg=libstdc++6 ;;
-      libgcc_s.so.1) pkg=libgcc-s1 ;;
-      libjpeg.so.62) pkg=libjpeg62-turbo ;;
-      libpng16.so.16) pkg=libpng16-16 ;;
-      libexif.so.12) pkg=libexif12 ;;
-      libmd.so.0) pkg=libmd0 ;;
-      libz.so.1) pkg=zlib1g ;;
-      libmicrohttpd.so.12) pkg=libmicrohttpd12 ;;
-      libcamera.so.* | libcamera-base.so.*) pkg=libcamera0.0.3 ;;
-      *) fail "$program links $lib, which no known package provides" ;;
-    esac
-    [[ ", $depends," == *", $pkg"[\ ,]* ]] || fail "$program links $lib but Depends lacks $pkg"
+  readelf -h "$file" | grep -q "Machine: *$machine" || fail "$program is not an $machine program"
+  for lib in $(readelf -d "$file" | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p'); do
+    pkg=$(owner "$lib")
+    [[ -n $pkg ]] || fail "$program links $lib, which no package of $root provides"
+    [[ ", $depends," == *", $pkg "[\(,]* || ", $depends," == *", $pkg,"* ]] ||
+      fail "$program links $lib ($pkg) but Depends lacks $pkg"
+    [[ $lib == libcamera.so.* ]] && camera_linked=1
   done
 done
-
+((camera_linked)) || fail "refocusd does not link libcamera: the package has no libcamera backend"
 out=$("${emulator[@]}" "$work/root/usr/bin/refocusd" --version) || fail "refocusd --version failed"
 echo "check_deb: packaged refocusd --version: $out"
-[[ $out == "refocusd $version (sensor backends: "* ]] || fail "unexpected --version output: $out"
+[[ $out == "refocusd $version (sensor backends: "*libcamera* ]] ||
+  fail "--version does not list the libcamera backend: $out"
 conf=$work/root/etc/refocusd.conf
 status=0
 out=$("${emulator[@]}" "$work/root/usr/bin/refocusd" --check-config --config "$conf" 2>&1) ||

@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# The board's Debian package for one release and architecture, built against that release's own
+# libraries: a root of the release (scripts/debian-root.sh) with its cross compiler and the
+# target's -dev packages installed by apt, a Release build of the programs in it, and cpack with
+# dpkg-shlibdeps stating the dependencies the release's apt resolves.
+#
+#   package.sh [--root-only] SUITE ARCH   SUITE: bookworm (Debian 12) or trixie (Debian 13)
+#                                         ARCH:  arm64 or armhf
+# Writes build/packages/refocusd_<version>+deb<N>_<ARCH>.deb and prints its path last; the
+# release's root stays in build/roots/SUITE-cross-ARCH. --root-only makes the root and stops.
+set -euo pipefail
+root_only=0
+[[ ${1:-} == --root-only ]] && { root_only=1; shift; }
+suite=${1:?usage: package.sh [--root-only] bookworm|trixie arm64|armhf}
+arch=${2:?usage: package.sh [--root-only] bookworm|trixie arm64|armhf}
+top=$(cd "$(dirname "$0")/.." && pwd)
+case $suite in
+  bookworm) release=deb12 ;;
+  trixie) release=deb13 ;;
+  *) echo "package: unknown release $suite (bookworm or trixie)" >&2; exit 2 ;;
+esac
+case $arch in
+  arm64) triple=aarch64-linux-gnu ;;
+  armhf) triple=arm-linux-gnueabihf ;;
+  *) echo "package: unknown architecture $arch (arm64 or armhf)" >&2; exit 2 ;;
+esac
+
+root=$top/build/roots/$suite-cross-$arch
+libs=(libjpeg62-turbo-dev libpng-dev libexif-dev libmd-dev libmicrohttpd-dev libcamera-dev)
+bash "$top/scripts/debian-root.sh" make "$root" "$suite" "amd64,$arch" \
+  "crossbuild-essential-$arch" cmake ninja-build pkg-config dpkg-dev file libeigen3-dev \
+  "${libs[@]/%/:$arch}"
+((root_only)) && exit 0
+
+tree=build/package/$suite-$arch
+out=$top/build/packages
+mkdir -p "$out"
+bash "$top/scripts/debian-root.sh" run "$root" "
+  set -e
+  cmake -S . -B $tree -G Ninja -DCMAKE_TOOLCHAIN_FILE=toolchains/$triple.cmake -DLB_MULTIARCH=ON \
+    -DCMAKE_BUILD_TYPE=Release -DLB_TESTS=OFF -DLB_BENCHMARKS=OFF -DLB_DEB_RELEASE=$release >/dev/null
+  cmake --build $tree -j ${JOBS:-$(nproc)}
+  rm -f $tree/*.deb
+  cd $tree && DEB_HOST_ARCH=$arch cpack -G DEB >cpack.log 2>&1 || { cat cpack.log; exit 1; }"
+debs=("$top/$tree"/*.deb)
+((${#debs[@]} == 1)) || { echo "package: expected one .deb in $tree" >&2; exit 1; }
+cp "${debs[0]}" "$out/"
+echo "$out/$(basename "${debs[0]}")"
