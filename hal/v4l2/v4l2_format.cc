@@ -14,6 +14,10 @@ FourccText FourccName(uint32_t fourcc) {
   return name;
 }
 
+bool IsJpegFourcc(uint32_t fourcc) {
+  return fourcc == V4L2_PIX_FMT_MJPEG || fourcc == V4L2_PIX_FMT_JPEG;
+}
+
 bool FourccToPixelFormat(uint32_t fourcc, PixelFormat* format) {
   switch (fourcc) {
     case V4L2_PIX_FMT_YUYV:
@@ -28,16 +32,21 @@ bool FourccToPixelFormat(uint32_t fourcc, PixelFormat* format) {
     case V4L2_PIX_FMT_BGR24:
       *format = PixelFormat::kBgr8;
       return true;
+    case V4L2_PIX_FMT_MJPEG:
+    case V4L2_PIX_FMT_JPEG:
+      *format = PixelFormat::kRgb8;
+      return true;
     default:
       return false;
   }
 }
 
-Status ChooseFourcc(const char* device, const uint32_t* listed, size_t count, uint32_t wanted,
-                    uint32_t* chosen) {
-  auto is_listed = [&](uint32_t fourcc) {
+Status ChooseFourcc(const char* device, const uint32_t* listed, const bool* at_size, size_t count,
+                    uint32_t wanted, uint32_t* chosen) {
+  // Whether `fourcc` is listed, and if `sized`, offered at the wanted size too.
+  auto offered = [&](uint32_t fourcc, bool sized) {
     for (size_t i = 0; i < count; ++i) {
-      if (listed[i] == fourcc) return true;
+      if (listed[i] == fourcc && (!sized || at_size == nullptr || at_size[i])) return true;
     }
     return false;
   };
@@ -47,28 +56,38 @@ Status ChooseFourcc(const char* device, const uint32_t* listed, size_t count, ui
       return Status(Code::kUnsupported, "%s: format %s is not one the pipeline reads", device,
                     FourccName(wanted).text);
     }
-    if (!is_listed(wanted)) {
+    if (!offered(wanted, false)) {
       return Status(Code::kUnsupported, "%s: the device does not offer format %s", device,
                     FourccName(wanted).text);
     }
     *chosen = wanted;
     return Status::Ok();
   }
-  for (uint32_t fourcc : kV4l2Preferred) {
-    if (is_listed(fourcc)) {
-      *chosen = fourcc;
-      return Status::Ok();
+  for (int pass = 0; pass < 2; ++pass) {
+    const bool sized = pass == 0;
+    for (uint32_t fourcc : kV4l2Preferred) {
+      if (offered(fourcc, sized)) {
+        *chosen = fourcc;
+        return Status::Ok();
+      }
+    }
+    for (uint32_t fourcc : kV4l2Compressed) {
+      if (offered(fourcc, sized)) {
+        *chosen = fourcc;
+        return Status::Ok();
+      }
     }
   }
-  char offered[96] = "nothing";
+  char offers[96] = "nothing";
   size_t used = 0;
-  for (size_t i = 0; i < count && used + 6 < sizeof(offered); ++i) {
-    used += static_cast<size_t>(snprintf(offered + used, sizeof(offered) - used, "%s%s",
-                                         i ? " " : "", FourccName(listed[i]).text));
+  for (size_t i = 0; i < count && used + 6 < sizeof(offers); ++i) {
+    used += static_cast<size_t>(snprintf(offers + used, sizeof(offers) - used, "%s%s", i ? " " : "",
+                                         FourccName(listed[i]).text));
   }
   return Status(Code::kUnsupported,
-                "%s: offers %s; the pipeline reads YUYV, NV12, RGB3 (RGB24) or BGR3 (BGR24)",
-                device, offered);
+                "%s: offers %s; the pipeline reads YUYV, NV12, RGB3 (RGB24), BGR3 (BGR24), MJPG "
+                "or JPEG",
+                device, offers);
 }
 
 Status LayoutFromFormat(const char* device, const v4l2_pix_format& pix, uint32_t requested,
@@ -90,6 +109,17 @@ Status LayoutFromFormat(const char* device, const v4l2_pix_format& pix, uint32_t
       pix.height > kMaxFrameSide) {
     return Status(Code::kUnsupported, "%s: frame size %ux%u outside 1x1..%dx%d", device, pix.width,
                   pix.height, kMaxFrameSide, kMaxFrameSide);
+  }
+  if (IsJpegFourcc(pix.pixelformat)) {
+    // Rows come from the decoder, not from the buffer; bytesused says how long each frame is.
+    layout->format = format;
+    layout->width = static_cast<int32_t>(pix.width);
+    layout->height = static_cast<int32_t>(pix.height);
+    layout->stride = 0;
+    layout->uv_offset = 0;
+    layout->min_bytes = kMinJpegBytes;
+    layout->compressed = true;
+    return Status::Ok();
   }
   if (format == PixelFormat::kYuyv && pix.width % 2 != 0) {
     return Status(Code::kUnsupported, "%s: YUYV with odd width %u", device, pix.width);
@@ -117,6 +147,7 @@ Status LayoutFromFormat(const char* device, const v4l2_pix_format& pix, uint32_t
   layout->stride = static_cast<ptrdiff_t>(stride);
   layout->uv_offset = format == PixelFormat::kNv12 ? plane0 : 0;
   layout->min_bytes = need;
+  layout->compressed = false;
   return Status::Ok();
 }
 

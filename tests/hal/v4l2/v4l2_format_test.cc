@@ -18,7 +18,7 @@ v4l2_pix_format Pix(uint32_t fourcc, uint32_t w, uint32_t h, uint32_t stride, ui
   return p;
 }
 
-TEST(V4l2FormatTest, MapsTheFourFormatsThePipelineReads) {
+TEST(V4l2FormatTest, MapsTheFormatsThePipelineReads) {
   PixelFormat f;
   ASSERT_TRUE(FourccToPixelFormat(V4L2_PIX_FMT_YUYV, &f));
   EXPECT_EQ(f, PixelFormat::kYuyv);
@@ -28,7 +28,12 @@ TEST(V4l2FormatTest, MapsTheFourFormatsThePipelineReads) {
   EXPECT_EQ(f, PixelFormat::kRgb8);
   ASSERT_TRUE(FourccToPixelFormat(V4L2_PIX_FMT_BGR24, &f));
   EXPECT_EQ(f, PixelFormat::kBgr8);
-  EXPECT_FALSE(FourccToPixelFormat(V4L2_PIX_FMT_MJPEG, &f));
+  // Decoded by the sensor: the sink receives RGB.
+  ASSERT_TRUE(FourccToPixelFormat(V4L2_PIX_FMT_MJPEG, &f));
+  EXPECT_EQ(f, PixelFormat::kRgb8);
+  ASSERT_TRUE(FourccToPixelFormat(V4L2_PIX_FMT_JPEG, &f));
+  EXPECT_EQ(f, PixelFormat::kRgb8);
+  EXPECT_FALSE(FourccToPixelFormat(V4L2_PIX_FMT_H264, &f));
   EXPECT_STREQ(FourccName(V4L2_PIX_FMT_YUYV).text, "YUYV");
 }
 
@@ -55,19 +60,76 @@ TEST(V4l2FormatTest, AnExplicitFormatMustBeOfferedAndReadable) {
   Status s = ChooseFourcc("/dev/video0", offered, 3, V4L2_PIX_FMT_NV12, &chosen);
   EXPECT_EQ(s.code(), Code::kUnsupported);
   EXPECT_NE(std::string(s.message()).find("NV12"), std::string::npos) << s.message();
-  s = ChooseFourcc("/dev/video0", offered, 3, V4L2_PIX_FMT_MJPEG, &chosen);
+  ASSERT_TRUE(ChooseFourcc("/dev/video0", offered, 3, V4L2_PIX_FMT_MJPEG, &chosen).ok());
+  EXPECT_EQ(chosen, V4L2_PIX_FMT_MJPEG);
+  s = ChooseFourcc("/dev/video0", offered, 3, V4L2_PIX_FMT_JPEG, &chosen);
   EXPECT_EQ(s.code(), Code::kUnsupported);
+  s = ChooseFourcc("/dev/video0", offered, 3, V4L2_PIX_FMT_H264, &chosen);
+  EXPECT_EQ(s.code(), Code::kUnsupported);
+  EXPECT_NE(std::string(s.message()).find("not one the pipeline reads"), std::string::npos);
+}
+
+TEST(V4l2FormatTest, MjpegOnlyWhereNothingUncompressedHasTheSize) {
+  uint32_t chosen = 0;
+  const uint32_t offered[] = {V4L2_PIX_FMT_MJPEG, V4L2_PIX_FMT_YUYV, V4L2_PIX_FMT_JPEG,
+                              V4L2_PIX_FMT_NV12};
+  // YUYV and NV12 at the size: uncompressed first, whatever the driver's order.
+  const bool all[] = {true, true, true, true};
+  ASSERT_TRUE(ChooseFourcc("/dev/video0", offered, all, 4, 0, &chosen).ok());
+  EXPECT_EQ(chosen, V4L2_PIX_FMT_YUYV);
+  const bool nv12[] = {true, false, true, true};
+  ASSERT_TRUE(ChooseFourcc("/dev/video0", offered, nv12, 4, 0, &chosen).ok());
+  EXPECT_EQ(chosen, V4L2_PIX_FMT_NV12);
+  // Only the compressed ones have it: MJPEG before JPEG.
+  const bool compressed[] = {true, false, true, false};
+  ASSERT_TRUE(ChooseFourcc("/dev/video0", offered, compressed, 4, 0, &chosen).ok());
+  EXPECT_EQ(chosen, V4L2_PIX_FMT_MJPEG);
+  const bool jpeg[] = {false, false, true, false};
+  ASSERT_TRUE(ChooseFourcc("/dev/video0", offered, jpeg, 4, 0, &chosen).ok());
+  EXPECT_EQ(chosen, V4L2_PIX_FMT_JPEG);
+  // Nothing has it: uncompressed, at the size the driver picks.
+  const bool none[] = {false, false, false, false};
+  ASSERT_TRUE(ChooseFourcc("/dev/video0", offered, none, 4, 0, &chosen).ok());
+  EXPECT_EQ(chosen, V4L2_PIX_FMT_YUYV);
+  ASSERT_TRUE(ChooseFourcc("/dev/video0", offered, none, 1, 0, &chosen).ok());
+  EXPECT_EQ(chosen, V4L2_PIX_FMT_MJPEG);
+  // Asked for by name, the size does not matter.
+  ASSERT_TRUE(ChooseFourcc("/dev/video0", offered, none, 4, V4L2_PIX_FMT_JPEG, &chosen).ok());
+  EXPECT_EQ(chosen, V4L2_PIX_FMT_JPEG);
 }
 
 TEST(V4l2FormatTest, NothingReadableNamesWhatTheDeviceOffers) {
   uint32_t chosen = 0;
-  const uint32_t offered[] = {V4L2_PIX_FMT_MJPEG, V4L2_PIX_FMT_SRGGB10};
+  const uint32_t offered[] = {V4L2_PIX_FMT_H264, V4L2_PIX_FMT_SRGGB10};
   Status s = ChooseFourcc("/dev/video3", offered, 2, 0, &chosen);
   ASSERT_EQ(s.code(), Code::kUnsupported);
   std::string m = s.message();
   EXPECT_NE(m.find("/dev/video3"), std::string::npos) << m;
-  EXPECT_NE(m.find("MJPG"), std::string::npos) << m;
+  EXPECT_NE(m.find("H264"), std::string::npos) << m;
   EXPECT_NE(m.find("RG10"), std::string::npos) << m;
+  EXPECT_NE(m.find("MJPG or JPEG"), std::string::npos) << m;
+}
+
+TEST(V4l2FormatTest, MjpegLayoutIsCompressedRgb) {
+  V4l2Layout l;
+  // UVC drivers report no bytesperline and the largest frame as sizeimage; odd sizes are fine.
+  ASSERT_TRUE(LayoutFromFormat("/dev/video0", Pix(V4L2_PIX_FMT_MJPEG, 1279, 719, 0, 1843200),
+                               V4L2_PIX_FMT_MJPEG, &l)
+                  .ok());
+  EXPECT_TRUE(l.compressed);
+  EXPECT_EQ(l.format, PixelFormat::kRgb8);
+  EXPECT_EQ(l.width, 1279);
+  EXPECT_EQ(l.height, 719);
+  EXPECT_EQ(l.stride, 0);
+  EXPECT_EQ(l.min_bytes, kMinJpegBytes);
+  ASSERT_TRUE(
+      LayoutFromFormat("/dev/video0", Pix(V4L2_PIX_FMT_YUYV, 64, 48, 0, 0), V4L2_PIX_FMT_YUYV, &l)
+          .ok());
+  EXPECT_FALSE(l.compressed);
+  EXPECT_EQ(LayoutFromFormat("/dev/video0", Pix(V4L2_PIX_FMT_MJPEG, 9000, 48, 0, 0),
+                             V4L2_PIX_FMT_MJPEG, &l)
+                .code(),
+            Code::kUnsupported);
 }
 
 TEST(V4l2FormatTest, PaddedYuyvLayout) {
