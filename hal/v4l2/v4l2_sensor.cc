@@ -41,7 +41,10 @@ V4l2Sensor::V4l2Sensor(const V4l2Options& options, V4l2Io* io)
     : io_(io ? io : &SystemV4l2Io()),
       wanted_fourcc_(options.fourcc),
       wanted_buffers_(options.buffers),
-      wanted_fps_(options.fps) {
+      wanted_fps_(options.fps),
+      max_corrupt_(options.max_corrupt_frames),
+      log_(options.log),
+      log_context_(options.log_context) {
   snprintf(device_, sizeof(device_), "%s", options.device ? options.device : "");
 }
 
@@ -119,10 +122,20 @@ Status V4l2Sensor::Configure(const SensorConfig& config, SensorMode* mode) {
     return Status(Code::kInvalidArgument, "%s: %d buffers requested, 2..%d allowed", device_,
                   wanted_buffers_, V4l2Options::kMaxBuffers);
   }
+  if (max_corrupt_ < 0 || max_corrupt_ > kMaxFrames) {
+    return Status(Code::kInvalidArgument, "%s: %d corrupt frames allowed, 0..%d", device_,
+                  max_corrupt_, kMaxFrames);
+  }
   config_ = config;
   Status status = OpenAndNegotiate(config);
   if (status.ok()) status = SetFrameRate();
   if (status.ok()) status = MapBuffers();
+  if (status.ok() && layout_.compressed) {
+    status = decoder_.Configure(layout_.width, layout_.height);
+    if (!status.ok()) status.Prefix("%s: ", device_);
+  } else if (status.ok()) {
+    decoder_.Release();
+  }
   if (!status.ok()) {
     Stop();
     return status;
@@ -150,7 +163,15 @@ Status V4l2Sensor::OpenAndNegotiate(const SensorConfig& config) {
     return IoctlError("VIDIOC_QUERYCAP", -r);
   LB_RETURN_IF_ERROR(CheckCaps(cap));
 
+  v4l2_format fmt;
+  memset(&fmt, 0, sizeof(fmt));
+  fmt.type = kCapture;
+  if (int r = io_->Ioctl(fd_, VIDIOC_G_FMT, &fmt); r < 0) return IoctlError("VIDIOC_G_FMT", -r);
+  if (config.width > 0) fmt.fmt.pix.width = static_cast<uint32_t>(config.width);
+  if (config.height > 0) fmt.fmt.pix.height = static_cast<uint32_t>(config.height);
+
   uint32_t listed[64];
+  bool at_size[64];
   size_t count = 0;
   for (; count < 64; ++count) {
     v4l2_fmtdesc desc;
@@ -161,21 +182,39 @@ Status V4l2Sensor::OpenAndNegotiate(const SensorConfig& config) {
     if (r == -EINVAL) break;  // the end of the list
     if (r < 0) return IoctlError("VIDIOC_ENUM_FMT", -r);
     listed[count] = desc.pixelformat;
+    at_size[count] = OffersSize(desc.pixelformat, fmt.fmt.pix.width, fmt.fmt.pix.height);
   }
-  LB_RETURN_IF_ERROR(ChooseFourcc(device_, listed, count, wanted_fourcc_, &fourcc_));
+  LB_RETURN_IF_ERROR(ChooseFourcc(device_, listed, at_size, count, wanted_fourcc_, &fourcc_));
 
-  v4l2_format fmt;
-  memset(&fmt, 0, sizeof(fmt));
-  fmt.type = kCapture;
-  if (int r = io_->Ioctl(fd_, VIDIOC_G_FMT, &fmt); r < 0) return IoctlError("VIDIOC_G_FMT", -r);
-  if (config.width > 0) fmt.fmt.pix.width = static_cast<uint32_t>(config.width);
-  if (config.height > 0) fmt.fmt.pix.height = static_cast<uint32_t>(config.height);
   fmt.fmt.pix.pixelformat = fourcc_;
   fmt.fmt.pix.field = V4L2_FIELD_NONE;
   fmt.fmt.pix.bytesperline = 0;  // let the driver pick its natural stride
   fmt.fmt.pix.sizeimage = 0;
   if (int r = io_->Ioctl(fd_, VIDIOC_S_FMT, &fmt); r < 0) return IoctlError("VIDIOC_S_FMT", -r);
   return LayoutFromFormat(device_, fmt.fmt.pix, fourcc_, &layout_);
+}
+
+bool V4l2Sensor::OffersSize(uint32_t fourcc, uint32_t width, uint32_t height) {
+  // A UVC camera lists a few dozen sizes at most.
+  for (uint32_t index = 0; index < 256; ++index) {
+    v4l2_frmsizeenum size;
+    memset(&size, 0, sizeof(size));
+    size.index = index;
+    size.pixel_format = fourcc;
+    if (io_->Ioctl(fd_, VIDIOC_ENUM_FRAMESIZES, &size) < 0) return index == 0;
+    if (size.type == V4L2_FRMSIZE_TYPE_DISCRETE) {
+      if (size.discrete.width == width && size.discrete.height == height) return true;
+      continue;
+    }
+    // Stepwise or continuous: one range, the only entry.
+    const v4l2_frmsize_stepwise& r = size.stepwise;
+    auto within = [](uint32_t v, uint32_t lo, uint32_t hi, uint32_t step) {
+      return v >= lo && v <= hi && (step == 0 || (v - lo) % step == 0);
+    };
+    return within(width, r.min_width, r.max_width, r.step_width) &&
+           within(height, r.min_height, r.max_height, r.step_height);
+  }
+  return false;
 }
 
 Status V4l2Sensor::SetFrameRate() {
@@ -292,7 +331,9 @@ Status V4l2Sensor::Stream(FrameSink& sink) {
   }
   streaming_ = true;
   sequence_.Reset();
-  for (int32_t i = 0; i < config_.frames; ++i) {
+  corrupt_frames_ = 0;
+  int32_t with_driver = buffer_count_;
+  for (int32_t i = 0; i < config_.frames;) {
     v4l2_buffer buf;
     for (;;) {
       LB_RETURN_IF_ERROR(WaitFrame());
@@ -304,6 +345,7 @@ Status V4l2Sensor::Stream(FrameSink& sink) {
       if (r < 0) return IoctlError("VIDIOC_DQBUF", -r);
       break;
     }
+    --with_driver;
     if (buf.index >= static_cast<uint32_t>(buffer_count_)) {
       return Status(Code::kInternal, "%s: the driver returned buffer %u of %d", device_, buf.index,
                     buffer_count_);
@@ -323,18 +365,28 @@ Status V4l2Sensor::Stream(FrameSink& sink) {
                     "%s: frame %d (sequence %u) flagged bad by the driver; burst abandoned",
                     device_, i, buf.sequence);
     }
-    if (buf.bytesused != 0 && buf.bytesused < layout_.min_bytes) {
-      return Status(Code::kCorruptData, "%s: frame %d holds %u bytes, %zu expected", device_, i,
-                    buf.bytesused, layout_.min_bytes);
+    if (layout_.compressed) {
+      bool delivered = false;
+      LB_RETURN_IF_ERROR(DeliverMjpeg(sink, buf, i, &delivered));
+      if (delivered) ++i;
+    } else {
+      if (buf.bytesused != 0 && buf.bytesused < layout_.min_bytes) {
+        return Status(Code::kCorruptData, "%s: frame %d holds %u bytes, %zu expected", device_, i,
+                      buf.bytesused, layout_.min_bytes);
+      }
+      LB_RETURN_IF_ERROR(Deliver(sink, buf, i));
+      ++i;
     }
-    LB_RETURN_IF_ERROR(Deliver(sink, buf, i));
     // Requeue only buffers still needed, so the tail of the burst does not wait on the driver.
-    if (i + buffer_count_ < config_.frames) LB_RETURN_IF_ERROR(QueueBuffer(buf.index));
+    if (with_driver < config_.frames - i) {
+      LB_RETURN_IF_ERROR(QueueBuffer(buf.index));
+      ++with_driver;
+    }
   }
   return Status::Ok();
 }
 
-Status V4l2Sensor::Deliver(FrameSink& sink, const v4l2_buffer& buf, int32_t index) {
+FrameInfo V4l2Sensor::Info(const v4l2_buffer& buf, int32_t index) const {
   FrameInfo info;
   info.index = index;
   info.format = layout_.format;
@@ -343,6 +395,10 @@ Status V4l2Sensor::Deliver(FrameSink& sink, const v4l2_buffer& buf, int32_t inde
   info.timestamp_ns = static_cast<int64_t>(buf.timestamp.tv_sec) * 1000000000 +
                       static_cast<int64_t>(buf.timestamp.tv_usec) * 1000;
   info.sequence = buf.sequence;
+  return info;
+}
+
+Status V4l2Sensor::Deliver(FrameSink& sink, const v4l2_buffer& buf, int32_t index) {
   const uint8_t* base = static_cast<const uint8_t*>(buffers_[buf.index].addr);
   FrameRows rows;
   rows.y0 = 0;
@@ -353,11 +409,43 @@ Status V4l2Sensor::Deliver(FrameSink& sink, const v4l2_buffer& buf, int32_t inde
     rows.planes[1] = base + layout_.uv_offset;
     rows.strides[1] = layout_.stride;
   }
-  Status status = sink.BeginFrame(info);
+  Status status = sink.BeginFrame(Info(buf, index));
   if (status.ok()) status = sink.Rows(rows);
   if (status.ok()) status = sink.EndFrame();
   if (!status.ok()) status.Prefix("%s: frame %d: ", device_, index);
   return status;
+}
+
+Status V4l2Sensor::DeliverMjpeg(FrameSink& sink, const v4l2_buffer& buf, int32_t index,
+                                bool* delivered) {
+  const Buffer& b = buffers_[buf.index];
+  bool began = false;
+  Status status;
+  if (buf.bytesused > b.length) {
+    status =
+        Status(Code::kCorruptData, "%u bytes used in a buffer of %zu", buf.bytesused, b.length);
+  } else {
+    status = decoder_.Decode(static_cast<const uint8_t*>(b.addr), buf.bytesused, Info(buf, index),
+                             sink, &began);
+  }
+  *delivered = status.ok();
+  if (status.ok()) return status;
+  if (began) return status.Prefix("%s: frame %d (sequence %u): ", device_, index, buf.sequence);
+  ++corrupt_frames_;
+  if (corrupt_frames_ > max_corrupt_) {
+    return status.Prefix(
+        "%s: %d corrupt MJPEG frames in this burst, at most %d skipped; burst abandoned; the "
+        "last (sequence %u): ",
+        device_, corrupt_frames_, max_corrupt_, buf.sequence);
+  }
+  if (log_ != nullptr) {
+    char line[Status::kMaxMessage + 96];
+    snprintf(line, sizeof(line),
+             "%s: corrupt MJPEG frame (sequence %u) skipped, %d of at most %d this burst: %s",
+             device_, buf.sequence, corrupt_frames_, max_corrupt_, status.message());
+    log_(log_context_, line);
+  }
+  return Status::Ok();
 }
 
 void V4l2Sensor::Stop() {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 
 namespace lb {
@@ -29,7 +30,34 @@ int FakeV4l2::Close(int fd) {
   return 0;
 }
 
+bool FakeV4l2::Compressed() const {
+  return pix_.pixelformat == V4L2_PIX_FMT_MJPEG || pix_.pixelformat == V4L2_PIX_FMT_JPEG;
+}
+
+void FakeV4l2::PickSize(v4l2_pix_format* p) const {
+  const FrameSize* best = nullptr;
+  int64_t best_distance = 0;
+  for (const FrameSize& s : sizes) {
+    if (s.fourcc != p->pixelformat) continue;
+    const int64_t d =
+        std::abs(int64_t{s.width} - p->width) + std::abs(int64_t{s.height} - p->height);
+    if (best == nullptr || d < best_distance) {
+      best = &s;
+      best_distance = d;
+    }
+  }
+  if (best != nullptr) {
+    p->width = best->width;
+    p->height = best->height;
+    return;
+  }
+  p->width = std::min(std::max(p->width, 2u), width) & ~1u;
+  p->height = std::min(std::max(p->height, 2u), height) & ~1u;
+}
+
 size_t FakeV4l2::ImageBytes() const {
+  // A UVC driver's usual bound for a compressed frame.
+  if (Compressed()) return static_cast<size_t>(pix_.width) * pix_.height * 2;
   size_t plane0 = static_cast<size_t>(pix_.bytesperline) * pix_.height;
   return pix_.pixelformat == V4L2_PIX_FMT_NV12 ? plane0 + plane0 / 2 : plane0;
 }
@@ -52,6 +80,24 @@ int FakeV4l2::Ioctl(int fd, unsigned long request, void* arg) {
       desc->pixelformat = formats[desc->index];
       return 0;
     }
+    case VIDIOC_ENUM_FRAMESIZES: {
+      auto* size = static_cast<v4l2_frmsizeenum*>(arg);
+      uint32_t n = 0;
+      for (const FrameSize& s : sizes) {
+        if (s.fourcc != size->pixel_format) continue;
+        if (n++ == size->index) {
+          size->type = V4L2_FRMSIZE_TYPE_DISCRETE;
+          size->discrete = {s.width, s.height};
+          return 0;
+        }
+      }
+      if (n > 0 || size->index > 0) return -EINVAL;
+      if (std::find(formats.begin(), formats.end(), size->pixel_format) == formats.end())
+        return -EINVAL;
+      size->type = V4L2_FRMSIZE_TYPE_STEPWISE;
+      size->stepwise = {2, width, 2, 2, height, 2};
+      return 0;
+    }
     case VIDIOC_G_FMT:
       static_cast<v4l2_format*>(arg)->fmt.pix = pix_;
       return 0;
@@ -61,13 +107,13 @@ int FakeV4l2::Ioctl(int fd, unsigned long request, void* arg) {
       if (std::find(formats.begin(), formats.end(), p.pixelformat) == formats.end()) {
         p.pixelformat = formats[0];
       }
-      p.width = std::min(std::max(p.width, 2u), width) & ~1u;
-      p.height = std::min(std::max(p.height, 2u), height) & ~1u;
+      PickSize(&p);
       uint32_t bpp = p.pixelformat == V4L2_PIX_FMT_YUYV   ? 2
                      : p.pixelformat == V4L2_PIX_FMT_NV12 ? 1
                                                           : 3;
-      p.bytesperline = p.width * bpp + line_padding;
       p.field = V4L2_FIELD_NONE;
+      pix_ = p;
+      p.bytesperline = Compressed() ? 0 : p.width * bpp + line_padding;
       pix_ = p;
       p.sizeimage = static_cast<uint32_t>(ImageBytes());
       pix_ = p;
@@ -80,6 +126,7 @@ int FakeV4l2::Ioctl(int fd, unsigned long request, void* arg) {
       req->count = granted_buffers;
       buffers_.assign(granted_buffers, std::vector<uint8_t>(ImageBytes() + 64));
       queued_.clear();
+      queued_.reserve(granted_buffers);
       return 0;
     }
     case VIDIOC_QUERYBUF: {
@@ -102,10 +149,9 @@ int FakeV4l2::Ioctl(int fd, unsigned long request, void* arg) {
       if (queued_.empty() || delivered_ == stall_after) return -EAGAIN;
       if (delivered_ == skip_at) sequence_ += skip_count;
       buf->index = queued_.front();
-      queued_.pop_front();
-      Fill(buf->index, static_cast<uint32_t>(delivered_));
+      queued_.erase(queued_.begin());
+      buf->bytesused = Fill(buf->index, static_cast<uint32_t>(delivered_));
       buf->sequence = sequence_++;
-      buf->bytesused = static_cast<uint32_t>(ImageBytes());
       buf->flags = delivered_ == error_flag_at ? V4L2_BUF_FLAG_ERROR : 0;
       buf->timestamp.tv_sec = 100 + delivered_;
       buf->timestamp.tv_usec = 0;
@@ -165,9 +211,16 @@ int FakeV4l2::Unmap(void*, size_t) {
   return 0;
 }
 
-void FakeV4l2::Fill(uint32_t index, uint32_t frame) {
+uint32_t FakeV4l2::Fill(uint32_t index, uint32_t frame) {
   uint8_t* base = buffers_[index].data();
   std::memset(base, 0xEE, buffers_[index].size());
+  if (Compressed()) {
+    if (jpeg_frames.empty()) return 0;
+    const std::vector<uint8_t>& jpeg = jpeg_frames[frame % jpeg_frames.size()];
+    const size_t n = std::min(jpeg.size(), buffers_[index].size());
+    if (n > 0) std::memcpy(base, jpeg.data(), n);
+    return static_cast<uint32_t>(n);
+  }
   uint32_t bpp = pix_.pixelformat == V4L2_PIX_FMT_YUYV   ? 2
                  : pix_.pixelformat == V4L2_PIX_FMT_NV12 ? 1
                                                          : 3;
@@ -183,6 +236,7 @@ void FakeV4l2::Fill(uint32_t index, uint32_t frame) {
         uv[y * pix_.bytesperline + x] = Pattern(frame, 1, y, x);
     }
   }
+  return static_cast<uint32_t>(ImageBytes());
 }
 
 }  // namespace lb

@@ -1,13 +1,14 @@
 // A scripted V4L2 capture node behind the V4l2Io seam: enough of the driver side of
-// QUERYCAP / ENUM_FMT / G_FMT / S_FMT / REQBUFS / QUERYBUF / QBUF / DQBUF / STREAMON / STREAMOFF
-// to exercise the sensor's negotiation, streaming and fault paths without hardware. Each
-// delivered frame is filled with a pattern that names the frame, row and column.
+// QUERYCAP / ENUM_FMT / ENUM_FRAMESIZES / G_FMT / S_FMT / REQBUFS / QUERYBUF / QBUF / DQBUF /
+// STREAMON / STREAMOFF to exercise the sensor's negotiation, streaming and fault paths without
+// hardware. Each delivered uncompressed frame is filled with a pattern that names the frame, row
+// and column; an MJPEG or JPEG frame carries one of the scripted `jpeg_frames`. Streaming
+// allocates nothing (buffers are made at REQBUFS), so allocation tests can run through it.
 #pragma once
 
 #include <linux/videodev2.h>
 
 #include <cstdint>
-#include <deque>
 #include <vector>
 
 #include "hal/v4l2/v4l2_io.h"
@@ -21,7 +22,16 @@ class FakeV4l2 : public V4l2Io {
   uint32_t caps = V4L2_CAP_VIDEO_CAPTURE | V4L2_CAP_STREAMING;
   std::vector<uint32_t> formats = {V4L2_PIX_FMT_YUYV, V4L2_PIX_FMT_NV12, V4L2_PIX_FMT_RGB24};
   uint32_t width = 64, height = 48;  // the native size; S_FMT grants any even size up to it
-  uint32_t line_padding = 16;        // bytes beyond the pixels in every row
+  // Formats listed here come in these sizes only (ENUM_FRAMESIZES lists them, S_FMT picks the
+  // nearest); the others in any even size up to the native one.
+  struct FrameSize {
+    uint32_t fourcc, width, height;
+  };
+  std::vector<FrameSize> sizes;
+  // MJPEG and JPEG: frame k of a stream carries jpeg_frames[k % size()] (bytesused 0 for an
+  // empty one, cut to the buffer for one longer than it).
+  std::vector<std::vector<uint8_t>> jpeg_frames;
+  uint32_t line_padding = 16;  // bytes beyond the pixels in every row
   uint32_t max_buffers = 8;
   int stall_after = -1;  // frames delivered per stream before it goes quiet (-1 never)
   int skip_at = -1;      // frame of the stream before which the driver skips `skip_count`
@@ -53,13 +63,15 @@ class FakeV4l2 : public V4l2Io {
  private:
   static constexpr int kFd = 42;
   static constexpr uint32_t kCookieStep = 0x100000;
-  void Fill(uint32_t index, uint32_t frame);
+  uint32_t Fill(uint32_t index, uint32_t frame);  // returns bytesused
   size_t ImageBytes() const;
+  bool Compressed() const;
+  void PickSize(v4l2_pix_format* p) const;
 
   v4l2_pix_format pix_ = {};
   std::vector<std::vector<uint8_t>> buffers_;
-  std::deque<uint32_t> queued_;
-  int delivered_ = 0;  // frames of the current stream
+  std::vector<uint32_t> queued_;  // reserved at REQBUFS
+  int delivered_ = 0;             // frames of the current stream
   uint32_t sequence_ = 0;
 };
 
