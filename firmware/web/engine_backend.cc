@@ -167,18 +167,20 @@ Status EngineBackend::Submit(Request* r) {
   wake_.notify_one();
   const auto deadline =
       std::chrono::steady_clock::now() + std::chrono::milliseconds(wait_limit_ms_);
-  while (!r->done) {
-    if (done_.wait_until(lock, deadline) == std::cv_status::timeout && !r->done && !r->taken) {
-      for (int i = 0; i < count_; ++i) {
-        if (queue_[i] != r) continue;
-        for (int j = i + 1; j < count_; ++j) queue_[j - 1] = queue_[j];
-        queue_[--count_] = nullptr;
-        break;
-      }
-      return Status(Code::kBusy, "web: the renderer did not get to this within %d ms",
-                    wait_limit_ms_);
+  // The limit is for waiting in the queue; once the render thread has taken the request it holds
+  // `r` until done, so the caller waits for that without a deadline (an expired one would wake
+  // it at once, again and again).
+  if (!done_.wait_until(lock, deadline, [r] { return r->done || r->taken; })) {
+    for (int i = 0; i < count_; ++i) {
+      if (queue_[i] != r) continue;
+      for (int j = i + 1; j < count_; ++j) queue_[j - 1] = queue_[j];
+      queue_[--count_] = nullptr;
+      break;
     }
+    return Status(Code::kBusy, "web: the renderer did not get to this within %d ms",
+                  wait_limit_ms_);
   }
+  done_.wait(lock, [r] { return r->done; });
   return r->status;
 }
 
@@ -199,7 +201,14 @@ Status EngineBackend::EnsureLoaded(const char* path) {
   loaded_path_[0] = '\0';
   const auto t0 = std::chrono::steady_clock::now();
   ++loads_;
-  LB_RETURN_IF_ERROR(engine_.Load(path));
+  Status s = engine_.Load(path);
+  if (!s.ok()) {
+    // A file the engine cannot take (larger than the camera's photos, an original or depth map
+    // over its buffers, more extended-XMP pieces than it holds, no depth at all) is a photo the
+    // page cannot refocus, not a fault of the server: Describe and every render decide it here.
+    if (s.code() == Code::kNotFound || s.code() == Code::kIoError) return s;
+    return Status(Code::kUnsupported, "%s", s.message());
+  }
   snprintf(loaded_path_, sizeof(loaded_path_), "%s", path);
   loaded_dev_ = st.st_dev;
   loaded_ino_ = st.st_ino;

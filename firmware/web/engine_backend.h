@@ -46,6 +46,9 @@ class EngineBackend final : public RefocusBackend {
   Status Render(const char* path, const RefocusParams& params, bool preview,
                 ByteSink* jpeg) override;
   Status Save(const char* path, const RefocusParams& params, const char* out_path) override;
+  bool CameraBusy() const override {
+    return camera_busy_ != nullptr && camera_busy_->load(std::memory_order_acquire);
+  }
 
   // For tests and the log: files read so far, requests waiting, the render thread's id.
   int64_t loads() const { return loads_.load(); }

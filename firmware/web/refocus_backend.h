@@ -50,6 +50,8 @@ class RefocusBackend {
   // Renders full size and writes a new refocusable photo at `out_path` (absent; the atomic-write
   // rule; the original is never touched).
   virtual Status Save(const char* path, const RefocusParams& params, const char* out_path) = 0;
+  // Whether the camera is taking a photo now: the page's other work (thumbnails) waits for it.
+  virtual bool CameraBusy() const { return false; }
 };
 
 }  // namespace lb

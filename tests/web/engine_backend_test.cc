@@ -150,8 +150,9 @@ TEST_F(EngineBackendTest, PhotosItCannotRefocusAreStillDescribed) {
   EXPECT_FALSE(info.refocusable);
   EXPECT_EQ(info.width, 320);
   VectorSink jpeg;
+  // The same decision for a render: a photo the page cannot refocus (422), not a server fault.
   EXPECT_EQ(backend.Render(Photo().c_str(), Tap(0.5f, 0.5f), true, &jpeg).code(),
-            Code::kOutOfMemory);
+            Code::kUnsupported);
 }
 
 TEST_F(EngineBackendTest, QueueIsBoundedAndPreviewsSupersede) {
