@@ -21,6 +21,7 @@
 #include "firmware/codecs/png_reader.h"
 #include "firmware/platform/worker_pool.h"
 #include "firmware/refocusable/refocusable_reader.h"
+#include "firmware/storage/input_file.h"
 
 namespace lb {
 
@@ -151,17 +152,10 @@ Status RefocusEngine::Configure(const RefocusEngineConfig& config) {
 
 Status RefocusEngine::LoadFile(const char* path) {
   // The web side checked the name without following links; a link swapped in since is refused.
-  const int fd = open(path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
-  if (fd < 0) {
-    return Status(errno == ENOENT ? Code::kNotFound : Code::kIoError, "%s: %s", path,
-                  strerror(errno));
-  }
-  struct stat st;
-  if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    close(fd);
-    return Status(Code::kInvalidArgument, "%s: not a regular file", path);
-  }
-  const size_t size = static_cast<size_t>(st.st_size);
+  int fd = -1;
+  int64_t length = 0;
+  LB_RETURN_IF_ERROR(OpenInputFile(path, &fd, &length, O_NOFOLLOW));
+  const size_t size = static_cast<size_t>(length);
   if (size > scratch_.capacity()) {
     close(fd);
     return Status(Code::kOutOfMemory, "%s: %zu bytes, more than the %zu the engine takes", path,

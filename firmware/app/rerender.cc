@@ -2,6 +2,7 @@
 
 #include <cstdlib>
 #include <memory>
+#include <vector>
 
 #include "algo/core/color.h"
 #include "firmware/app/refocusable.h"
@@ -10,12 +11,22 @@
 #include "firmware/platform/worker_pool.h"
 #include "firmware/refocusable/refocusable_reader.h"
 #include "firmware/storage/atomic_file.h"
+#include "firmware/storage/input_file.h"
 
 namespace lb {
+namespace {
+
+// A refocusable JPEG is read whole; larger than any the product writes at 8192x8192.
+constexpr size_t kMaxFileBytes = size_t{512} << 20;
+
+}  // namespace
 
 Status Rerenderer::Load(const char* path) {
+  std::vector<uint8_t> bytes;
+  LB_RETURN_IF_ERROR(ReadInputFile(path, kMaxFileBytes, &bytes));
   RefocusableImage file;
-  LB_RETURN_IF_ERROR(ReadRefocusableFile(path, &file));
+  LB_RETURN_IF_ERROR(ReadRefocusable(bytes.data(), bytes.size(), path, &file));
+  bytes = std::vector<uint8_t>();  // the parts are copied out; the file's bytes are not needed
   if (file.xmp.image.empty()) {
     return Status(Code::kUnsupported, "%s: no all-in-focus original (GImage) to re-render from",
                   path);
@@ -60,10 +71,11 @@ Status Rerenderer::Load(const char* path) {
   scale_ = depth_w_ > 0 ? width_ / depth_w_ : 0;
   if (scale_ < 1 || depth_h_ * scale_ > height_ || depth_w_ * scale_ > width_ ||
       height_ / scale_ != depth_h_) {
-    width_ = 0;
-    return Status(Code::kUnsupported,
-                  "%s: depth map %dx%d is not a whole-number fraction of the %dx%d original", path,
-                  depth_w_, depth_h_, width_, height_);
+    const Status refused(Code::kUnsupported,
+                         "%s: depth map %dx%d is not a whole-number fraction of the %dx%d original",
+                         path, depth_w_, depth_h_, width_, height_);
+    width_ = 0;  // nothing loaded: Render refuses
+    return refused;
   }
   original_jpeg_ = std::move(file.xmp.image);
   return Status::Ok();

@@ -75,6 +75,17 @@ int OptionReader::Next(JobOptions* job) {
   if (c == ':') return Problem(std::string(argv_[optind - 1]) + " needs a value");
   if (c == '?') return Problem(std::string("unknown option '") + argv_[optind - 1] + "'");
   if (const Setting* s = SettingOfOption(c)) {
+    // refocusd.conf refuses a key given twice; the command line keeps the same rule rather
+    // than let the last one win unnoticed.
+    const size_t i = static_cast<size_t>(c - kFirstSettingOption);
+    if (given_.size() <= i) given_.resize(i + 1, nullptr);
+    if (given_[i] != nullptr) {
+      return Problem(strcmp(given_[i], name_) == 0
+                         ? std::string("--") + name_ + " given twice"
+                         : std::string("--") + name_ + " given twice (--" + given_[i] +
+                               " is the same setting)");
+    }
+    given_[i] = name_;
     std::string why;
     if (!s->parse(arg_, job, &why)) return Problem(std::string("--") + name_ + ": " + why);
   }

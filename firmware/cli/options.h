@@ -43,7 +43,7 @@ class OptionReader {
 
   // The next option's id, a setting's once parsed into `job`; kPositional; or -1 after the last
   // (rest() then indexes what is left). 0 with error() set when a value is missing, an option
-  // unknown or a setting's value wrong.
+  // unknown, a setting's value wrong or a setting given twice (under either of its names).
   int Next(JobOptions* job);
   const char* arg() const { return arg_; }
   // The option's long name as the user chose it, without the dashes: an alias stays an alias
@@ -65,6 +65,7 @@ class OptionReader {
   const char* arg_ = nullptr;
   const char* name_ = nullptr;
   std::string error_;
+  std::vector<const char*> given_;  // by setting index: the name it was first given under
 };
 
 // Prints "refocus: <message>" on stderr and returns exit code 1.

@@ -59,6 +59,7 @@ int RunCommand(int argc, char** argv) {
   std::string input_dir, out_path, error;
   bool synthetic = false, range_given = false;
   const char* synthetic_only = nullptr;  // the last option that only the synthetic scene takes
+  const char* synthetic_why = "";
   const char* motion = nullptr;
   job.pipeline.geometry = ViewGeometry::kAuto;
   SceneParams scene;
@@ -91,9 +92,13 @@ int RunCommand(int argc, char** argv) {
         break;
       case kSeed:
         ok = ParseWholeNumber(arg, 0, INT32_MAX, &seed, &error);
+        synthetic_only = "seed";
+        synthetic_why = "files bring their own scene";
         break;
       case kMotion:
         motion = arg;
+        synthetic_only = "motion";
+        synthetic_why = "files bring their own camera motion";
         ok = !strcmp(arg, "handheld") || !strcmp(arg, "rectified");
         if (!ok) error = std::string("motion '") + arg + "' is neither handheld nor rectified";
         break;
@@ -111,7 +116,10 @@ int RunCommand(int argc, char** argv) {
       case kHelp:
         return Help();
       default:  // a setting, already taken into `job`
-        if (SettingOfOption(c)->group == SettingGroup::kBurst) synthetic_only = options.name();
+        if (SettingOfOption(c)->group == SettingGroup::kBurst) {
+          synthetic_only = options.name();
+          synthetic_why = "files bring their own size and count";
+        }
     }
     if (!ok) return Usage(error);
   }
@@ -122,7 +130,7 @@ int RunCommand(int argc, char** argv) {
   }
   if (synthetic_only && (!input_dir.empty() || !files.empty())) {
     return Usage(std::string("--") + synthetic_only +
-                 " is for the synthetic scene: files bring their own size and count");
+                 " is for the synthetic scene: " + synthetic_why);
   }
 
   std::unique_ptr<Sensor> sensor;

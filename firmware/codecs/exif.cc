@@ -10,6 +10,7 @@
 
 #include "algo/motion/camera.h"
 #include "firmware/codecs/jpeg_writer.h"
+#include "firmware/storage/input_file.h"
 
 namespace lb {
 namespace {
@@ -158,27 +159,16 @@ Status BuildExif(const ExifTags& meta, int32_t width, int32_t height,
   return status;
 }
 
-double ExifFocalPx(const char* path, int32_t width, int32_t height) {
-  // 0 means "unknown" in EXIF; a 35 mm equivalent outside 8..2000 mm is a broken tag.
-  const int32_t f35 = ShortTag(exif_data_new_from_file(path), EXIF_IFD_EXIF,
-                               EXIF_TAG_FOCAL_LENGTH_IN_35MM_FILM, 8, 2000);
-  return f35 > 0 ? FocalPxFrom35mm(f35, width, height) : 0;
-}
-
-int32_t ExifOrientation(const char* path) {
-  return ShortTag(exif_data_new_from_file(path), EXIF_IFD_0, EXIF_TAG_ORIENTATION, 1, 8);
-}
-
 namespace {
 
-// The loader a path goes through too, so every read finds the same APP1 segment. It is fed the
-// 1 KiB pieces libexif's own file reader hands it, so that every read makes the same calls; it
-// takes a non-const buffer it only reads, and says when it has enough. `next` fills a piece
-// and returns its length, 0 at the end.
+// The loader every read goes through, so a file and its bytes in memory find the same APP1
+// segment. It is fed the 1 KiB pieces libexif's own file reader hands it, so that every read
+// makes the same calls; it takes a non-const buffer it only reads, and says when it has enough.
+// `next` fills a piece and returns its length, 0 at the end.
 template <typename Next>
-int32_t OrientationFromPieces(Next&& next) {
+ExifData* ExifFromPieces(Next&& next) {
   ExifLoader* loader = exif_loader_new();
-  if (loader == nullptr) return 0;
+  if (loader == nullptr) return nullptr;
   constexpr size_t kPiece = 1024;
   unsigned char piece[kPiece];
   for (size_t n = next(piece, kPiece); n > 0; n = next(piece, kPiece)) {
@@ -186,25 +176,12 @@ int32_t OrientationFromPieces(Next&& next) {
   }
   ExifData* exif = exif_loader_get_data(loader);
   exif_loader_unref(loader);
-  return ShortTag(exif, EXIF_IFD_0, EXIF_TAG_ORIENTATION, 1, 8);
+  return exif;
 }
 
-}  // namespace
-
-int32_t ExifOrientation(const uint8_t* data, size_t size) {
-  size_t pos = 0;
-  return OrientationFromPieces([&](unsigned char* piece, size_t max) {
-    const size_t n = size - pos < max ? size - pos : max;
-    if (n == 0) return n;  // data may be null when size is 0
-    memcpy(piece, data + pos, n);
-    pos += n;
-    return n;
-  });
-}
-
-int32_t ExifOrientationAt(int fd) {
+ExifData* ExifFromDescriptor(int fd) {
   off_t pos = 0;
-  return OrientationFromPieces([&](unsigned char* piece, size_t max) -> size_t {
+  return ExifFromPieces([&](unsigned char* piece, size_t max) -> size_t {
     for (;;) {
       const ssize_t n = pread(fd, piece, max, pos);
       if (n < 0 && errno == EINTR) continue;
@@ -213,6 +190,44 @@ int32_t ExifOrientationAt(int fd) {
       return static_cast<size_t>(n);
     }
   });
+}
+
+// Through the product's input open, so a FIFO is no tag rather than a wait.
+ExifData* ExifFromFile(const char* path) {
+  int fd = -1;
+  if (!OpenInputFile(path, &fd).ok()) return nullptr;
+  ExifData* exif = ExifFromDescriptor(fd);
+  close(fd);
+  return exif;
+}
+
+}  // namespace
+
+double ExifFocalPx(const char* path, int32_t width, int32_t height) {
+  // 0 means "unknown" in EXIF; a 35 mm equivalent outside 8..2000 mm is a broken tag.
+  const int32_t f35 =
+      ShortTag(ExifFromFile(path), EXIF_IFD_EXIF, EXIF_TAG_FOCAL_LENGTH_IN_35MM_FILM, 8, 2000);
+  return f35 > 0 ? FocalPxFrom35mm(f35, width, height) : 0;
+}
+
+int32_t ExifOrientation(const char* path) {
+  return ShortTag(ExifFromFile(path), EXIF_IFD_0, EXIF_TAG_ORIENTATION, 1, 8);
+}
+
+int32_t ExifOrientation(const uint8_t* data, size_t size) {
+  size_t pos = 0;
+  ExifData* exif = ExifFromPieces([&](unsigned char* piece, size_t max) {
+    const size_t n = size - pos < max ? size - pos : max;
+    if (n == 0) return n;  // data may be null when size is 0
+    memcpy(piece, data + pos, n);
+    pos += n;
+    return n;
+  });
+  return ShortTag(exif, EXIF_IFD_0, EXIF_TAG_ORIENTATION, 1, 8);
+}
+
+int32_t ExifOrientationAt(int fd) {
+  return ShortTag(ExifFromDescriptor(fd), EXIF_IFD_0, EXIF_TAG_ORIENTATION, 1, 8);
 }
 
 namespace {

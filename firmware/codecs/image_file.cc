@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "firmware/codecs/decoder.h"
+#include "firmware/storage/input_file.h"
 
 namespace lb {
 
@@ -103,10 +104,13 @@ struct FileCloser {
 using FilePtr = std::unique_ptr<FILE, FileCloser>;
 
 Status OpenFile(const char* path, FilePtr* out) {
-  FILE* f = fopen(path, "rb");
+  int fd = -1;
+  LB_RETURN_IF_ERROR(OpenInputFile(path, &fd));
+  FILE* f = fdopen(fd, "rb");
   if (f == nullptr) {
-    if (errno == ENOENT) return Status(Code::kNotFound, "%s: no such file or directory", path);
-    return Status(Code::kIoError, "%s: cannot open: %s", path, strerror(errno));
+    const int err = errno;
+    close(fd);
+    return Status(Code::kIoError, "%s: cannot open: %s", path, strerror(err));
   }
   out->reset(f);
   return Status::Ok();
