@@ -1,6 +1,7 @@
 #include "firmware/daemon/config.h"
 
 #include <arpa/inet.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
@@ -48,6 +49,8 @@ bool WebAddress(const char* v, DaemonConfig* c, std::string* why) {
   if (!ParseWholeNumber(colon + 1, 0, 65535, &port, &port_why)) {
     return Why(why, "port: %s", port_why.c_str());
   }
+  // The kernel would pick another port at every start, where no browser could find the page.
+  if (port == 0) return Why(why, "port 0 is not a port a browser can find; name one (e.g. 8080)");
   c->web_address = host;
   c->web_port = port;
   return true;
@@ -211,7 +214,8 @@ Status ParseConfig(const char* name, const char* text, DaemonConfig* config) {
   int line_no = 0;
   int focus_line = 0;
   int web_line = 0;
-  const char* p = text;
+  // Editors on other systems start a UTF-8 file with a byte-order mark; it is no part of a key.
+  const char* p = strncmp(text, "\xEF\xBB\xBF", 3) == 0 ? text + 3 : text;
   while (*p != '\0') {
     ++line_no;
     const char* eol = strchr(p, '\n');
@@ -252,7 +256,9 @@ Status ParseConfig(const char* name, const char* text, DaemonConfig* config) {
     }
     if (strcmp(known, "focus") == 0) focus_line = line_no;
     if (strcmp(known, "web") == 0) web_line = line_no;
+    if (strcmp(known, "web_root") == 0) config->web_root_line = line_no;
   }
+  config->web_line = web_line;
   // The page shows and changes every photo: never without a token.
   if (config->web_on() && config->web_token.empty()) {
     return Status(Code::kInvalidArgument,
@@ -288,7 +294,25 @@ Status LoadConfig(const char* path, DaemonConfig* config) {
   if (text.find('\0') != std::string::npos) {
     return Status(Code::kInvalidArgument, "%s: not a text file (holds a NUL byte)", path);
   }
-  return ParseConfig(path, text.c_str(), config);
+  LB_RETURN_IF_ERROR(ParseConfig(path, text.c_str(), config));
+  return CheckWebRoot(path, *config);
+}
+
+Status CheckWebRoot(const char* name, const DaemonConfig& config) {
+  if (!config.web_on()) return Status::Ok();
+  // Without the page every address would answer 404: refused like any other bad value, on the
+  // line that chose the folder (the web line when the default is kept).
+  const std::string page = config.web_root + "/index.html";
+  if (access(page.c_str(), R_OK) == 0) return Status::Ok();
+  const int err = errno;
+  if (config.web_root_line > 0) {
+    return Status(Code::kInvalidArgument, "%s:%d: web_root: cannot read %s: %s", name,
+                  config.web_root_line, page.c_str(), strerror(err));
+  }
+  return Status(Code::kInvalidArgument,
+                "%s:%d: web is on but the page's files are missing: cannot read %s: %s (set "
+                "web_root)",
+                name, config.web_line, page.c_str(), strerror(err));
 }
 
 JobOptions MakeJobOptions(const DaemonConfig& config) {

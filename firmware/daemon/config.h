@@ -43,21 +43,26 @@ struct DaemonConfig {
   // Log.
   LogLevel log_level = LogLevel::kInfo;
   // Web page (firmware/web/web_server.h): off while web_address is "". The address is numeric
-  // (IPv4 dotted or IPv6 without brackets); port 0 takes any free port (tests; the log says
-  // which). web_token is required (16 to 128 printable characters, no space) whenever the web
-  // side is on: the page is reachable by anyone on the network.
+  // (IPv4 dotted or IPv6 without brackets) and the port 1..65535 (the file refuses 0).
+  // web_token is required (16 to 128 printable characters, no space) whenever the web side is
+  // on: the page is reachable by anyone on the network.
   std::string web_address;
   int32_t web_port = 0;
   std::string web_token;
   std::string web_root = "/usr/share/refocusd/www";
   bool web_on() const { return !web_address.empty(); }
+  // The lines that set web and web_root (0: not in the file), for CheckWebRoot's message.
+  int32_t web_line = 0, web_root_line = 0;
 };
 
 // Parses the text of a configuration file over the defaults in `config`; `name` is the file
 // name for messages ("refocusd.conf:12: unknown key 'burst'").
 Status ParseConfig(const char* name, const char* text, DaemonConfig* config);
-// Reads and parses `path` (at most 64 KiB).
+// Reads and parses `path` (at most 64 KiB), then CheckWebRoot.
 Status LoadConfig(const char* path, DaemonConfig* config);
+// What ParseConfig cannot see in the text: with web on, web_root must hold a readable
+// index.html. The error names `name` and the web_root line (the web line for the default).
+Status CheckWebRoot(const char* name, const DaemonConfig& config);
 
 // The job settings the configuration implies; make and model point into `config`.
 JobOptions MakeJobOptions(const DaemonConfig& config);

@@ -28,7 +28,8 @@ const char kUsage[] =
     "The lens-blur camera daemon: each press of the shutter button (KEY_CAMERA) takes a burst,\n"
     "computes depth, renders a shallow depth of field and saves IMG_YYYYMMDD_HHMMSS_NNNN.jpg in\n"
     "the output folder. A half press (KEY_CAMERA_FOCUS) readies the sensor. Logs go to stderr\n"
-    "(the journal under systemd); SIGTERM or SIGINT stop it after the photo in progress.\n"
+    "(the journal under systemd); SIGTERM, SIGINT or SIGHUP stop it after the photo in\n"
+    "progress.\n"
     "\n"
     "At start it checks the camera (there, and a capture device) and the output folder (there,\n"
     "and writable) and says \"ready\" once both hold. Until then it logs each problem once,\n"
@@ -86,14 +87,6 @@ int CheckConfig(const char* path, const lb::DaemonConfig& config) {
   if (!s.ok()) {
     fprintf(stderr, "refocusd: %s\n", s.message());
     ++problems;
-  }
-  // The web page's files (the token was checked with the file).
-  if (config.web_on()) {
-    const std::string page = config.web_root + "/index.html";
-    if (access(page.c_str(), R_OK) != 0) {
-      fprintf(stderr, "refocusd: web_root: cannot read %s: %s\n", page.c_str(), strerror(errno));
-      ++problems;
-    }
   }
   if (problems > 0) return 1;
   printf("refocusd: %s: configuration OK\n", path);
@@ -167,6 +160,8 @@ int main(int argc, char** argv) {
   sigemptyset(&sa.sa_mask);
   sigaction(SIGTERM, &sa, nullptr);
   sigaction(SIGINT, &sa, nullptr);
+  // A closed terminal or a stray `kill -HUP` must not cut a photo short: taken as SIGTERM.
+  sigaction(SIGHUP, &sa, nullptr);
   // A closed log pipe must not kill the camera; writes then fail quietly.
   signal(SIGPIPE, SIG_IGN);
 
@@ -182,6 +177,9 @@ int main(int argc, char** argv) {
     if (!ws.ok()) {
       log.Printf(lb::LogLevel::kError, "%s; the camera runs without the web page", ws.message());
       web.reset();
+      // The renderer is sized for the largest photo and has its own threads: a page that will
+      // not come must not keep them.
+      backend.reset();
     }
   }
   if (s.ok()) s = daemon.Run();

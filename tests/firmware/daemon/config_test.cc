@@ -261,9 +261,9 @@ TEST(ConfigTest, WebIsOffUntilAnAddressAndATokenAreSet) {
   EXPECT_EQ(c.web_token, "0123456789abcdef");
   DaemonConfig v6;
   ASSERT_TRUE(
-      Parse("web = [::1]:0\nweb_token = 0123456789abcdef\nweb_root = /srv/www\n", &v6).ok());
+      Parse("web = [::1]:8081\nweb_token = 0123456789abcdef\nweb_root = /srv/www\n", &v6).ok());
   EXPECT_EQ(v6.web_address, "::1");
-  EXPECT_EQ(v6.web_port, 0);
+  EXPECT_EQ(v6.web_port, 8081);
   EXPECT_EQ(v6.web_root, "/srv/www");
   DaemonConfig off;
   ASSERT_TRUE(Parse("web = off\n", &off).ok());
@@ -289,6 +289,23 @@ TEST(ConfigTest, WebWithoutAGoodTokenIsRefusedAtLoad) {
             "test.conf:1: web: '0.0.0.0' is neither off nor ADDRESS:PORT");
   EXPECT_NE(Error("web = 0.0.0.0:70000\n").find("test.conf:1: web: port: "), std::string::npos);
   EXPECT_EQ(Error("web_root = www\n"), "test.conf:1: web_root: 'www' is not an absolute path");
+  // A port the kernel picks anew at each start is one no browser can find.
+  EXPECT_EQ(Error("frames = 5\nweb = [::]:0\n"),
+            "test.conf:2: web: port 0 is not a port a browser can find; name one (e.g. 8080)");
+}
+
+TEST(ConfigTest, AByteOrderMarkIsNoPartOfTheFirstKey) {
+  DaemonConfig c;
+  Status s = Parse(
+      "\xEF\xBB\xBF"
+      "frames = 5\n",
+      &c);
+  ASSERT_TRUE(s.ok()) << s.message();
+  EXPECT_EQ(c.job.sensor.frames, 5);
+  // Only at the start: elsewhere it is part of a key, and the key is unknown.
+  EXPECT_EQ(Error("frames = 5\n\xEF\xBB\xBF"
+                  "labels = 8\n"),
+            "test.conf:2: unknown key '\xEF\xBB\xBFlabels'");
 }
 
 }  // namespace

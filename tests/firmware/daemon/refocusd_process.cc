@@ -1,10 +1,13 @@
 #include "tests/firmware/daemon/refocusd_process.h"
 
+#include <arpa/inet.h>
 #include <dirent.h>
 #include <fcntl.h>
 #include <linux/input.h>
+#include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -13,6 +16,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <string>
 
 namespace lb::test {
 namespace {
@@ -23,11 +27,42 @@ int64_t NowMs() {
   return static_cast<int64_t>(ts.tv_sec) * 1000 + ts.tv_nsec / 1000000;
 }
 
+// A loopback port free now. refocusd refuses `web = ...:0` (a user could not find the page),
+// so a test that wants any port gets one chosen here; another program taking it before
+// refocusd binds is possible but unlikely, and shows as "cannot listen".
+int FreeLoopbackPort() {
+  const int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (fd < 0) return 0;
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t len = sizeof(a);
+  int port = 0;
+  if (bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) == 0 &&
+      getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) == 0) {
+    port = ntohs(a.sin_port);
+  }
+  close(fd);
+  return port;
+}
+
+// `web = 127.0.0.1:0` in a test's settings: a free port instead.
+std::string WithFreePort(std::string extra) {
+  const std::string any = "web = 127.0.0.1:0\n";
+  const size_t at = ("\n" + extra).find("\n" + any);
+  if (at == std::string::npos) return extra;
+  const int port = FreeLoopbackPort();
+  if (port > 0) extra.replace(at, any.size(), "web = 127.0.0.1:" + std::to_string(port) + "\n");
+  return extra;
+}
+
 }  // namespace
 
 std::string RefocusdBinary() { return REFOCUSD_BIN; }
 
-RefocusdProcess::RefocusdProcess(const std::string& dir, const std::string& extra) : dir_(dir) {
+RefocusdProcess::RefocusdProcess(const std::string& dir, const std::string& extra_settings)
+    : dir_(dir) {
+  const std::string extra = WithFreePort(extra_settings);
   mkdir(out_dir().c_str(), 0755);
   mkfifo((dir_ + "/button").c_str(), 0600);
   // The base settings, each unless `extra` sets it (a key given twice is an error).
@@ -164,19 +199,32 @@ int RefocusdProcess::Wait(int timeout_ms) {
   }
 }
 
-long RefocusdProcess::ResidentKib() const {
+namespace {
+
+// One "Name: N" field of /proc/PID/status, or -1.
+long StatusField(pid_t pid, const char* field) {
   char path[64];
-  snprintf(path, sizeof(path), "/proc/%d/status", static_cast<int>(pid_));
+  snprintf(path, sizeof(path), "/proc/%d/status", static_cast<int>(pid));
   FILE* f = fopen(path, "r");
   if (f == nullptr) return -1;
-  long kib = -1;
+  long value = -1;
+  const size_t n = strlen(field);
   char line[256];
   while (fgets(line, sizeof(line), f)) {
-    if (sscanf(line, "VmRSS: %ld kB", &kib) == 1) break;
+    if (strncmp(line, field, n) == 0 && line[n] == ':' &&
+        sscanf(line + n + 1, "%ld", &value) == 1) {
+      break;
+    }
   }
   fclose(f);
-  return kib;
+  return value;
 }
+
+}  // namespace
+
+long RefocusdProcess::ResidentKib() const { return StatusField(pid_, "VmRSS"); }
+
+int RefocusdProcess::Threads() const { return static_cast<int>(StatusField(pid_, "Threads")); }
 
 int RefocusdProcess::OpenFds() const {
   char path[64];

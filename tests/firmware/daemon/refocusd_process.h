@@ -13,7 +13,8 @@ namespace lb::test {
 class RefocusdProcess {
  public:
   // `dir` holds the configuration, the button FIFO and (unless `extra` sets output_dir) the
-  // photo folder `dir`/out. `extra` is appended to the configuration.
+  // photo folder `dir`/out. `extra` is appended to the configuration; `web = 127.0.0.1:0` in it
+  // becomes a port free at the time (refocusd itself refuses port 0).
   RefocusdProcess(const std::string& dir, const std::string& extra);
   ~RefocusdProcess();  // kills the child if it still runs
 
@@ -32,9 +33,10 @@ class RefocusdProcess {
 
   pid_t pid() const { return pid_; }
   std::string out_dir() const { return dir_ + "/out"; }
-  // From /proc: resident memory in KiB, open descriptors.
+  // From /proc: resident memory in KiB, open descriptors, threads.
   long ResidentKib() const;
   int OpenFds() const;
+  int Threads() const;
 
  private:
   void Key(int code, int value);
