@@ -1,6 +1,7 @@
 #include "firmware/app/settings.h"
 
 #include <cerrno>
+#include <cfloat>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -232,7 +233,11 @@ bool ParseRealNumber(const char* text, float lo, float hi, float* out, std::stri
   char* end = nullptr;
   errno = 0;
   const float v = strtof(text, &end);
-  if (errno != 0 || end == text || *end != '\0' || !std::isfinite(v) || v < lo || v > hi) {
+  // Below the smallest float strtof says ERANGE, yet the number is as good as 0 (or the
+  // denormal it returns): the range decides.
+  const bool underflow = errno == ERANGE && std::fabs(v) <= FLT_MIN;
+  if ((errno != 0 && !underflow) || end == text || *end != '\0' || !std::isfinite(v) || v < lo ||
+      v > hi) {
     return Why(why, "'%s' is not a number from %g to %g", text, static_cast<double>(lo),
                static_cast<double>(hi));
   }

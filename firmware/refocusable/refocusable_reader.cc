@@ -261,8 +261,8 @@ Status Reassemble(const char* name, std::string_view guid, ExtendedXmpChunk* all
   uint64_t expected = 0;
   for (const ExtendedXmpChunk* c = all; c != mine; ++c) {
     if (c->offset != expected) {
-      return Status(Code::kCorruptData, "%s: extended XMP has a %s at offset %llu", name,
-                    c->offset > expected ? "gap" : "overlap",
+      return Status(Code::kCorruptData, "%s: extended XMP has %s at offset %llu", name,
+                    c->offset > expected ? "a gap" : "an overlap",
                     static_cast<unsigned long long>(expected));
     }
     expected += c->size;

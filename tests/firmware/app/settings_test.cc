@@ -66,6 +66,20 @@ TEST(Settings, NumbersNeverWrap) {
   EXPECT_EQ(job.render.focus.width, before.render.focus.width);
 }
 
+TEST(Settings, ANumberTooSmallForAFloatIsInRangeWhereZeroIs) {
+  JobOptions job;
+  job.render.aperture.curvature = 0.5f;
+  std::string why;
+  EXPECT_TRUE(Parse("blade-curvature", "1e-40", &job, &why)) << why;
+  EXPECT_GE(job.render.aperture.curvature, 0.0f);
+  EXPECT_LT(job.render.aperture.curvature, 1e-30f);
+  EXPECT_TRUE(Parse("blade-curvature", "1e-400", &job, &why)) << why;
+  // Where the range starts above zero, the tiny number is below it, as any other.
+  EXPECT_FALSE(Parse("f-number", "1e-40", &job, &why));
+  EXPECT_NE(why.find("'1e-40' is not a number from 1 to 22"), std::string::npos) << why;
+  EXPECT_FALSE(Parse("blade-curvature", "-1e-40", &job));
+}
+
 TEST(Settings, BothSpellingsAndTheOlderNamesFindOneSetting) {
   EXPECT_EQ(FindSetting("f_number"), FindSetting("f-number"));
   EXPECT_EQ(FindSetting("max_blur_radius"), FindSetting("max-radius"));

@@ -122,6 +122,40 @@ TEST_F(Rerender, ALinearDepthMapIsRefusedNamingTheFile) {
   ExpectCleanFailure(r, In(), "RangeInverse");
 }
 
+TEST_F(Rerender, ADepthMapOfNoWholeFractionNamesBothSizes) {
+  std::vector<uint16_t> odd(5 * 5, 3 << 8);  // 64 / 5 = 12, and 5 x 12 rows are more than 48
+  ASSERT_TRUE(WriteRefocusable(In(), MakeView(odd.data(), 5, 5), OriginalJpeg()));
+  const Result r = Run({"rerender", In(), "--out", Out()});
+  ExpectCleanFailure(r, In(), "depth map 5x5 is not a whole-number fraction of the 64x48 original");
+}
+
+TEST_F(Rerender, OverlappingExtendedXmpChunksAreNamedSo) {
+  // An original too large for one XMP packet, so it travels in extended chunks; the bytes need
+  // not decode, as the chunks are refused first.
+  Bytes original = OriginalJpeg();
+  for (uint32_t i = 0; original.size() < 200 * 1024; ++i) {
+    original.push_back(static_cast<uint8_t>((i * 2654435761u) >> 24));
+  }
+  ASSERT_TRUE(WriteRefocusable(In(), depth(), original));
+  std::string bytes = clitest::Slurp(In());
+  const std::string signature("http://ns.adobe.com/xmp/extension/\0", 35);
+  const size_t first = bytes.find(signature);
+  ASSERT_NE(first, std::string::npos);
+  const size_t second = bytes.find(signature, first + 1);
+  ASSERT_NE(second, std::string::npos) << "one extended chunk only";
+  // After the signature: the 32-digit GUID, the full length, then this chunk's offset
+  // (big-endian): one byte back overlaps the chunk before.
+  const size_t at = second + signature.size() + 32 + 4;
+  uint32_t offset = 0;
+  for (int k = 0; k < 4; ++k) offset = offset << 8 | static_cast<uint8_t>(bytes[at + k]);
+  ASSERT_GT(offset, 0u);
+  --offset;
+  for (int k = 0; k < 4; ++k) bytes[at + k] = static_cast<char>(offset >> (24 - 8 * k));
+  ASSERT_TRUE(test::WriteFile(In(), Bytes(bytes.begin(), bytes.end())));
+  const Result r = Run({"rerender", In(), "--out", Out()});
+  ExpectCleanFailure(r, In(), "extended XMP has an overlap at offset");
+}
+
 TEST_F(Rerender, OutGivenTwiceIsRefused) {
   ASSERT_TRUE(WriteRefocusable(In(), depth(), OriginalJpeg()));
   const Result r = Run({"rerender", In(), "--out", Out(), "--out", Out() + "2"});
