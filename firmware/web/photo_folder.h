@@ -42,7 +42,8 @@ Status ListPhotoFolder(int dir_fd, size_t max_entries, std::vector<PhotoEntry>* 
 
 // The name a re-render of `name` is saved under: its stem without a trailing _rN, then _r1, _r2,
 // ... (the first that no entry of the folder has), with the original's extension. kBusy when
-// _r1 to _r99 are all taken, kInvalidArgument when the result would be too long.
+// _r1 to _r99 are all taken (the page answers 409: only removing some helps), kInvalidArgument
+// when the result would be too long.
 Status ChooseRerenderName(int dir_fd, const char* name, char* out, size_t size);
 
 }  // namespace lb

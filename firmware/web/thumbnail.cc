@@ -17,8 +17,13 @@ constexpr int32_t kStripRows = JpegWriter::kStripRows;
 // writer a strip at a time, as YCbCr 4:2:0.
 class ShrinkSink final : public FrameSink {
  public:
-  ShrinkSink(int32_t width, int quality, int32_t orientation, std::vector<uint8_t>* out)
-      : width_(width), quality_(quality), orientation_(orientation), out_(out) {}
+  ShrinkSink(int32_t width, int quality, int32_t orientation, std::vector<uint8_t>* out,
+             const std::function<Status()>& between_strips)
+      : width_(width),
+        quality_(quality),
+        orientation_(orientation),
+        out_(out),
+        between_strips_(between_strips) {}
 
   Status BeginFrame(const FrameInfo& info) override {
     if (info.format != PixelFormat::kRgb8 && info.format != PixelFormat::kGray8) {
@@ -50,6 +55,7 @@ class ShrinkSink final : public FrameSink {
   }
 
   Status Rows(const FrameRows& rows) override {
+    if (between_strips_) LB_RETURN_IF_ERROR(between_strips_());
     for (int32_t i = 0; i < rows.height; ++i) {
       const int32_t y = rows.y0 + i;
       const int32_t oy = static_cast<int32_t>(static_cast<int64_t>(y) * out_h_ / in_h_);
@@ -115,6 +121,7 @@ class ShrinkSink final : public FrameSink {
   const int quality_;
   const int32_t orientation_;
   std::vector<uint8_t>* out_;
+  const std::function<Status()>& between_strips_;
   JpegWriter writer_;
   int32_t channels_ = 3, in_w_ = 0, in_h_ = 0, out_w_ = 0, out_h_ = 0;
   int32_t current_ = 0, rows_in_ = 0, strip_rows_ = 0;
@@ -125,10 +132,11 @@ class ShrinkSink final : public FrameSink {
 
 }  // namespace
 
-Status MakeThumbnail(int fd, int32_t width, int quality, std::vector<uint8_t>* out) {
+Status MakeThumbnail(int fd, int32_t width, int quality, std::vector<uint8_t>* out,
+                     const std::function<Status()>& between_strips) {
   out->clear();
   if (width < 1) return Status(Code::kInvalidArgument, "thumbnail width %d", width);
-  ShrinkSink shrink(width, quality, ExifOrientationAt(fd), out);
+  ShrinkSink shrink(width, quality, ExifOrientationAt(fd), out, between_strips);
   const Status s = StreamImageDescriptor(fd, "thumbnail", width, shrink);
   if (!s.ok()) out->clear();
   return s;

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "algo/core/status.h"
@@ -19,6 +20,9 @@ namespace lb {
 // Reads the JPEG from `fd` (borrowed; read from its current offset) and writes a JPEG at most
 // `width` px wide (narrower images keep their width) into `out`. The reader's errors as they are:
 // kCorruptData for bytes that do not decode, kUnsupported for an image over 16384 px a side.
-Status MakeThumbnail(int fd, int32_t width, int quality, std::vector<uint8_t>* out);
+// `between_strips`, when given, is called before each strip of decoded rows (so the work can
+// pause for the camera); its error ends the thumbnail with that error.
+Status MakeThumbnail(int fd, int32_t width, int quality, std::vector<uint8_t>* out,
+                     const std::function<Status()>& between_strips = {});
 
 }  // namespace lb

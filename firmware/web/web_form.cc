@@ -1,5 +1,7 @@
 #include "firmware/web/web_form.h"
 
+#include <microhttpd.h>
+
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -40,7 +42,41 @@ bool Fields::Add(const char* k, const char* data, uint64_t offset, size_t size) 
   return true;
 }
 
+bool Fields::AddEmpty(const char* body, size_t size) {
+  for (size_t i = 0; i < size;) {
+    size_t end = i;
+    while (end < size && body[end] != '&') ++end;
+    size_t key_end = i;
+    while (key_end < end && body[key_end] != '=') ++key_end;
+    if (key_end > i && key_end + 1 >= end) {
+      std::string k(body + i, key_end - i);
+      for (char& ch : k) ch = ch == '+' ? ' ' : ch;
+      k.resize(MHD_http_unescape(k.data()));
+      if (Get(k.c_str()) == nullptr) {
+        if (count == kMax) return false;
+        key[count] = k;
+        value[count].clear();
+        ++count;
+      }
+    }
+    i = end + 1;
+  }
+  return true;
+}
+
 Status ParseRefocus(const Fields& f, std::string* name, RefocusParams* p) {
+  static const struct {
+    const char* key;
+    bool optional;
+  } kFields[] = {{"name", false}, {"x0", false}, {"y0", false},   {"x1", true},
+                 {"y1", true},    {"f", true},   {"blades", true}};
+  for (const auto& field : kFields) {
+    const char* v = f.Get(field.key);
+    if (v != nullptr && *v == '\0') {
+      return Status(Code::kInvalidArgument, "%s is empty%s", field.key,
+                    field.optional ? ": give it a value or leave it out" : "");
+    }
+  }
   const char* n = f.Get("name");
   if (n == nullptr) return Status(Code::kInvalidArgument, "the body names no photo (name=)");
   *name = n;

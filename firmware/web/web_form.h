@@ -25,11 +25,16 @@ struct Fields {
   // is refused) past kMax fields, for a piece that does not continue the last field, and for a
   // decoded NUL, which would cut the text the checks see short of what was sent.
   bool Add(const char* k, const char* data, uint64_t offset, size_t size);
+  // Adds, with an empty value, each field of the raw form `body` that has none ("f=" or "f"),
+  // which the post processor reports not at all; a name is percent-decoded by the library. False
+  // past kMax fields.
+  bool AddEmpty(const char* body, size_t size);
 };
 
 // The page's choice from a preview, render or save body: name, x0 and y0 (0..1 of the displayed
 // photo), x1 and y1 (default x0 and y0: a tap; a drag is put in order), f (an f-number in
-// RenderParams' range) and blades (0: a disc, or 3..12). kInvalidArgument says which is wrong.
+// RenderParams' range) and blades (0: a disc, or 3..12). Absent, an optional field takes its
+// default; sent empty, it is refused like any bad value. kInvalidArgument says which is wrong.
 Status ParseRefocus(const Fields& f, std::string* name, RefocusParams* p);
 
 }  // namespace lb

@@ -16,7 +16,7 @@
 namespace lb {
 
 // One request's state between libmicrohttpd's calls: the form fields so far (its post processor
-// decodes the body; at most max_body bytes) and whether an answer was queued.
+// decodes the body; at most max_body bytes), the body itself, and whether an answer was queued.
 struct WebServer::Request {
   ~Request() {
     if (post != nullptr) MHD_destroy_post_processor(post);
@@ -26,6 +26,7 @@ struct WebServer::Request {
   MHD_PostProcessor* post = nullptr;
   Fields fields;
   size_t body_bytes = 0;
+  std::string body;  // as sent (at most max_body): the fields the form parser passes over
   bool too_large = false;
   bool bad_body = false;
   bool replied = false;

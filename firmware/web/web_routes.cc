@@ -19,6 +19,14 @@
 namespace lb {
 namespace {
 
+constexpr int kCameraPollMs = 10;
+
+int64_t NowMs() {
+  return std::chrono::duration_cast<std::chrono::milliseconds>(
+             std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
 // libmicrohttpd frees a render's response: its sink goes back for the next render.
 void ReleaseSink(void* cls) {
   auto* sink = static_cast<WebServer::Sinks::Sink*>(cls);
@@ -105,14 +113,31 @@ Status WebServer::OpenNamedPhoto(const char* name, int* fd, struct stat* st) con
   return s;
 }
 
+Status WebServer::WaitForCamera(int64_t deadline_ms) const {
+  while (backend_->CameraBusy()) {
+    if (NowMs() >= deadline_ms) {
+      return Status(Code::kBusy, "the camera is taking a photo; try again in a moment");
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(kCameraPollMs));
+  }
+  return Status::Ok();
+}
+
 bool WebServer::ServePhoto(MHD_Connection* c, Request* r, const char* name, bool thumbnail) {
+  // The camera comes first: a thumbnail (a 12 MP decode, even at 1/8 scale) waits while it takes
+  // a photo, before it starts and between strips. The download of a photo is the kernel copying
+  // a file, and goes on.
+  const int64_t deadline = NowMs() + options_.camera_wait_ms;
+  Status s = thumbnail ? WaitForCamera(deadline) : Status::Ok();
+  if (!s.ok()) return ReplyStatus(c, r, s);
   int fd = -1;
   struct stat st;
-  Status s = OpenNamedPhoto(name, &fd, &st);
+  s = OpenNamedPhoto(name, &fd, &st);
   if (!s.ok()) return ReplyStatus(c, r, s);
   if (thumbnail) {
     std::vector<uint8_t> jpeg;
-    s = MakeThumbnail(fd, options_.thumb_width, 80, &jpeg);
+    s = MakeThumbnail(fd, options_.thumb_width, 80, &jpeg,
+                      [this, deadline] { return WaitForCamera(deadline); });
     close(fd);
     if (!s.ok()) return ReplyStatus(c, r, s.Prefix("%s: ", name));
     return Reply(c, r, MHD_HTTP_OK, "image/jpeg", jpeg.data(), jpeg.size(), nullptr);
@@ -177,6 +202,13 @@ bool WebServer::Refocus(MHD_Connection* c, Request* r, const char* action) {
       // Two saves at once must not pick the same name.
       std::lock_guard<std::mutex> lock(save_mutex_);
       s = ChooseRerenderName(dir_fd, name.c_str(), out, sizeof(out));
+      if (s.code() == Code::kBusy) {
+        // Every name taken: no retry helps (not 503), only removing some re-renders.
+        close(dir_fd);
+        char why[Status::kMaxMessage + 64];
+        snprintf(why, sizeof(why), "%s; delete or rename some to save another", s.message());
+        return ReplyError(c, r, MHD_HTTP_CONFLICT, why);
+      }
       if (s.ok()) {
         const std::string out_path = options_.photo_dir + "/" + out;
         s = backend_->Save(path.c_str(), params, out_path.c_str());

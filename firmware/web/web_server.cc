@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "firmware/storage/errno_text.h"
+#include "firmware/web/web_deadline.h"
 #include "firmware/web/web_request.h"
 
 namespace lb {
@@ -37,10 +38,44 @@ MHD_Result OnRequest(void* cls, MHD_Connection* c, const char* url, const char* 
              : MHD_NO;
 }
 
-void OnCompleted(void* /*cls*/, MHD_Connection* /*c*/, void** request,
-                 MHD_RequestTerminationCode /*why*/) {
+RequestDeadlines::Entry* DeadlineOf(MHD_Connection* c) {
+  const MHD_ConnectionInfo* info = MHD_get_connection_info(c, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+  return info != nullptr ? static_cast<RequestDeadlines::Entry*>(info->socket_context) : nullptr;
+}
+
+void ClientText(MHD_Connection* c, char* out, size_t size) {
+  snprintf(out, size, "?");
+  const MHD_ConnectionInfo* info = MHD_get_connection_info(c, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
+  if (info == nullptr || info->client_addr == nullptr) return;
+  const sockaddr* sa = info->client_addr;
+  if (sa->sa_family == AF_INET) {
+    inet_ntop(AF_INET, &reinterpret_cast<const sockaddr_in*>(sa)->sin_addr, out,
+              static_cast<socklen_t>(size));
+  } else if (sa->sa_family == AF_INET6) {
+    inet_ntop(AF_INET6, &reinterpret_cast<const sockaddr_in6*>(sa)->sin6_addr, out,
+              static_cast<socklen_t>(size));
+  }
+}
+
+void OnCompleted(void* cls, MHD_Connection* c, void** request, MHD_RequestTerminationCode /*why*/) {
   delete static_cast<WebServer::Request*>(*request);
   *request = nullptr;
+  static_cast<WebServer*>(cls)->deadlines()->Answered(DeadlineOf(c));
+}
+
+void OnConnection(void* cls, MHD_Connection* c, void** socket_context,
+                  MHD_ConnectionNotificationCode code) {
+  RequestDeadlines* deadlines = static_cast<WebServer*>(cls)->deadlines();
+  if (code == MHD_CONNECTION_NOTIFY_STARTED) {
+    const MHD_ConnectionInfo* info = MHD_get_connection_info(c, MHD_CONNECTION_INFO_CONNECTION_FD);
+    if (info == nullptr) return;
+    char client[INET6_ADDRSTRLEN];
+    ClientText(c, client, sizeof(client));
+    *socket_context = deadlines->Opened(info->connect_fd, client);
+  } else {
+    deadlines->Closed(static_cast<RequestDeadlines::Entry*>(*socket_context));
+    *socket_context = nullptr;
+  }
 }
 
 void OnLibraryMessage(void* cls, const char* format, va_list args) {
@@ -212,6 +247,7 @@ Status WebServer::Start() {
                    : reinterpret_cast<sockaddr_in*>(&bound)->sin_port);
   listen_fd_ = fd;
   sinks_ = std::make_unique<Sinks>();
+  deadlines_ = std::make_unique<RequestDeadlines>(options_.request_deadline_ms, log_);
 
   // Threads start with their creator's nice value: libmicrohttpd's listening thread is created
   // from one at the web's priority, and it creates every connection's thread.
@@ -220,6 +256,7 @@ Status WebServer::Start() {
     if (setpriority(PRIO_PROCESS, static_cast<id_t>(ThreadId()), options_.nice) != 0) {
       nice_err = errno;
     }
+    deadlines_->Start();
     const unsigned flags = MHD_USE_INTERNAL_POLLING_THREAD | MHD_USE_THREAD_PER_CONNECTION |
                            MHD_USE_POLL | MHD_USE_ERROR_LOG;
     mhd_ = MHD_start_daemon(
@@ -230,7 +267,7 @@ Status WebServer::Start() {
         MHD_OPTION_CONNECTION_MEMORY_LIMIT, options_.connection_memory,
         MHD_OPTION_CONNECTION_TIMEOUT, static_cast<unsigned>(options_.timeout_s),
         MHD_OPTION_THREAD_STACK_SIZE, static_cast<size_t>(1u << 20), MHD_OPTION_NOTIFY_COMPLETED,
-        &OnCompleted, this, MHD_OPTION_END);
+        &OnCompleted, this, MHD_OPTION_NOTIFY_CONNECTION, &OnConnection, this, MHD_OPTION_END);
   });
   starter.join();
   if (mhd_ == nullptr) {
@@ -238,6 +275,7 @@ Status WebServer::Start() {
     // where it failed (a thread or memory it could not get), and closing a number another
     // thread may have reused since would be worse than one descriptor left open.
     listen_fd_ = -1;
+    deadlines_.reset();
     return Status(Code::kIoError, "web: libmicrohttpd did not start");
   }
   if (nice_err != 0) {
@@ -246,9 +284,10 @@ Status WebServer::Start() {
   }
   log_->Printf(LogLevel::kInfo,
                "web: listening on %s%s%s:%d (page files from %s; at most %d connections, %d per "
-               "client)",
+               "client, a whole request within %.1f s)",
                v6 ? "[" : "", options_.address.c_str(), v6 ? "]" : "", port_,
-               options_.web_root.c_str(), options_.max_connections, options_.max_per_client);
+               options_.web_root.c_str(), options_.max_connections, options_.max_per_client,
+               options_.request_deadline_ms / 1000.0);
   return Status::Ok();
 }
 
@@ -259,6 +298,7 @@ void WebServer::Stop() {
   MHD_stop_daemon(mhd_);
   mhd_ = nullptr;
   listen_fd_ = -1;
+  deadlines_.reset();  // every connection has closed
   log_->Printf(LogLevel::kInfo, "web: stopped after %lld request(s)",
                static_cast<long long>(requests_.load()));
 }
@@ -306,12 +346,18 @@ bool WebServer::Handle(MHD_Connection* c, const char* url, const char* method, c
       r->too_large = true;
     } else {
       r->body_bytes += *upload_size;
+      r->body.append(upload, *upload_size);
       if (r->post == nullptr || MHD_post_process(r->post, upload, *upload_size) != MHD_YES) {
         r->bad_body = true;
       }
     }
     *upload_size = 0;
     return true;
+  }
+  deadlines_->Whole(DeadlineOf(c));
+  // The library's form parser passes over a field sent without a value; it is still a field.
+  if (r->post != nullptr && !r->bad_body && !r->fields.AddEmpty(r->body.data(), r->body.size())) {
+    r->bad_body = true;
   }
   if (r->too_large) {
     return ReplyError(c, r, MHD_HTTP_CONTENT_TOO_LARGE, "request body over the limit");
@@ -336,12 +382,12 @@ bool WebServer::Route(MHD_Connection* c, const char* url, const char* method, Re
   };
   for (const auto& page : kPage) {
     if (strcmp(url, page.url) == 0) {
-      if (!get) return ReplyError(c, r, MHD_HTTP_METHOD_NOT_ALLOWED, "only GET");
+      if (!get) return NotAllowed(c, r, "GET, HEAD");
       return ServePage(c, r, page.file, page.type);
     }
   }
   if (strcmp(url, "/api/login") == 0) {
-    if (!post) return ReplyError(c, r, MHD_HTTP_METHOD_NOT_ALLOWED, "only POST");
+    if (!post) return NotAllowed(c, r, "POST");
     return Login(c, r);
   }
   if (!Authorized(c)) {
@@ -349,20 +395,20 @@ bool WebServer::Route(MHD_Connection* c, const char* url, const char* method, Re
   }
   const char* rest = nullptr;
   if (strcmp(url, "/api/photos") == 0) {
-    if (!get) return ReplyError(c, r, MHD_HTTP_METHOD_NOT_ALLOWED, "only GET");
+    if (!get) return NotAllowed(c, r, "GET, HEAD");
     return ListPhotos(c, r);
   }
   if (StartsWith(url, "/photos/", &rest) || StartsWith(url, "/thumbs/", &rest)) {
-    if (!get) return ReplyError(c, r, MHD_HTTP_METHOD_NOT_ALLOWED, "only GET");
+    if (!get) return NotAllowed(c, r, "GET, HEAD");
     return ServePhoto(c, r, rest, url[1] == 't');
   }
   if (StartsWith(url, "/api/info/", &rest)) {
-    if (!get) return ReplyError(c, r, MHD_HTTP_METHOD_NOT_ALLOWED, "only GET");
+    if (!get) return NotAllowed(c, r, "GET, HEAD");
     return Info(c, r, rest);
   }
   if (StartsWith(url, "/api/", &rest) &&
       (strcmp(rest, "preview") == 0 || strcmp(rest, "render") == 0 || strcmp(rest, "save") == 0)) {
-    if (!post) return ReplyError(c, r, MHD_HTTP_METHOD_NOT_ALLOWED, "only POST");
+    if (!post) return NotAllowed(c, r, "POST");
     return Refocus(c, r, rest);
   }
   return ReplyError(c, r, MHD_HTTP_NOT_FOUND, "no such page");
@@ -379,18 +425,8 @@ bool WebServer::Authorized(MHD_Connection* c) const {
 }
 
 void WebServer::LogRequest(MHD_Connection* c, const Request* r, int status, const char* why) {
-  char client[INET6_ADDRSTRLEN] = "?";
-  const MHD_ConnectionInfo* info = MHD_get_connection_info(c, MHD_CONNECTION_INFO_CLIENT_ADDRESS);
-  if (info != nullptr && info->client_addr != nullptr) {
-    const sockaddr* sa = info->client_addr;
-    if (sa->sa_family == AF_INET) {
-      inet_ntop(AF_INET, &reinterpret_cast<const sockaddr_in*>(sa)->sin_addr, client,
-                sizeof(client));
-    } else if (sa->sa_family == AF_INET6) {
-      inet_ntop(AF_INET6, &reinterpret_cast<const sockaddr_in6*>(sa)->sin6_addr, client,
-                sizeof(client));
-    }
-  }
+  char client[INET6_ADDRSTRLEN];
+  ClientText(c, client, sizeof(client));
   LogLevel level = LogLevel::kInfo;
   if (status >= 500 && status != MHD_HTTP_SERVICE_UNAVAILABLE) {
     level = LogLevel::kError;
@@ -402,7 +438,7 @@ void WebServer::LogRequest(MHD_Connection* c, const Request* r, int status, cons
 }
 
 bool WebServer::Reply(MHD_Connection* c, Request* r, int status, const char* type, const void* data,
-                      size_t size, const char* why) {
+                      size_t size, const char* why, const char* allow) {
   MHD_Response* response =
       MHD_create_response_from_buffer(size, const_cast<void*>(data), MHD_RESPMEM_MUST_COPY);
   if (response == nullptr) return false;
@@ -412,6 +448,7 @@ bool WebServer::Reply(MHD_Connection* c, Request* r, int status, const char* typ
   if (status == MHD_HTTP_SERVICE_UNAVAILABLE) {
     MHD_add_response_header(response, MHD_HTTP_HEADER_RETRY_AFTER, "1");
   }
+  if (allow != nullptr) MHD_add_response_header(response, MHD_HTTP_HEADER_ALLOW, allow);
   return Send(c, r, response, status, why);
 }
 
@@ -424,15 +461,58 @@ bool WebServer::Send(MHD_Connection* c, Request* r, MHD_Response* response, int 
   return ok;
 }
 
-bool WebServer::ReplyError(MHD_Connection* c, Request* r, int status, const char* why) {
+bool WebServer::ReplyError(MHD_Connection* c, Request* r, int status, const char* why,
+                           const char* log_why, const char* allow) {
   std::string json = "{\"error\":";
   AppendJsonString(&json, why);
   json += "}";
-  return Reply(c, r, status, "application/json", json.data(), json.size(), why);
+  return Reply(c, r, status, "application/json", json.data(), json.size(),
+               log_why != nullptr ? log_why : why, allow);
 }
 
 bool WebServer::ReplyStatus(MHD_Connection* c, Request* r, const Status& s) {
-  return ReplyError(c, r, HttpStatusFor(s.code()), s.message());
+  return ReplyError(c, r, HttpStatusFor(s.code()), PublicText(s.message()).c_str(), s.message());
+}
+
+bool WebServer::NotAllowed(MHD_Connection* c, Request* r, const char* allow) {
+  char why[64];
+  snprintf(why, sizeof(why), "only %s", allow);
+  return ReplyError(c, r, MHD_HTTP_METHOD_NOT_ALLOWED, why, nullptr, allow);
+}
+
+std::string WebServer::PublicText(const char* text) const {
+  std::string out = text;
+  // The folder itself first (its name may hold spaces): "photo folder /media/card: ..." reads
+  // "photo folder: ...", "/media/card/IMG_1.jpg: ..." reads "IMG_1.jpg: ...".
+  std::string dir = options_.photo_dir;
+  while (dir.size() > 1 && dir.back() == '/') dir.pop_back();
+  if (!dir.empty() && dir != "/") {
+    for (size_t at; (at = out.find(dir)) != std::string::npos;) {
+      size_t end = at + dir.size();
+      while (end < out.size() && out[end] == '/') ++end;
+      size_t begin = at;
+      if (end == at + dir.size() && begin > 0 && out[begin - 1] == ' ') --begin;
+      out.erase(begin, end - begin);
+    }
+  }
+  // Any other absolute path: its last name.
+  std::string cut;
+  for (size_t i = 0; i < out.size();) {
+    const bool starts_word = i == 0 || out[i - 1] == ' ' || out[i - 1] == '(' || out[i - 1] == '\'';
+    if (out[i] != '/' || !starts_word) {
+      cut.push_back(out[i++]);
+      continue;
+    }
+    size_t end = i;
+    while (end < out.size() && out[end] != ' ' && out[end] != ':' && out[end] != ',' &&
+           out[end] != ')' && out[end] != '\'') {
+      ++end;
+    }
+    const size_t slash = out.rfind('/', end - 1);
+    cut.append(out, slash + 1, end - slash - 1);
+    i = end;
+  }
+  return cut;
 }
 
 }  // namespace lb

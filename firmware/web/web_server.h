@@ -4,7 +4,8 @@
 // HTTP comes from GNU libmicrohttpd (Debian libmicrohttpd12, C, made for embedded devices): it
 // parses requests (no HTTP parsing here), percent-decodes the path, bounds each connection's
 // memory pool (headers and the body buffer), the number of connections, the connections per
-// client address, and drops idle connections after a timeout. One thread per connection, all
+// client address, and drops idle connections after a timeout; a request that has not arrived
+// whole by its deadline is cut here (web_deadline.h). One thread per connection, all
 // created from a thread started at a lower priority (nice), so every web thread runs below the
 // camera's and a blocking render waits in its own connection only.
 //
@@ -29,8 +30,10 @@
 //   POST /api/save       the same body -> {"name":"IMG_..._r1.jpg"}, a new photo beside the
 //                        original (_r1, _r2, ...: the first absent), never over a file
 // NAME is one path component checked by photo_folder.h and opened without following links.
-// Errors are JSON {"error":"..."}: 400 bad name or body, 401, 404, 405, 413 body over 16 KiB,
-// 422 a photo that cannot be refocused, 503 + Retry-After when the renderer is busy.
+// Errors are JSON {"error":"..."} naming photos, never a folder's path (the log has the paths):
+// 400 bad name or body (a field sent empty included), 401, 404, 405 with Allow, 409 every
+// re-render name taken, 413 body over 16 KiB, 422 a photo that cannot be refocused, 503 +
+// Retry-After when the renderer is busy or a thumbnail waited too long for the camera.
 #pragma once
 
 #include <sys/stat.h>
@@ -54,6 +57,7 @@ struct MHD_Response;
 namespace lb {
 
 class CameraDaemon;
+class RequestDeadlines;
 
 struct WebServerOptions {
   std::string address = "127.0.0.1";  // numeric IPv4 or IPv6
@@ -61,14 +65,20 @@ struct WebServerOptions {
   std::string token;                  // required, at least 16 characters
   std::string web_root;               // index.html, app.js, style.css
   std::string photo_dir;
-  int32_t max_connections = 16;
-  int32_t max_per_client = 8;
+  // A browser opens up to 6 connections to a host; a few addresses cannot take every slot.
+  int32_t max_connections = 24;
+  int32_t max_per_client = 6;
   size_t connection_memory = 32 * 1024;  // per connection: request line, headers, body buffer
   int32_t timeout_s = 15;                // an idle connection is closed
-  size_t max_body = 16 * 1024;           // larger request bodies: 413
-  int32_t nice = 10;                     // of every web thread (the camera's stay at 0)
-  size_t max_listed = 5000;              // newest photos listed
+  // A whole request (headers and body) must arrive within this of the connection opening or of
+  // its previous answer, however steadily it trickles in.
+  int32_t request_deadline_ms = 10000;
+  size_t max_body = 16 * 1024;  // larger request bodies: 413
+  int32_t nice = 10;            // of every web thread (the camera's stay at 0)
+  size_t max_listed = 5000;     // newest photos listed
   int32_t thumb_width = 320;
+  // A thumbnail waits at most this long for the camera to finish a photo, then gets 503.
+  int32_t camera_wait_ms = 30000;
   int32_t failed_login_delay_ms = 500;  // slows guessing down
 };
 
@@ -95,17 +105,27 @@ class WebServer {
   bool Handle(MHD_Connection* c, const char* url, const char* method, const char* upload,
               size_t* upload_size, Request** request);
   void LogLibraryMessage(const char* text);
+  RequestDeadlines* deadlines() { return deadlines_.get(); }
 
   class Sinks;  // the render outputs, reused (web_server.cc)
 
  private:
   bool Route(MHD_Connection* c, const char* url, const char* method, Request* r);
+  // `allow`: the Allow header of a 405.
   bool Reply(MHD_Connection* c, Request* r, int status, const char* type, const void* data,
-             size_t size, const char* why);
+             size_t size, const char* why, const char* allow = nullptr);
   // Queues `response` (and frees it) with `status`, marks the request answered and logs it.
   bool Send(MHD_Connection* c, Request* r, MHD_Response* response, int status, const char* why);
-  bool ReplyError(MHD_Connection* c, Request* r, int status, const char* why);
+  // `why` is the client's; the log gets `log_why` when given (the same with paths).
+  bool ReplyError(MHD_Connection* c, Request* r, int status, const char* why,
+                  const char* log_why = nullptr, const char* allow = nullptr);
   bool ReplyStatus(MHD_Connection* c, Request* r, const Status& s);
+  bool NotAllowed(MHD_Connection* c, Request* r, const char* allow);
+  // `text` as a client may see it: the photo folder's path and any other absolute path cut down
+  // to the last name in it.
+  std::string PublicText(const char* text) const;
+  // Returns once the camera takes no photo; kBusy when `deadline` (steady clock, ms) passes first.
+  Status WaitForCamera(int64_t deadline_ms) const;
   bool Authorized(MHD_Connection* c) const;
   bool ServePage(MHD_Connection* c, Request* r, const char* file, const char* type);
   bool Login(MHD_Connection* c, Request* r);
@@ -125,6 +145,7 @@ class WebServer {
   int listen_fd_ = -1;
   int32_t port_ = 0;
   std::unique_ptr<Sinks> sinks_;
+  std::unique_ptr<RequestDeadlines> deadlines_;
   std::mutex save_mutex_;  // one save at a time chooses its name and writes it (web path only)
   std::atomic<int64_t> requests_{0};
 };

@@ -39,9 +39,20 @@ std::string HttpResponse::Header(const std::string& name) const {
   return "";
 }
 
-int ConnectLoopback(int port) {
+int ConnectLoopback(int port) { return ConnectLoopbackFrom(nullptr, port); }
+
+int ConnectLoopbackFrom(const char* source, int port) {
   const int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
   if (fd < 0) return -1;
+  if (source != nullptr) {
+    sockaddr_in from{};
+    from.sin_family = AF_INET;
+    if (inet_pton(AF_INET, source, &from.sin_addr) != 1 ||
+        bind(fd, reinterpret_cast<sockaddr*>(&from), sizeof(from)) != 0) {
+      close(fd);
+      return -1;
+    }
+  }
   sockaddr_in a{};
   a.sin_family = AF_INET;
   a.sin_port = htons(static_cast<uint16_t>(port));

@@ -19,6 +19,9 @@ struct HttpResponse {
 
 // Connects to 127.0.0.1:port; -1 on failure.
 int ConnectLoopback(int port);
+// The same from `source`, another loopback address ("127.0.0.2": Linux answers all of 127/8), so
+// one test can be several clients to the server's per-address limit.
+int ConnectLoopbackFrom(const char* source, int port);
 
 // Sends `method target` with `headers` (each "Name: value\r\n") and `body`, and reads the answer
 // to the end of the connection (at most `timeout_ms`).

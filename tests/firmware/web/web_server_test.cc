@@ -336,6 +336,53 @@ TEST_F(WebServerTest, InfoPreviewRenderAndSaveReachTheRenderer) {
   EXPECT_EQ(sink_.Count("POST /api/save 200: saved IMG_20260101_120000_0001_r2.jpg"), 1);
 }
 
+// Absent, an optional field takes its default; present but empty, it is a mistake like any
+// other bad value.
+TEST_F(WebServerTest, EmptyFieldsAre400) {
+  Start();
+  const std::string tap = std::string("name=") + kPhoto + "&x0=0.5&y0=0.5";
+  EXPECT_EQ(Post("/api/preview", tap).status, 200);
+  for (const char* empty : {"&f=", "&blades=", "&x1=", "&y1=", "&f", "&x1=&y1=0.5"}) {
+    HttpResponse r = Post("/api/preview", tap + empty);
+    EXPECT_EQ(r.status, 400) << empty << ": " << r.body;
+    EXPECT_NE(r.body.find("empty"), std::string::npos) << empty << ": " << r.body;
+  }
+  EXPECT_EQ(Post("/api/preview", std::string("name=") + kPhoto + "&x0=&y0=0.5").status, 400);
+}
+
+// A method a path does not take is 405 with the ones it does.
+TEST_F(WebServerTest, MethodNotAllowedSaysWhichAre) {
+  Start();
+  const struct {
+    const char *method, *target, *allow;
+  } kCases[] = {
+      {"POST", "/", "GET, HEAD"},
+      {"DELETE", "/app.js", "GET, HEAD"},
+      {"GET", "/api/login", "POST"},
+      {"PUT", "/api/photos", "GET, HEAD"},
+      {"POST", "/thumbs/a.jpg", "GET, HEAD"},
+      {"GET", "/api/save", "POST"},
+      {"DELETE", "/api/info/a.jpg", "GET, HEAD"},
+  };
+  for (const auto& c : kCases) {
+    HttpResponse r = Http(port_, c.method, c.target, kAuth);
+    EXPECT_EQ(r.status, 405) << c.method << " " << c.target;
+    EXPECT_EQ(r.Header("Allow"), c.allow) << c.method << " " << c.target;
+  }
+}
+
+// Every re-render name taken: no retry can help, so not 503 but 409 saying what to do.
+TEST_F(WebServerTest, NoFreeRerenderNameIs409) {
+  for (int k = 1; k <= 99; ++k) {
+    WriteFile(photos_.Path("IMG_20260101_120000_0001_r" + std::to_string(k) + ".jpg"), "x");
+  }
+  Start();
+  HttpResponse r = Post("/api/save", std::string("name=") + kPhoto + "&x0=0.3&y0=0.3");
+  EXPECT_EQ(r.status, 409) << r.body;
+  EXPECT_EQ(r.Header("Retry-After"), "");
+  EXPECT_NE(r.body.find("_r99"), std::string::npos) << r.body;
+}
+
 TEST_F(WebServerTest, TraversalAbsolutePathsAndLinksAreRefused) {
   ASSERT_EQ(symlink(outside_.Path("outside.jpg").c_str(), photos_.Path("link.jpg").c_str()), 0);
   Start();
