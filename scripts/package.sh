@@ -8,12 +8,34 @@
 #                                         ARCH:  arm64 or armhf
 # Writes build/packages/refocusd_<version>+deb<N>_<ARCH>.deb and prints its path last; the
 # release's root stays in build/roots/SUITE-cross-ARCH. --root-only makes the root and stops.
+#
+#   package.sh native
+# On the board itself (Raspberry Pi OS, or any Debian-based system with its own libcamera):
+# installs the build's packages with apt, builds against the system's own libraries and writes
+# build/packages/refocusd_<version>+local_<arch>.deb for that system alone.
 set -euo pipefail
+top=$(cd "$(dirname "$0")/.." && pwd)
+if [[ ${1:-} == native ]]; then
+  SUDO=""
+  [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  $SUDO apt-get -o DPkg::Lock::Timeout=600 install -y -q cmake ninja-build g++ pkg-config \
+    dpkg-dev file libcamera-dev libjpeg62-turbo-dev libpng-dev libexif-dev libeigen3-dev \
+    libmd-dev libmicrohttpd-dev >/dev/null
+  tree=$top/build/package/native
+  cmake -S "$top" -B "$tree" -G Ninja -DCMAKE_BUILD_TYPE=Release -DLB_TESTS=OFF \
+    -DLB_BENCHMARKS=OFF -DLB_DEB_RELEASE=local >/dev/null
+  cmake --build "$tree" -j "${JOBS:-$(nproc)}"
+  rm -f "$tree"/*.deb
+  (cd "$tree" && cpack -G DEB >cpack.log 2>&1) || { cat "$tree/cpack.log"; exit 1; }
+  mkdir -p "$top/build/packages"
+  cp "$tree"/*.deb "$top/build/packages/"
+  echo "$top/build/packages/$(basename "$tree"/*.deb)"
+  exit 0
+fi
 root_only=0
 [[ ${1:-} == --root-only ]] && { root_only=1; shift; }
-suite=${1:?usage: package.sh [--root-only] bookworm|trixie arm64|armhf}
+suite=${1:?usage: package.sh [--root-only] bookworm|trixie arm64|armhf, or package.sh native}
 arch=${2:?usage: package.sh [--root-only] bookworm|trixie arm64|armhf}
-top=$(cd "$(dirname "$0")/.." && pwd)
 case $suite in
   bookworm) release=deb12 ;;
   trixie) release=deb13 ;;
