@@ -3,8 +3,7 @@
 #include <sys/socket.h>
 
 #include <cstdio>
-
-#include "firmware/daemon/log.h"
+#include <utility>
 
 namespace lb {
 
@@ -16,8 +15,9 @@ struct RequestDeadlines::Entry {
   bool cut = false;
 };
 
-RequestDeadlines::RequestDeadlines(int32_t deadline_ms, Log* log)
-    : deadline_ms_(deadline_ms), log_(log) {}
+RequestDeadlines::RequestDeadlines(int32_t deadline_ms,
+                                   std::function<void(const char* client)> on_cut)
+    : deadline_ms_(deadline_ms), on_cut_(std::move(on_cut)) {}
 
 RequestDeadlines::~RequestDeadlines() { Stop(); }
 
@@ -90,10 +90,7 @@ void RequestDeadlines::Loop() {
         // The connection's thread sees the end of the stream and closes it the usual way.
         shutdown(e->fd, SHUT_RDWR);
         e->cut = true;
-        if (log_ != nullptr) {
-          log_->Printf(LogLevel::kWarning, "web: %s no whole request within %.1f s; closed",
-                       e->client, deadline_ms_ / 1000.0);
-        }
+        if (on_cut_) on_cut_(e->client);
       } else if (e->due < next) {
         next = e->due;
       }

@@ -10,20 +10,19 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <mutex>
 #include <set>
 #include <thread>
 
 namespace lb {
 
-class Log;
-
 class RequestDeadlines {
  public:
   struct Entry;
 
-  // `log` is borrowed.
-  RequestDeadlines(int32_t deadline_ms, Log* log);
+  // `on_cut` is told each client cut (for the log), on the deadlines' thread.
+  RequestDeadlines(int32_t deadline_ms, std::function<void(const char* client)> on_cut);
   ~RequestDeadlines();  // Stop
   RequestDeadlines(const RequestDeadlines&) = delete;
   RequestDeadlines& operator=(const RequestDeadlines&) = delete;
@@ -46,7 +45,7 @@ class RequestDeadlines {
   void Loop();
 
   const int32_t deadline_ms_;
-  Log* log_;
+  const std::function<void(const char*)> on_cut_;
   std::mutex mutex_;
   std::condition_variable wake_;
   std::set<Entry*> open_;

@@ -247,7 +247,11 @@ Status WebServer::Start() {
                    : reinterpret_cast<sockaddr_in*>(&bound)->sin_port);
   listen_fd_ = fd;
   sinks_ = std::make_unique<Sinks>();
-  deadlines_ = std::make_unique<RequestDeadlines>(options_.request_deadline_ms, log_);
+  deadlines_ =
+      std::make_unique<RequestDeadlines>(options_.request_deadline_ms, [this](const char* client) {
+        log_->Printf(LogLevel::kWarning, "web: %s no whole request within %.1f s; closed", client,
+                     options_.request_deadline_ms / 1000.0);
+      });
 
   // Threads start with their creator's nice value: libmicrohttpd's listening thread is created
   // from one at the web's priority, and it creates every connection's thread.
