@@ -13,6 +13,7 @@
 
 #include "firmware/codecs/exif.h"
 #include "firmware/refocusable/base64.h"
+#include "firmware/refocusable/depth_image.h"
 
 namespace lb {
 namespace {
@@ -177,11 +178,14 @@ Status ReadDepth(const char* name, const Fields& f, RefocusableMemory& memory,
                   near_depth, far_depth);
   }
   LB_RETURN_IF_ERROR(f.Text(kGDepthNs, "GDepth", "Mime", &text));
-  if (text != "image/png") {
-    return Status(Code::kUnsupported, "%s: GDepth:Mime '%.*s' (only image/png)", name,
+  if (text != "image/png" && text != "image/jpeg") {
+    return Status(Code::kUnsupported, "%s: GDepth:Mime '%.*s' (image/png or image/jpeg)", name,
                   static_cast<int>(text.size() < 32 ? text.size() : 32), text.data());
   }
   out->depth_mime = text;
+  if (f.Has(kGDepthNs, "GDepth", "Units")) {
+    LB_RETURN_IF_ERROR(f.Text(kGDepthNs, "GDepth", "Units", &out->depth_units));
+  }
   LB_RETURN_IF_ERROR(f.Base64(kGDepthNs, "GDepth", "Data", memory,
                               RefocusableMemory::Part::kDepthPng, &out->depth_png,
                               &out->depth_png_size));
@@ -447,6 +451,7 @@ Status ReadRefocusable(const uint8_t* data, size_t size, const char* name, Refoc
   d.near_depth = f.near_depth;
   d.far_depth = f.far_depth;
   d.mime = std::string(f.depth_mime);
+  d.units = std::string(f.depth_units);
   d.width = f.depth_width;
   d.height = f.depth_height;
   if (f.image != nullptr) out->xmp.image_mime = std::string(f.image_mime);
@@ -454,8 +459,8 @@ Status ReadRefocusable(const uint8_t* data, size_t size, const char* name, Refoc
   out->xmp.focus = f.focus;
   char what[300];
   DepthPngName(name, what, sizeof(what));
-  return DecodeGrayPng(d.data.data(), d.data.size(), what, f.depth_max_side, d.width, d.height,
-                       &out->depth);
+  return DecodeDepthImage(d.data.data(), d.data.size(), d.mime, what, f.depth_max_side, d.width,
+                          d.height, &out->depth);
 }
 
 Status ReadRefocusableFile(const char* path, RefocusableImage* out) {
@@ -494,6 +499,44 @@ Status DisparityFromDepth(const RefocusableImage& image, std::vector<uint16_t>* 
   disp_q8->assign(png.values.size(), 0);
   ConstImageU16 values = MakeView(png.values.data(), png.width, png.height);
   return DecodeDepthMap(values, *range, png.bits, MakeView(disp_q8->data(), png.width, png.height));
+}
+
+Status ScaledDisparityFromDepth(const RefocusableImage& image, double scale,
+                                std::vector<uint16_t>* disp_q8, DisparityRange* range) {
+  const GDepthInfo& d = image.xmp.depth;
+  if (scale == 1.0 || d.format != "RangeInverse") return DisparityFromDepth(image, disp_q8, range);
+  const double near_depth = d.near_depth, far_depth = d.far_depth;
+  if (!(scale > 0.0 && std::isfinite(scale) && near_depth > 0.0 && far_depth > near_depth &&
+        std::isfinite(far_depth))) {
+    return Status(Code::kUnsupported, "depth map: Near %g, Far %g at scale %g give no disparity",
+                  near_depth, far_depth, scale);
+  }
+  const double max_q8 = 256.0 * scale / near_depth;
+  if (!(max_q8 <= 65535.0)) {
+    return Status(Code::kUnsupported, "depth map: Near %g at scale %g is too close", near_depth,
+                  scale);
+  }
+  range->max_q8 = static_cast<int32_t>(std::lround(max_q8));
+  range->min_q8 = static_cast<int32_t>(std::lround(256.0 * scale / far_depth));
+  if (range->min_q8 >= range->max_q8) {
+    return Status(Code::kUnsupported, "depth map: Near %g and Far %g are one disparity at scale %g",
+                  near_depth, far_depth, scale);
+  }
+  // Every stored value once, whatever the map's size.
+  const GrayPng& png = image.depth;
+  const int32_t top = png.bits == 16 ? 65535 : 255;
+  std::vector<uint16_t> table(static_cast<size_t>(top) + 1);
+  for (int32_t v = 0; v <= top; ++v) {
+    const double dn = static_cast<double>(v) / top;
+    const double depth = far_depth * near_depth / (far_depth - dn * (far_depth - near_depth));
+    table[static_cast<size_t>(v)] =
+        static_cast<uint16_t>(std::clamp(std::lround(256.0 * scale / depth), 0L, 65535L));
+  }
+  disp_q8->resize(png.values.size());
+  for (size_t i = 0; i < png.values.size(); ++i) {
+    (*disp_q8)[i] = table[std::min<size_t>(png.values[i], static_cast<size_t>(top))];
+  }
+  return Status::Ok();
 }
 
 }  // namespace lb

@@ -59,10 +59,10 @@ struct RefocusableFields {
   int32_t width = 0;  // the primary (refocused) image, from its frame header
   int32_t height = 0;
   int32_t orientation = 0;  // the photo's EXIF Orientation 1..8, 0 when it records none
-  std::string_view depth_format, depth_mime;
+  std::string_view depth_format, depth_mime, depth_units;  // units: "" when not given
   double near_depth = 0.0, far_depth = 0.0;
   int32_t depth_width = 0, depth_height = 0;  // GDepth:ImageWidth/Height, 0 = not recorded
-  const uint8_t* depth_png = nullptr;         // the depth image, still encoded
+  const uint8_t* depth_png = nullptr;  // the depth image (PNG or JPEG, depth_mime), still encoded
   size_t depth_png_size = 0;
   int32_t depth_max_side =
       0;  // the largest side the depth image may have (no larger than the photo)
@@ -80,7 +80,7 @@ struct RefocusableImage {
   int32_t width = 0;  // the primary (refocused) image, from its frame header
   int32_t height = 0;
   RefocusableXmp xmp;  // depth.data holds the PNG bytes, image the original JPEG (may be empty)
-  GrayPng depth;       // the decoded depth image
+  GrayPng depth;       // the decoded depth image, grey whatever colour type it was stored in
   int32_t orientation = 0;  // the photo's EXIF Orientation 1..8, 0 when it records none
 };
 
@@ -94,5 +94,11 @@ void DepthPngName(const char* name, char* out, size_t out_size);
 // The depth image as Q8.8 disparity (RangeInverse files), with the range its Near and Far give.
 Status DisparityFromDepth(const RefocusableImage& image, std::vector<uint16_t>* disp_q8,
                           DisparityRange* range);
+
+// The depth image as Q8.8 disparity (RangeInverse files) with disparity = `scale` / depth: a
+// phone's depth is in its own units, not the product's 1 / px. Scale 1 is DisparityFromDepth,
+// exact for the product's own files.
+Status ScaledDisparityFromDepth(const RefocusableImage& image, double scale,
+                                std::vector<uint16_t>* disp_q8, DisparityRange* range);
 
 }  // namespace lb

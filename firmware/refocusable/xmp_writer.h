@@ -31,7 +31,8 @@ struct GDepthInfo {
   double near_depth = 0.0;
   double far_depth = 0.0;
   std::string mime = "image/png";
-  std::vector<uint8_t> data;  // the encoded depth image (PNG bytes)
+  std::string units;          // GDepth:Units as read ("" = not given); not written
+  std::vector<uint8_t> data;  // the encoded depth image (PNG or JPEG bytes)
   int32_t width = 0;          // GDepth:ImageWidth / ImageHeight, 0 = not written
   int32_t height = 0;
 };

@@ -224,10 +224,13 @@ TEST(RefocusableTest, BadFieldsAreReported) {
                "not a valid range");
   ExpectDefect(WithMainPacket(s, "GDepth:Format=\"[^\"]*\"", "GDepth:Format=\"Disparity\""),
                "GDepth:Format 'Disparity'");
+  ExpectDefect(WithMainPacket(s, "GDepth:Mime=\"[^\"]*\"", "GDepth:Mime=\"image/gif\""),
+               "(image/png or image/jpeg)");
   ExpectDefect(WithMainPacket(s, "GDepth:Mime=\"[^\"]*\"", "GDepth:Mime=\"image/jpeg\""),
-               "only image/png");
+               "Not a JPEG");
   ExpectDefect(WithMainPacket(s, "GDepth:Data=\"", "GDepth:Data=\"!"), "base64");
-  ExpectDefect(WithMainPacket(s, "GDepth:Data=\"[^\"]*\"", "GDepth:Data=\"AAAA\""), "not a PNG");
+  ExpectDefect(WithMainPacket(s, "GDepth:Data=\"[^\"]*\"", "GDepth:Data=\"AAAA\""),
+               "PNG data ends");
   ExpectDefect(WithMainPacket(s, "GDepth:ImageWidth=\"[^\"]*\"", "GDepth:ImageWidth=\"25\""),
                "expected 25x16");
   ExpectDefect(WithMainPacket(s, "GDepth:ImageHeight=\"[^\"]*\"", ""), "must come together");
