@@ -12,6 +12,7 @@
 #include "firmware/app/job.h"
 #include "firmware/app/progress.h"
 #include "firmware/refocusable/depth_encoding.h"
+#include "firmware/refocusable/xmp_writer.h"
 
 namespace lb {
 
@@ -61,9 +62,16 @@ class Ycc420Sink final : public FrameSink {
 
 class Rerenderer {
  public:
-  // Reads `path`: its GDepth must be RangeInverse and its depth map a whole-number fraction of
-  // the original's size (as `refocus run` writes them).
+  // Reads `path`: its GDepth (RangeInverse or RangeLinear, PNG or JPEG, any size up to the
+  // photo's: resampled onto the render's working grid) and the original it refocuses, GImage or,
+  // when the file has none, the photo itself (from_primary()).
   Status Load(const char* path);
+  // The file's own focus (GFocus: its point, moved to the nearest pixel at its FocalDistance,
+  // and the f-number that gives its BlurAtInfinity) into `params`, except what the user chose.
+  void StartFromFile(RenderParams* params, bool keep_focus, bool keep_f_number) const;
+  bool has_file_focus() const { return has_file_focus_; }
+  // The file had no GImage: the starting picture is already blurred where it was not in focus.
+  bool from_primary() const { return from_primary_; }
   // Renders and writes `out_path` atomically; `observer` sees every strip before encoding.
   Status Render(const RerenderOptions& options, const char* out_path,
                 StripObserver* observer = nullptr);
@@ -75,12 +83,24 @@ class Rerenderer {
   int32_t working_scale() const { return scale_; }
 
  private:
+  // How a file's depth maps to the render's disparity: disparity = scale / depth, and the
+  // f-number that reproduces its GFocus blur.
+  struct FileUnits {
+    double scale = 1.0;
+    float f_number = 2.8f;
+  };
+  static FileUnits ChooseUnits(const RefocusableXmp& xmp, int32_t width, int32_t scale);
+  FocusRegion FocusNear(double point_x, double point_y, double target_q8) const;
+
   int32_t width_ = 0, height_ = 0, scale_ = 1, depth_w_ = 0, depth_h_ = 0;
   int32_t orientation_ = 0;           // the file's EXIF Orientation, carried into the re-render
   std::vector<uint8_t> y_, cb_, cr_;  // the original as JFIF YCbCr 4:2:0
   std::vector<uint16_t> disp_q8_;
   DisparityRange range_;
-  std::vector<uint8_t> original_jpeg_;
+  std::vector<uint8_t> original_jpeg_;  // empty when from_primary_: the output has no GImage
+  bool from_primary_ = false, has_file_focus_ = false;
+  FocusRegion file_focus_;
+  float file_f_number_ = 2.8f;
 };
 
 }  // namespace lb

@@ -7,5 +7,6 @@ namespace lb::cli {
 int RunCommand(int argc, char** argv);       // refocus run: burst -> refocused JPEG
 int DepthCommand(int argc, char** argv);     // refocus depth: views -> disparity PFM (+ preview)
 int RerenderCommand(int argc, char** argv);  // refocus rerender: refocusable JPEG -> new focus
+int InfoCommand(int argc, char** argv);      // refocus info: what a photo carries for refocusing
 
 }  // namespace lb::cli

@@ -21,6 +21,9 @@ const char kUsage[] =
 #ifdef LB_HAVE_RERENDER_COMMAND
     "  rerender   refocusable JPEG -> the same photo with a new focus\n"
 #endif
+#ifdef LB_HAVE_INFO_COMMAND
+    "  info       what a photo carries for refocusing (depth, original, focus)\n"
+#endif
     "\n"
     "'refocus COMMAND --help' describes a command's options.\n";
 
@@ -45,6 +48,9 @@ int main(int argc, char** argv) {
 #endif
 #ifdef LB_HAVE_RERENDER_COMMAND
   if (!strcmp(cmd, "rerender")) return lb::cli::RerenderCommand(argc - 1, argv + 1);
+#endif
+#ifdef LB_HAVE_INFO_COMMAND
+  if (!strcmp(cmd, "info")) return lb::cli::InfoCommand(argc - 1, argv + 1);
 #endif
   fprintf(stderr, "refocus: unknown command '%s'\n\n%s", cmd, kUsage);
   return 2;

@@ -1,5 +1,6 @@
 // refocus rerender: a refocusable JPEG -> the same photo with a new focus or aperture.
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <utility>
 
@@ -14,8 +15,11 @@ namespace {
 const char kUsage[] =
     "usage: refocus rerender IN.jpg --out OUT.jpg [--focus X,Y[,W,H]] [--f-number N] [options]\n"
     "\n"
-    "Renders a new focus from a refocusable JPEG alone (one written by `refocus run`, or any file\n"
-    "with a RangeInverse GDepth depth map and a GImage original), no burst needed.\n"
+    "Renders a new focus from a refocusable JPEG alone (one written by `refocus run`, or a\n"
+    "phone's Lens Blur photo: any file with a GDepth depth map), no burst needed. Without\n"
+    "--focus and --f-number it starts from the file's own focus and blur (GFocus) when it has\n"
+    "them. A file without the all-in-focus original (GImage) is refocused from the photo itself,\n"
+    "which is already blurred: a warning says so.\n"
     "  --out OUT.jpg          written atomically: the name holds a whole JPEG or nothing\n"
     "Lens (refocusd.conf takes the same settings, with _ for -):\n";
 
@@ -35,8 +39,13 @@ int RerenderCommand(int argc, char** argv) {
   OptionReader options(argc, argv, std::move(table));
   JobOptions lens;
   std::string out_path, error;
+  bool focus_given = false, f_number_given = false;
   for (int c; (c = options.Next(&lens)) != -1;) {
     if (c == 0) return Usage(options.error());
+    if (options.name() != nullptr) {
+      focus_given |= strcmp(options.name(), "focus") == 0;
+      f_number_given |= strcmp(options.name(), "f-number") == 0;
+    }
     if (c == kOut && !options.Once(&out_path, &error)) return Usage(error);
     if (c == kHelp) {
       printf("%s%sWork:\n%s", kUsage, SettingsHelp(SettingGroup::kLens).c_str(),
@@ -58,7 +67,16 @@ int RerenderCommand(int argc, char** argv) {
   if (!s.ok()) return Fail(s.message());
   Rerenderer r;
   s = r.Load(input);
-  if (s.ok()) s = r.Render(o, out_path.c_str());
+  if (s.ok() && r.from_primary()) {
+    fprintf(stderr,
+            "refocus: warning: %s has no all-in-focus original (GImage): refocusing the photo "
+            "itself, already blurred where it was out of focus\n",
+            input);
+  }
+  if (s.ok()) {
+    r.StartFromFile(&o.render, focus_given, f_number_given);
+    s = r.Render(o, out_path.c_str());
+  }
   progress.Clear();
   if (!s.ok()) return Fail(s.message());
   printf("wrote %s: %dx%d re-rendered at f/%.1f\n", out_path.c_str(), r.width(), r.height(),
