@@ -19,7 +19,7 @@ constexpr int32_t kCrr = FromDouble<kQ15>(0.5), kCrg = FromDouble<kQ15>(-0.41868
 // JFIF YCbCr -> RGB, Q15 (coefficients above 1 fit: int32 products stay below 2^24).
 constexpr int32_t kRcr = FromDouble<kQ15>(1.402), kGcb = FromDouble<kQ15>(-0.344136),
                   kGcr = FromDouble<kQ15>(-0.714136), kBcb = FromDouble<kQ15>(1.772);
-// BT.601 limited range YUV -> RGB, Q15 (the V4L2 default for YUYV and NV12).
+// BT.601 limited range YUV -> RGB, Q15 (the V4L2 default for YUV). Full range uses JFIF's.
 constexpr int32_t kLy = FromDouble<kQ15>(255.0 / 219.0), kLrv = FromDouble<kQ15>(1.596027),
                   kLgu = FromDouble<kQ15>(-0.391762), kLgv = FromDouble<kQ15>(-0.812968),
                   kLbu = FromDouble<kQ15>(2.017232);
@@ -34,10 +34,28 @@ inline void LimitedYuvToRgb(int32_t y, int32_t u, int32_t v, uint8_t* rgb) {
   rgb[2] = ClampU8((yy + kLbu * u) >> kQ15);
 }
 
+// The range is the row's, not the pixel's: one branch per row, and a loop per range the
+// compiler can keep free of it.
+template <typename Sample>
+inline void YuvRowToRgb(YuvRange range, int32_t width, uint8_t* rgb, Sample sample) {
+  int32_t y, u, v;
+  if (range == YuvRange::kFull) {
+    for (int32_t x = 0; x < width; ++x) {
+      sample(x, &y, &u, &v);
+      YCbCrToRgb8(y, u, v, rgb + 3 * x);
+    }
+  } else {
+    for (int32_t x = 0; x < width; ++x) {
+      sample(x, &y, &u, &v);
+      LimitedYuvToRgb(y, u, v, rgb + 3 * x);
+    }
+  }
+}
+
 }  // namespace
 
-void RowToRgb8(PixelFormat format, const uint8_t* src, const uint8_t* uv, int32_t width,
-               uint8_t* rgb) {
+void RowToRgb8(PixelFormat format, YuvRange range, const uint8_t* src, const uint8_t* u,
+               const uint8_t* v, int32_t width, uint8_t* rgb) {
   switch (format) {
     case PixelFormat::kRgb8:
       for (int32_t i = 0; i < width * 3; ++i) rgb[i] = src[i];
@@ -65,17 +83,37 @@ void RowToRgb8(PixelFormat format, const uint8_t* src, const uint8_t* uv, int32_
       }
       return;
     }
-    case PixelFormat::kYuyv:
+    case PixelFormat::kRgbx8:
+    case PixelFormat::kBgrx8: {
+      const int r = format == PixelFormat::kRgbx8 ? 0 : 2;
       for (int32_t x = 0; x < width; ++x) {
-        const uint8_t* p = src + (x / 2) * 4;
-        LimitedYuvToRgb(p[(x & 1) * 2], p[1], p[3], rgb + 3 * x);
+        rgb[3 * x] = src[4 * x + r];
+        rgb[3 * x + 1] = src[4 * x + 1];
+        rgb[3 * x + 2] = src[4 * x + 2 - r];
       }
       return;
+    }
+    case PixelFormat::kYuyv:
+      YuvRowToRgb(range, width, rgb, [src](int32_t x, int32_t* y, int32_t* cb, int32_t* cr) {
+        const uint8_t* p = src + (x / 2) * 4;
+        *y = p[(x & 1) * 2];
+        *cb = p[1];
+        *cr = p[3];
+      });
+      return;
     case PixelFormat::kNv12:
-      for (int32_t x = 0; x < width; ++x) {
-        const uint8_t* c = uv + (x / 2) * 2;
-        LimitedYuvToRgb(src[x], c[0], c[1], rgb + 3 * x);
-      }
+      YuvRowToRgb(range, width, rgb, [src, u](int32_t x, int32_t* y, int32_t* cb, int32_t* cr) {
+        *y = src[x];
+        *cb = u[(x / 2) * 2];
+        *cr = u[(x / 2) * 2 + 1];
+      });
+      return;
+    case PixelFormat::kI420:
+      YuvRowToRgb(range, width, rgb, [src, u, v](int32_t x, int32_t* y, int32_t* cb, int32_t* cr) {
+        *y = src[x];
+        *cb = u[x / 2];
+        *cr = v[x / 2];
+      });
       return;
   }
 }

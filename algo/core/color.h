@@ -9,10 +9,11 @@
 
 namespace lb {
 
-// Converts one row of `width` pixels of any PixelFormat to RGB8. For NV12, `uv` is the row of
-// the UV plane that covers this row; for other formats it is ignored.
-void RowToRgb8(PixelFormat format, const uint8_t* src, const uint8_t* uv, int32_t width,
-               uint8_t* rgb);
+// Converts one row of `width` pixels of any PixelFormat to RGB8. For the 4:2:0 formats, `u` and
+// `v` are the chroma rows that cover this row: NV12's UV row in `u` (`v` unused), I420's U and V
+// rows; for other formats both are ignored. `range` applies to the YUV formats.
+void RowToRgb8(PixelFormat format, YuvRange range, const uint8_t* src, const uint8_t* u,
+               const uint8_t* v, int32_t width, uint8_t* rgb);
 
 // One row of RGB8 to full-range luma.
 void RowRgb8ToY(const uint8_t* rgb, int32_t width, uint8_t* y);

@@ -237,6 +237,17 @@ Status Pipeline::Rows(const FrameRows& rows) {
     return Status(Code::kInvalidArgument, "frame %d: rows %d..%d out of order (expected row %d)",
                   frame_.index, rows.y0, rows.y0 + rows.height - 1, next_row_);
   }
+  const int32_t planes = PlaneCount(frame_.format);
+  for (int32_t k = 0; k < planes; ++k) {
+    if (rows.planes[k] == nullptr && rows.height > 0) {
+      return Status(Code::kInvalidArgument, "frame %d: %s rows without plane %d", frame_.index,
+                    PixelFormatName(frame_.format), k);
+    }
+  }
+  if (planes > 1 && rows.y0 % 2 != 0) {
+    return Status(Code::kInvalidArgument, "frame %d: a %s strip starts on odd row %d", frame_.index,
+                  PixelFormatName(frame_.format), rows.y0);
+  }
   // Bands of columns, each a whole number of boxes starting on an even column (a YUYV or NV12
   // pair, a 4:2:0 chroma sample), so every task writes columns of its own: the same bytes for
   // any number of workers.
@@ -249,23 +260,27 @@ Status Pipeline::Rows(const FrameRows& rows) {
     if (x1 <= x0) return;
     for (int32_t i = 0; i < rows.height; ++i) {
       const uint8_t* src = rows.planes[0] + rows.strides[0] * i;
-      const uint8_t* uv = nullptr;
-      if (frame_.format == PixelFormat::kNv12) {
-        uv = rows.planes[1] + rows.strides[1] * ((rows.y0 + i) / 2 - rows.y0 / 2);
-      }
-      IngestRow(src, uv, rows.y0 + i, {x0, x1, wx0, wx1});
+      // 4:2:0: one chroma row for two rows, the strip's first at its own start.
+      const ptrdiff_t c = (rows.y0 + i) / 2 - rows.y0 / 2;
+      const uint8_t* u = planes > 1 ? rows.planes[1] + rows.strides[1] * c : nullptr;
+      const uint8_t* v = planes > 2 ? rows.planes[2] + rows.strides[2] * c : nullptr;
+      IngestRow(src, u, v, rows.y0 + i, {x0, x1, wx0, wx1});
     }
   });
   next_row_ += rows.height;
   return Status::Ok();
 }
 
-void Pipeline::IngestRow(const uint8_t* src, const uint8_t* uv, int32_t y, const Columns& c) {
+void Pipeline::IngestRow(const uint8_t* src, const uint8_t* u, const uint8_t* v, int32_t y,
+                         const Columns& c) {
   const int32_t n = c.x1 - c.x0;
   uint8_t* rgb = rgb_rows_[y & 1] + 3 * c.x0;
-  // x0 is even: a YUYV pair or an NV12 chroma pair starts there.
-  RowToRgb8(frame_.format, src + static_cast<ptrdiff_t>(c.x0) * BytesPerPixel(frame_.format),
-            uv != nullptr ? uv + c.x0 : nullptr, n, rgb);
+  // x0 is even: a YUYV pair or a 4:2:0 chroma sample starts there (NV12's UV pair at byte x0,
+  // I420's U and V at x0 / 2).
+  const ptrdiff_t cx = frame_.format == PixelFormat::kNv12 ? c.x0 : c.x0 / 2;
+  RowToRgb8(frame_.format, frame_.range,
+            src + static_cast<ptrdiff_t>(c.x0) * BytesPerPixel(frame_.format),
+            u != nullptr ? u + cx : nullptr, v != nullptr ? v + cx : nullptr, n, rgb);
   if (frame_.index == config_.reference) {
     RowRgb8ToY(rgb, n, ref_.planes[0].Row(y) + c.x0);
     if ((y & 1) || y == config_.height - 1) FlushChroma(y, c);

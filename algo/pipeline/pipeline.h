@@ -115,7 +115,8 @@ class Pipeline : public FrameSink {
   struct Columns {
     int32_t x0, x1, wx0, wx1;
   };
-  void IngestRow(const uint8_t* src, const uint8_t* uv, int32_t y, const Columns& columns);
+  void IngestRow(const uint8_t* src, const uint8_t* u, const uint8_t* v, int32_t y,
+                 const Columns& columns);
   void FlushChroma(int32_t y, const Columns& columns);
 
   PipelineConfig config_;

@@ -175,7 +175,8 @@ Status Ycc420Sink::Rows(const FrameRows& rows) {
   for (int32_t i = 0; i < rows.height; ++i) {
     const int32_t y = rows.y0 + i;
     uint8_t* row = rgb_ + static_cast<size_t>(y & 1) * w * 3;
-    RowToRgb8(frame_.format, rows.planes[0] + i * rows.strides[0], nullptr, w, row);
+    RowToRgb8(frame_.format, frame_.range, rows.planes[0] + i * rows.strides[0], nullptr, nullptr,
+              w, row);
     RowRgb8ToY(row, w, y_ + static_cast<size_t>(y) * w);
     if ((y & 1) || y == frame_.height - 1) {
       const uint8_t* above = (y & 1) ? rgb_ : row;

@@ -85,7 +85,8 @@ Status ReadRgb(const char* path, int32_t* width, int32_t* height, std::vector<ui
   *height = info.height;
   rgb->resize(static_cast<size_t>(info.width) * info.height * 3);
   for (int32_t y = 0; y < info.height; ++y) {
-    RowToRgb8(info.format, pixels.data() + static_cast<size_t>(y) * info.width * bpp, nullptr,
+    RowToRgb8(info.format, YuvRange::kLimited,
+              pixels.data() + static_cast<size_t>(y) * info.width * bpp, nullptr, nullptr,
               info.width, rgb->data() + static_cast<size_t>(y) * info.width * 3);
   }
   return Status::Ok();

@@ -94,6 +94,11 @@ uint64_t IngestChecksum(PixelFormat format, int32_t width, int32_t height, int32
       rows.strides[0] = stride;
       rows.planes[1] = uv.data() + (y0 / 2) * stride;
       rows.strides[1] = stride;
+      if (format == PixelFormat::kI420) {  // U and V rows of half the luma's stride
+        rows.strides[1] = rows.strides[2] = stride / 2;
+        rows.planes[1] = uv.data() + (y0 / 2) * (stride / 2);
+        rows.planes[2] = rows.planes[1] + uv.size() / 2;
+      }
       EXPECT_TRUE(p.Rows(rows).ok());
     }
     EXPECT_TRUE(p.EndFrame().ok());
@@ -107,13 +112,14 @@ uint64_t IngestChecksum(PixelFormat format, int32_t width, int32_t height, int32
 // The ingest splits every strip into bands of columns: the same reference and working views
 // for any number of threads, in every sensor format, with odd and even box sizes and widths.
 TEST(Pipeline, IngestGivesTheSameBytesForAnyNumberOfThreads) {
-  for (PixelFormat format : {PixelFormat::kRgb8, PixelFormat::kYuyv, PixelFormat::kNv12,
-                             PixelFormat::kGray16, PixelFormat::kBgr8}) {
+  for (PixelFormat format :
+       {PixelFormat::kRgb8, PixelFormat::kYuyv, PixelFormat::kNv12, PixelFormat::kGray16,
+        PixelFormat::kBgr8, PixelFormat::kI420, PixelFormat::kRgbx8, PixelFormat::kBgrx8}) {
     for (const auto& [w, h, working] :
          {std::tuple{998, 302, 334}, {640, 480, 320}, {401, 97, 100}}) {
       SCOPED_TRACE(std::string(PixelFormatName(format)) + " " + std::to_string(w) + "x" +
                    std::to_string(h));
-      if ((format == PixelFormat::kYuyv || format == PixelFormat::kNv12) && w % 2 != 0) continue;
+      if ((format == PixelFormat::kYuyv || PlaneCount(format) > 1) && w % 2 != 0) continue;
       const uint64_t one = IngestChecksum(format, w, h, working, 1);
       for (int32_t threads : {2, 3, 4}) {
         EXPECT_EQ(IngestChecksum(format, w, h, working, threads), one) << threads << " threads";
