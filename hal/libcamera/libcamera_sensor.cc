@@ -21,7 +21,9 @@
 #include <vector>
 
 #include "hal/frame_sequence.h"
+#include "hal/libcamera/buffer_layout.h"
 #include "hal/libcamera/exposure_hold.h"
+#include "hal/libcamera/frame_check.h"
 #include "hal/libcamera/libcamera_format.h"
 
 namespace lb {
@@ -36,11 +38,18 @@ struct LibcameraSensor::Impl {
   // Where one buffer's planes lie in the process.
   struct Planes {
     const lc::FrameBuffer* buffer = nullptr;
-    const uint8_t* plane[2] = {nullptr, nullptr};
+    const uint8_t* plane[3] = {nullptr, nullptr, nullptr};
+    ptrdiff_t stride[3] = {0, 0, 0};
   };
+
+  explicit Impl(const LibcameraOptions& options)
+      : wanted_id(options.camera_id ? options.camera_id : ""),
+        hold_exposure(options.hold_exposure),
+        reporter(options.log, options.log_context) {}
 
   std::string wanted_id;
   bool hold_exposure = true;
+  HoldReporter reporter;
 
   std::unique_ptr<lc::CameraManager> manager;
   std::shared_ptr<lc::Camera> camera;
@@ -53,6 +62,7 @@ struct LibcameraSensor::Impl {
   std::vector<Planes> planes;
   SensorConfig burst;
   PixelFormat format = PixelFormat::kRgb8;
+  YuvRange range = YuvRange::kLimited;
   int32_t width = 0, height = 0;
   ptrdiff_t stride = 0;
   HeldControls held;
@@ -88,7 +98,9 @@ struct LibcameraSensor::Impl {
   Status Queue(lc::Request* request, const lc::ControlList* controls);
   Status Meter(lc::ControlList* fixed);
   Status Burst(FrameSink& sink);
-  Status Deliver(FrameSink& sink, lc::Request* request, int32_t index, FrameSequence* sequence);
+  // What the burst does with a completed request (frame_check.h), as a Status when it ends it.
+  Status Check(lc::Request* request, int32_t index, FrameSequence* sequence, bool* skip);
+  Status Deliver(FrameSink& sink, lc::Request* request, int32_t index);
   void Release();
 };
 
@@ -149,7 +161,9 @@ Status LibcameraSensor::Impl::ConfigureStream(const SensorConfig& wanted) {
   }
   lc::PixelFormat chosen = ChooseLibcameraFormat(cfg.pixelFormat, cfg.formats().pixelformats());
   if (!chosen.isValid()) {
-    return Status(Code::kUnsupported, "libcamera %s: offers no YUYV, NV12, BGR888 or RGB888 (%s)",
+    return Status(Code::kUnsupported,
+                  "libcamera %s: offers no YUYV, NV12, YUV420, BGR888, RGB888, XBGR8888 or "
+                  "XRGB8888 (%s)",
                   id.c_str(), cfg.pixelFormat.toString().c_str());
   }
   cfg.pixelFormat = chosen;
@@ -173,9 +187,10 @@ Status LibcameraSensor::Impl::ConfigureStream(const SensorConfig& wanted) {
   width = static_cast<int32_t>(cfg.size.width);
   height = static_cast<int32_t>(cfg.size.height);
   stride = static_cast<ptrdiff_t>(cfg.stride);
-  if (format == PixelFormat::kNv12 && (width % 2 || height % 2)) {
-    return Status(Code::kUnsupported, "libcamera %s: NV12 with odd size %dx%d", id.c_str(), width,
-                  height);
+  range = LibcameraYuvRange(cfg.colorSpace);
+  if (PlaneCount(format) > 1 && (width % 2 || height % 2)) {
+    return Status(Code::kUnsupported, "libcamera %s: %s with odd size %dx%d", id.c_str(),
+                  PixelFormatName(format), width, height);
   }
   return Status::Ok();
 }
@@ -186,43 +201,36 @@ Status LibcameraSensor::Impl::MapBuffers() {
     return Error(Code::kOutOfMemory, "FrameBufferAllocator::allocate", r);
   }
   const std::vector<std::unique_ptr<lc::FrameBuffer>>& buffers = allocator->buffers(stream);
-  size_t plane0 = static_cast<size_t>(stride) * static_cast<size_t>(height);
-  bool nv12 = format == PixelFormat::kNv12;
   for (const std::unique_ptr<lc::FrameBuffer>& buffer : buffers) {
-    const std::vector<lc::FrameBuffer::Plane>& bp = buffer->planes();
-    if (bp.empty() || bp.size() > 2) {
-      return Status(Code::kUnsupported, "libcamera %s: buffer with %zu planes", id.c_str(),
-                    bp.size());
+    // A vector before libcamera 0.6, a Span since: bound to a reference either way.
+    const auto& bp = buffer->planes();
+    BufferPlane listed[3];
+    const size_t n = bp.size();
+    for (size_t i = 0; i < n && i < 3; ++i) {
+      listed[i] = {bp[i].fd.get(), bp[i].offset, bp[i].length};
     }
-    // Planes may share one dmabuf: map each fd once over the extent its planes cover.
-    const uint8_t* base[2] = {nullptr, nullptr};
-    for (size_t i = 0; i < bp.size(); ++i) {
-      if (i == 1 && bp[1].fd.get() == bp[0].fd.get()) {
-        base[1] = base[0];
-        continue;
+    PlaneLayout layout;
+    Status laid = LayOutPlanes(format, width, height, stride, listed, n, &layout);
+    if (!laid.ok()) return laid.Prefix("libcamera %s: ", id.c_str());
+    // Planes may share one dmabuf: map each once, over the extent its planes cover.
+    const uint8_t* base[3] = {nullptr, nullptr, nullptr};
+    for (size_t i = 0; i < n; ++i) {
+      for (size_t j = 0; j < i && !base[i]; ++j) {
+        if (listed[j].fd == listed[i].fd) base[i] = base[j];
       }
-      size_t extent = 0;
-      for (const lc::FrameBuffer::Plane& other : bp) {
-        if (other.fd.get() == bp[i].fd.get()) {
-          extent = std::max(extent, static_cast<size_t>(other.offset) + other.length);
-        }
-      }
-      void* addr = mmap(nullptr, extent, PROT_READ, MAP_SHARED, bp[i].fd.get(), 0);
+      if (base[i]) continue;
+      const size_t extent = MappedExtent(listed, n, i);
+      void* addr = mmap(nullptr, extent, PROT_READ, MAP_SHARED, listed[i].fd, 0);
       if (addr == MAP_FAILED) return Error(Code::kIoError, "mmap", errno);
       mappings.push_back({addr, extent});
       base[i] = static_cast<const uint8_t*>(addr);
     }
-    // A one-plane NV12 buffer holds the chroma right after the luma.
-    size_t need0 = nv12 && bp.size() == 1 ? plane0 + plane0 / 2 : plane0;
-    if (bp[0].length < need0 || (nv12 && bp.size() == 2 && bp[1].length < plane0 / 2)) {
-      return Status(Code::kCorruptData,
-                    "libcamera %s: buffer planes of %u bytes, a %dx%d %s frame needs %zu",
-                    id.c_str(), bp[0].length, width, height, PixelFormatName(format), need0);
-    }
     Planes p;
     p.buffer = buffer.get();
-    p.plane[0] = base[0] + bp[0].offset;
-    if (nv12) p.plane[1] = bp.size() == 2 ? base[1] + bp[1].offset : p.plane[0] + plane0;
+    for (int32_t k = 0; k < layout.count; ++k) {
+      p.plane[k] = base[layout.source[k]] + layout.offset[k];
+      p.stride[k] = layout.stride[k];
+    }
     planes.push_back(p);
   }
 
@@ -267,16 +275,25 @@ Status LibcameraSensor::Impl::Queue(lc::Request* request, const lc::ControlList*
 
 Status LibcameraSensor::Impl::Meter(lc::ControlList* fixed) {
   held = HeldControls();
-  namespace c = lc::controls;
+  if (!hold_exposure) return Status::Ok();
   const lc::ControlInfoMap& available = camera->controls();
-  if (!hold_exposure || (!available.count(&c::AeEnable) && !available.count(&c::AwbEnable))) {
-    return Status::Ok();  // nothing to hold: the camera has no automatic algorithms to stop
+  if (!CanHoldAny(available)) {
+    // Nothing to meter for; the note still says what drifts.
+    held = HoldExposure(available, lc::ControlList(), fixed);
+    reporter.Note(id.c_str(), held);
+    return Status::Ok();
   }
+  // Startup frames carry the algorithms' values before they converge: meter a later one.
   lc::Request* request = requests.front().get();
-  LB_RETURN_IF_ERROR(Queue(request, nullptr));
   lc::Request* done = nullptr;
-  LB_RETURN_IF_ERROR(WaitRequest(&done));
+  for (int32_t skipped = 0;; ++skipped) {
+    LB_RETURN_IF_ERROR(Queue(request, nullptr));
+    LB_RETURN_IF_ERROR(WaitRequest(&done));
+    const lc::FrameBuffer* buffer = done->findBuffer(stream);
+    if (!buffer || !IsStartupFrame(buffer->metadata()) || skipped >= kMaxStartupFrames) break;
+  }
   held = HoldExposure(available, done->metadata(), fixed);
+  reporter.Note(id.c_str(), held);
   return Status::Ok();
 }
 
@@ -289,10 +306,22 @@ Status LibcameraSensor::Impl::Burst(FrameSink& sink) {
     LB_RETURN_IF_ERROR(Queue(requests[queued].get(), controls));
   }
   FrameSequence sequence;
-  for (int32_t i = 0; i < burst.frames; ++i) {
+  int32_t skipped = 0;
+  for (int32_t i = 0; i < burst.frames;) {
     lc::Request* request = nullptr;
     LB_RETURN_IF_ERROR(WaitRequest(&request));
-    LB_RETURN_IF_ERROR(Deliver(sink, request, i, &sequence));
+    bool skip = false;
+    LB_RETURN_IF_ERROR(Check(request, i, &sequence, &skip));
+    if (skip) {
+      if (++skipped > kMaxStartupFrames) {
+        return Status(Code::kTimeout, "libcamera %s: still starting after %d frames", id.c_str(),
+                      kMaxStartupFrames);
+      }
+      LB_RETURN_IF_ERROR(Queue(request, controls));  // it takes the skipped frame's place
+      continue;
+    }
+    LB_RETURN_IF_ERROR(Deliver(sink, request, i));
+    ++i;
     if (static_cast<int32_t>(queued) < burst.frames) {
       LB_RETURN_IF_ERROR(Queue(request, controls));
       ++queued;
@@ -301,27 +330,41 @@ Status LibcameraSensor::Impl::Burst(FrameSink& sink) {
   return Status::Ok();
 }
 
-Status LibcameraSensor::Impl::Deliver(FrameSink& sink, lc::Request* request, int32_t index,
-                                      FrameSequence* sequence) {
-  lc::FrameBuffer* buffer = request->findBuffer(stream);
+Status LibcameraSensor::Impl::Check(lc::Request* request, int32_t index, FrameSequence* sequence,
+                                    bool* skip) {
+  *skip = false;
+  const lc::FrameBuffer* buffer = request->findBuffer(stream);
+  if (!buffer) {
+    return Status(Code::kInternal, "libcamera %s: request without its buffer", id.c_str());
+  }
+  const lc::FrameMetadata& md = buffer->metadata();
+  uint32_t missing = 0;
+  switch (CheckFrame(md, index, sequence, &missing)) {
+    case FrameVerdict::kDeliver:
+      return Status::Ok();
+    case FrameVerdict::kSkip:
+      *skip = true;
+      return Status::Ok();
+    case FrameVerdict::kFailed:
+      return Status(Code::kCorruptData,
+                    "libcamera %s: frame %d (sequence %u) failed in the camera; burst abandoned",
+                    id.c_str(), index, md.sequence);
+    case FrameVerdict::kDropped:
+      break;
+  }
+  return Status(Code::kCorruptData,
+                "libcamera %s: frame %d: %u frame(s) dropped before sequence %u; burst abandoned",
+                id.c_str(), index, missing, md.sequence);
+}
+
+Status LibcameraSensor::Impl::Deliver(FrameSink& sink, lc::Request* request, int32_t index) {
+  const lc::FrameBuffer* buffer = request->findBuffer(stream);
   const Planes* p = nullptr;
   for (const Planes& candidate : planes) {
     if (candidate.buffer == buffer) p = &candidate;
   }
   if (!p) return Status(Code::kInternal, "libcamera %s: unknown buffer completed", id.c_str());
   const lc::FrameMetadata& md = buffer->metadata();
-  if (md.status != lc::FrameMetadata::FrameSuccess) {
-    return Status(Code::kCorruptData,
-                  "libcamera %s: frame %d (sequence %u) failed in the camera; burst abandoned",
-                  id.c_str(), index, md.sequence);
-  }
-  uint32_t missing = 0;
-  if (!sequence->Next(md.sequence, &missing) || missing > 0) {
-    return Status(Code::kCorruptData,
-                  "libcamera %s: frame %d: %u frame(s) dropped before sequence %u; burst "
-                  "abandoned",
-                  id.c_str(), index, missing, md.sequence);
-  }
   FrameInfo info;
   info.index = index;
   info.format = format;
@@ -329,14 +372,13 @@ Status LibcameraSensor::Impl::Deliver(FrameSink& sink, lc::Request* request, int
   info.height = height;
   info.timestamp_ns = static_cast<int64_t>(md.timestamp);
   info.sequence = md.sequence;
+  info.range = range;
   FrameRows rows;
   rows.y0 = 0;
   rows.height = height;
-  rows.planes[0] = p->plane[0];
-  rows.strides[0] = stride;
-  if (format == PixelFormat::kNv12) {
-    rows.planes[1] = p->plane[1];
-    rows.strides[1] = stride;
+  for (int32_t k = 0; k < 3; ++k) {
+    rows.planes[k] = p->plane[k];
+    rows.strides[k] = p->stride[k];
   }
   Status status = sink.BeginFrame(info);
   if (status.ok()) status = sink.Rows(rows);
@@ -364,10 +406,7 @@ void LibcameraSensor::Impl::Release() {
   completed.clear();
 }
 
-LibcameraSensor::LibcameraSensor(const LibcameraOptions& options) : impl_(new Impl) {
-  impl_->wanted_id = options.camera_id ? options.camera_id : "";
-  impl_->hold_exposure = options.hold_exposure;
-}
+LibcameraSensor::LibcameraSensor(const LibcameraOptions& options) : impl_(new Impl(options)) {}
 
 LibcameraSensor::~LibcameraSensor() {
   Stop();
@@ -384,6 +423,7 @@ Status LibcameraSensor::Configure(const SensorConfig& config, SensorMode* mode) 
                   config.frames, config.timeout_ms, config.width, config.height);
   }
   impl_->burst = config;
+  impl_->reporter.Reset();
   Status status = impl_->Open();
   if (status.ok()) status = impl_->ConfigureStream(config);
   if (status.ok()) status = impl_->MapBuffers();
@@ -429,6 +469,7 @@ Status LibcameraSensor::Probe() {
 void LibcameraSensor::Stop() { impl_->Release(); }
 
 bool LibcameraSensor::exposure_held() const { return impl_->held.exposure; }
+bool LibcameraSensor::gain_held() const { return impl_->held.gain; }
 bool LibcameraSensor::white_balance_held() const { return impl_->held.white_balance; }
 const char* LibcameraSensor::camera_id() const { return impl_->id.c_str(); }
 
