@@ -16,6 +16,12 @@
 
 namespace lb {
 
+#ifdef LB_HAVE_LIBCAMERA
+static void LogSensorLine(void* log, const char* line) {
+  static_cast<Log*>(log)->Printf(LogLevel::kWarning, "%s", line);
+}
+#endif
+
 const char* BuiltBackends() {
 #ifdef LB_HAVE_LIBCAMERA
   return "v4l2, libcamera, synthetic";
@@ -24,7 +30,7 @@ const char* BuiltBackends() {
 #endif
 }
 
-Status MakeSensor(const DaemonConfig& config, std::unique_ptr<Sensor>* sensor) {
+Status MakeSensor(const DaemonConfig& config, std::unique_ptr<Sensor>* sensor, Log* log) {
   switch (config.backend) {
     case Backend::kV4l2: {
       V4l2Options o;
@@ -37,6 +43,10 @@ Status MakeSensor(const DaemonConfig& config, std::unique_ptr<Sensor>* sensor) {
 #ifdef LB_HAVE_LIBCAMERA
       LibcameraOptions o;
       o.camera_id = config.device.c_str();
+      if (log != nullptr) {
+        o.log = LogSensorLine;
+        o.log_context = log;
+      }
       *sensor = std::make_unique<LibcameraSensor>(o);
       return Status::Ok();
 #else

@@ -6,6 +6,7 @@
 
 #include "algo/core/status.h"
 #include "firmware/daemon/config.h"
+#include "firmware/daemon/log.h"
 #include "hal/button.h"
 #include "hal/sensor.h"
 
@@ -14,7 +15,9 @@ namespace lb {
 // The backends this build holds, e.g. "v4l2, libcamera, synthetic".
 const char* BuiltBackends();
 
-Status MakeSensor(const DaemonConfig& config, std::unique_ptr<Sensor>* sensor);
+// `log` (may be null) gets the sensor's warnings: what the libcamera sensor cannot hold constant
+// across a burst.
+Status MakeSensor(const DaemonConfig& config, std::unique_ptr<Sensor>* sensor, Log* log = nullptr);
 
 // `button`: "auto" (the first input device that sends KEY_CAMERA), an evdev node, or a FIFO
 // that carries struct input_event records (how the host tests press the button). `*where` gets

@@ -143,7 +143,7 @@ int main(int argc, char** argv) {
   std::unique_ptr<lb::Sensor> sensor;
   std::unique_ptr<lb::Button> button;
   std::string button_path;
-  s = lb::MakeSensor(config, &sensor);
+  s = lb::MakeSensor(config, &sensor, &log);
   if (s.ok()) s = lb::OpenButton(config, &button, &button_path);
   if (!s.ok()) {
     log.Printf(lb::LogLevel::kError, "%s", s.message());

@@ -13,7 +13,9 @@ namespace lb {
 namespace {
 
 TEST(VimcJobTest, BurstThroughLibcameraBecomesAJpeg) {
-  LibcameraSensor sensor(LibcameraOptions{});
+  LibcameraOptions sensor_options;
+  sensor_options.log = [](void*, const char* line) { printf("%s\n", line); };
+  LibcameraSensor sensor(sensor_options);
   JobOptions options;
   options.sensor.width = 640;
   options.sensor.height = 480;
