@@ -16,11 +16,9 @@
 
 namespace lb {
 
-#ifdef LB_HAVE_LIBCAMERA
 static void LogSensorLine(void* log, const char* line) {
   static_cast<Log*>(log)->Printf(LogLevel::kWarning, "%s", line);
 }
-#endif
 
 const char* BuiltBackends() {
 #ifdef LB_HAVE_LIBCAMERA
@@ -36,6 +34,10 @@ Status MakeSensor(const DaemonConfig& config, std::unique_ptr<Sensor>* sensor, L
       V4l2Options o;
       if (!config.device.empty()) o.device = config.device.c_str();  // copied by the sensor
       o.fps = config.fps;
+      if (log != nullptr) {
+        o.log = LogSensorLine;
+        o.log_context = log;
+      }
       *sensor = std::make_unique<V4l2Sensor>(o);
       return Status::Ok();
     }

@@ -16,7 +16,7 @@ namespace lb {
 const char* BuiltBackends();
 
 // `log` (may be null) gets the sensor's warnings: what the libcamera sensor cannot hold constant
-// across a burst.
+// across a burst, the corrupt MJPEG frames the V4L2 sensor skipped.
 Status MakeSensor(const DaemonConfig& config, std::unique_ptr<Sensor>* sensor, Log* log = nullptr);
 
 // `button`: "auto" (the first input device that sends KEY_CAMERA), an evdev node, or a FIFO

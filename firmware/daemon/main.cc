@@ -66,8 +66,11 @@ int Usage(const char* error) {
 
 // --check-config once the file reads: the checks refocusd runs at start (camera, output folder)
 // and the button it would open, each problem on its own line, so "configuration OK" means
-// refocusd would start and say "ready" now.
+// refocusd would start and say "ready" now. The first line names the sensor backends this build
+// has, since `backend =` can only name one of them.
 int CheckConfig(const char* path, const lb::DaemonConfig& config) {
+  printf("refocusd: sensor backends: %s\n", lb::BuiltBackends());
+  fflush(stdout);
   int problems = 0;
   std::unique_ptr<lb::Sensor> sensor;
   lb::Status s = lb::MakeSensor(config, &sensor);

@@ -55,6 +55,15 @@ void WriteFile(const std::string& path, const std::string& text) {
   fclose(f);
 }
 
+// The line --check-config starts with: the backends `refocusd --version` names.
+std::string BackendsLine() {
+  std::string out;
+  if (RunRefocusd({"--version"}, &out) != 0) return "refocusd --version failed";
+  const size_t at = out.find("(sensor backends: "), end = out.rfind(')');
+  if (at == std::string::npos || end == std::string::npos || end < at) return "no backends";
+  return "refocusd: sensor backends: " + out.substr(at + 18, end - at - 18) + "\n";
+}
+
 TEST(RefocusdCommandTest, CheckConfigReportsTheLine) {
   ScratchDir dir;
   const std::string good = dir.Path("good.conf"), bad = dir.Path("bad.conf");
@@ -65,7 +74,7 @@ TEST(RefocusdCommandTest, CheckConfigReportsTheLine) {
   WriteFile(bad, "backend = synthetic\n# comment\nf_number = 0.5\n");
   std::string out;
   EXPECT_EQ(RunRefocusd({"--check-config", "--config", good}, &out), 0);
-  EXPECT_EQ(out, "refocusd: " + good + ": configuration OK\n");
+  EXPECT_EQ(out, BackendsLine() + "refocusd: " + good + ": configuration OK\n");
   EXPECT_EQ(RunRefocusd({"--check-config", "--config", bad}, &out), 1);
   EXPECT_EQ(out, "refocusd: " + bad + ":3: f_number: '0.5' is not a number from 1 to 22\n");
 }
@@ -80,18 +89,18 @@ TEST(RefocusdCommandTest, CheckConfigChecksTheCameraTheButtonAndTheFolder) {
                       dir.Path("button") + "\noutput_dir = " + dir.Path("photos") + "\n");
   std::string out;
   EXPECT_EQ(RunRefocusd({"--check-config", "--config", conf}, &out), 1);
-  EXPECT_EQ(out, "refocusd: camera " + dir.Path("video7") +
+  EXPECT_EQ(out, BackendsLine() + "refocusd: camera " + dir.Path("video7") +
                      ": no such device\nrefocusd: output folder " + dir.Path("photos") +
                      ": not a folder (a regular file)\n");
 
   WriteFile(conf, "device = /dev/null\nbutton = " + dir.Path("no-button") +
                       "\noutput_dir = " + dir.Path("card/DCIM") + "\n");
   EXPECT_EQ(RunRefocusd({"--check-config", "--config", conf}, &out), 1);
-  EXPECT_EQ(
-      out,
-      "refocusd: camera /dev/null: not a V4L2 device\nrefocusd: button: " + dir.Path("no-button") +
-          ": cannot open: No such file or directory (errno 2)\nrefocusd: output folder " +
-          dir.Path("card/DCIM") + ": no such file or directory\n");
+  EXPECT_EQ(out,
+            BackendsLine() + "refocusd: camera /dev/null: not a V4L2 device\nrefocusd: button: " +
+                dir.Path("no-button") +
+                ": cannot open: No such file or directory (errno 2)\nrefocusd: output folder " +
+                dir.Path("card/DCIM") + ": no such file or directory\n");
 }
 
 TEST(RefocusdCommandTest, MissingButtonIsAClearStartupError) {
