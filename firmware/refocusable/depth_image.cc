@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <cstring>
+#include <utility>
 
 #include "algo/core/frame.h"
 #include "firmware/codecs/image_file.h"
@@ -33,8 +34,10 @@ Status TypeOf(std::string_view mime, const char* name, ImageFileType* type) {
 // Grey values out of grey or colour rows, into the caller's array.
 class DepthSink final : public FrameSink {
  public:
-  DepthSink(const char* name, bool lossy, DepthImageBuffer* out)
-      : name_(name), slack_(lossy ? kJpegChannelSlack : 0), out_(out) {}
+  // `grow` (may be null): the values go there, grown with the rows actually decoded, instead of
+  // into out->values.
+  DepthSink(const char* name, bool lossy, DepthImageBuffer* out, std::vector<uint16_t>* grow)
+      : name_(name), slack_(lossy ? kJpegChannelSlack : 0), out_(out), grow_(grow) {}
 
   Status BeginFrame(const FrameInfo& info) override {
     const PixelFormat f = info.format;
@@ -45,7 +48,8 @@ class DepthSink final : public FrameSink {
     width_ = info.width;
     channels_ = f == PixelFormat::kRgb8 || f == PixelFormat::kRgb16 ? 3 : 1;
     wide_ = f == PixelFormat::kGray16 || f == PixelFormat::kRgb16;
-    if (static_cast<uint64_t>(info.width) * static_cast<uint64_t>(info.height) > out_->capacity) {
+    if (grow_ == nullptr &&
+        static_cast<uint64_t>(info.width) * static_cast<uint64_t>(info.height) > out_->capacity) {
       return Status(Code::kOutOfMemory, "%s: a %dx%d depth image, more than the %zu values given",
                     name_, info.width, info.height, out_->capacity);
     }
@@ -56,9 +60,12 @@ class DepthSink final : public FrameSink {
   }
 
   Status Rows(const FrameRows& rows) override {
+    // A header that claims more rows than the data holds costs only the rows decoded.
+    if (grow_ != nullptr) grow_->resize(static_cast<size_t>(rows.y0 + rows.height) * width_);
+    uint16_t* values = grow_ != nullptr ? grow_->data() : out_->values;
     for (int32_t y = 0; y < rows.height; ++y) {
       const uint8_t* row = rows.planes[0] + y * rows.strides[0];
-      uint16_t* out = out_->values + static_cast<size_t>(rows.y0 + y) * width_;
+      uint16_t* out = values + static_cast<size_t>(rows.y0 + y) * width_;
       for (int32_t x = 0; x < width_; ++x) {
         int32_t c[3];
         for (int32_t k = 0; k < channels_; ++k) c[k] = Sample(row, x * channels_ + k);
@@ -92,6 +99,7 @@ class DepthSink final : public FrameSink {
   const char* name_;
   int32_t slack_;
   DepthImageBuffer* out_;
+  std::vector<uint16_t>* grow_;
   int32_t width_ = 0, channels_ = 1;
   bool wide_ = false;
 };
@@ -143,9 +151,11 @@ Status ProbeDepthImage(const uint8_t* data, size_t size, std::string_view mime, 
   return Status::Ok();
 }
 
-Status DecodeDepthImageInto(const uint8_t* data, size_t size, std::string_view mime,
-                            const char* name, int32_t max_side, int32_t width, int32_t height,
-                            DepthImageBuffer* out) {
+namespace {
+
+Status Decode(const uint8_t* data, size_t size, std::string_view mime, const char* name,
+              int32_t max_side, int32_t width, int32_t height, DepthImageBuffer* out,
+              std::vector<uint16_t>* grow) {
   out->width = out->height = out->bits = 0;
   DepthImageHeader header;
   LB_RETURN_IF_ERROR(ProbeDepthImage(data, size, mime, name, &header));
@@ -163,11 +173,19 @@ Status DecodeDepthImageInto(const uint8_t* data, size_t size, std::string_view m
   memory.strip_bytes = out->strip_bytes;
   memory.max_width = header.width;
   memory.max_height = header.height;
-  DepthSink sink(name, header.is_jpeg, out);
+  DepthSink sink(name, header.is_jpeg, out, grow);
   const Status s = StreamImageMemory(data, size, name, 0, sink, memory,
                                      header.is_jpeg ? ImageFileType::kJpeg : ImageFileType::kPng);
   if (!s.ok()) out->width = out->height = out->bits = 0;
   return s;
+}
+
+}  // namespace
+
+Status DecodeDepthImageInto(const uint8_t* data, size_t size, std::string_view mime,
+                            const char* name, int32_t max_side, int32_t width, int32_t height,
+                            DepthImageBuffer* out) {
+  return Decode(data, size, mime, name, max_side, width, height, out, nullptr);
 }
 
 Status DecodeDepthImage(const uint8_t* data, size_t size, std::string_view mime, const char* name,
@@ -175,20 +193,21 @@ Status DecodeDepthImage(const uint8_t* data, size_t size, std::string_view mime,
   *out = GrayPng();
   DepthImageHeader header;
   LB_RETURN_IF_ERROR(ProbeDepthImage(data, size, mime, name, &header));
-  // Sized by the header only once it has passed the same checks the decode makes.
+  // The strip only once the header has passed the same checks the decode makes.
   if (header.width > max_side || header.height > max_side) {
     return Status(Code::kCorruptData, "%s: a %dx%d depth image, larger than %d a side", name,
                   header.width, header.height, max_side);
   }
-  std::vector<uint16_t> values(static_cast<size_t>(header.width) * header.height);
   std::vector<uint8_t> strip(DepthStripBytes(header.width));
   DepthImageBuffer buffer;
-  buffer.values = values.data();
-  buffer.capacity = values.size();
   buffer.strip = strip.data();
   buffer.strip_bytes = strip.size();
-  LB_RETURN_IF_ERROR(
-      DecodeDepthImageInto(data, size, mime, name, max_side, width, height, &buffer));
+  std::vector<uint16_t> values;
+  LB_RETURN_IF_ERROR(Decode(data, size, mime, name, max_side, width, height, &buffer, &values));
+  if (values.size() != static_cast<size_t>(buffer.width) * static_cast<size_t>(buffer.height)) {
+    return Status(Code::kCorruptData, "%s: the depth image ends after %zu of %d rows", name,
+                  values.size() / static_cast<size_t>(std::max(buffer.width, 1)), buffer.height);
+  }
   out->width = buffer.width;
   out->height = buffer.height;
   out->bits = buffer.bits;
