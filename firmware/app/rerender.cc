@@ -81,7 +81,7 @@ Status Rerenderer::Load(const char* path) {
                   "nor of its shape",
                   path, dw, dh, width, height);
   }
-  const FileUnits units = ChooseUnits(file.xmp, width, scale_);
+  const FileDepthUnits units = DepthUnitsOf(file.xmp, width, scale_);
   std::vector<uint16_t> disp;
   s = ScaledDisparityFromDepth(file, units.scale, &disp, &range_);
   if (!s.ok()) return s.Prefix("%s: ", path);
@@ -105,9 +105,9 @@ Status Rerenderer::Load(const char* path) {
   return Status::Ok();
 }
 
-Rerenderer::FileUnits Rerenderer::ChooseUnits(const RefocusableXmp& xmp, int32_t width,
-                                              int32_t scale) {
-  FileUnits u;
+FileDepthUnits DepthUnitsOf(const RefocusableXmp& xmp, int32_t width, int32_t working_scale) {
+  const double scale = working_scale;
+  FileDepthUnits u;
   const GDepthInfo& d = xmp.depth;
   const double blur_px = xmp.focus.blur_at_infinity * width, focal = xmp.focus.focal_distance;
   if (xmp.has_focus && blur_px > 0.0 && focal > 0.0) {

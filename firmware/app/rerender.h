@@ -60,6 +60,16 @@ class Ycc420Sink final : public FrameSink {
   uint8_t *y_, *cb_, *cr_, *rgb_;
 };
 
+// How a refocusable file's depth maps to the render's disparity (disparity = scale / depth, in
+// working px), and the f-number that reproduces its GFocus blur: the product's own files store
+// 1 / disparity, a phone's its own units. `width` is the original's, `working_scale` the
+// render's. For every reader of such files (rerender, the camera's page).
+struct FileDepthUnits {
+  double scale = 1.0;
+  float f_number = 2.8f;
+};
+FileDepthUnits DepthUnitsOf(const RefocusableXmp& xmp, int32_t width, int32_t working_scale);
+
 class Rerenderer {
  public:
   // Reads `path`: its GDepth (RangeInverse or RangeLinear, PNG or JPEG, any size up to the
@@ -83,13 +93,6 @@ class Rerenderer {
   int32_t working_scale() const { return scale_; }
 
  private:
-  // How a file's depth maps to the render's disparity: disparity = scale / depth, and the
-  // f-number that reproduces its GFocus blur.
-  struct FileUnits {
-    double scale = 1.0;
-    float f_number = 2.8f;
-  };
-  static FileUnits ChooseUnits(const RefocusableXmp& xmp, int32_t width, int32_t scale);
   FocusRegion FocusNear(double point_x, double point_y, double target_q8) const;
 
   int32_t width_ = 0, height_ = 0, scale_ = 1, depth_w_ = 0, depth_h_ = 0;
