@@ -35,7 +35,7 @@ make_root() {
   local include
   include=$(IFS=,; echo "$*")
   rm -rf "$dir.tmp" "$dir"
-  echo "debian-root: making $dir ($suites, $archs)"
+  echo "debian-root: making $dir ($suites, $archs)" >&2
   if ! mmdebstrap --quiet --mode=root --variant=apt --architectures="$archs" \
       --include="$include" "$release" "$dir.tmp" "${sources[@]}" >"$dir.log" 2>&1; then
     tail -30 "$dir.log" >&2

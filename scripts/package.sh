@@ -42,8 +42,8 @@ case $suite in
   *) echo "package: unknown release $suite (bookworm or trixie)" >&2; exit 2 ;;
 esac
 case $arch in
-  arm64) triple=aarch64-linux-gnu ;;
-  armhf) triple=arm-linux-gnueabihf ;;
+  arm64) toolchain=aarch64-linux-gnu ;;
+  armhf) toolchain=armhf-linux-gnueabihf ;;
   *) echo "package: unknown architecture $arch (arm64 or armhf)" >&2; exit 2 ;;
 esac
 
@@ -59,7 +59,7 @@ out=$top/build/packages
 mkdir -p "$out"
 bash "$top/scripts/debian-root.sh" run "$root" "
   set -e
-  cmake -S . -B $tree -G Ninja -DCMAKE_TOOLCHAIN_FILE=toolchains/$triple.cmake -DLB_MULTIARCH=ON \
+  cmake -S . -B $tree -G Ninja -DCMAKE_TOOLCHAIN_FILE=toolchains/$toolchain.cmake -DLB_MULTIARCH=ON \
     -DCMAKE_BUILD_TYPE=Release -DLB_TESTS=OFF -DLB_BENCHMARKS=OFF -DLB_DEB_RELEASE=$release >/dev/null
   cmake --build $tree -j ${JOBS:-$(nproc)}
   rm -f $tree/*.deb

@@ -113,7 +113,7 @@ size_t DepthStripBytes(int32_t max_width) {
 Status ProbeDepthImage(const uint8_t* data, size_t size, std::string_view mime, const char* name,
                        DepthImageHeader* header) {
   *header = DepthImageHeader();
-  ImageFileType type;
+  ImageFileType type = ImageFileType::kAuto;
   LB_RETURN_IF_ERROR(TypeOf(mime, name, &type));
   ImageFileInfo info;
   LB_RETURN_IF_ERROR(ProbeImageMemory(data, size, name, &info, type));
