@@ -18,10 +18,9 @@
 #    button, checks the photo, its depth, the web page and `refocusd --check-config`, prints
 #    `BOARD-RESULT NAME ok|FAILED ...` lines and figures on the serial console, and powers off.
 #
-# DEB is used as given when it exists. A pattern that matched nothing (such as
-# build/aarch64/refocusd_*_arm64.deb, where a cross build no longer makes a package) stands for
-# the release's own package, build/packages/refocusd_*+deb12_arm64.deb (deb13 for trixie), made
-# by scripts/package.sh SUITE arm64 when missing, or waited for while another process makes it.
+# DEB is used as given when it exists. A pattern (build/packages/refocusd_*_arm64.deb, as the
+# board tests pass it) stands for the release's own package (+deb12 or +deb13), made now by
+# scripts/package.sh SUITE arm64 from the tree as it is.
 #
 # Exit: 0 every check passed, 1 a check failed or the board did not finish, 2 usage, 77 skipped
 # (qemu-system-aarch64, mmdebstrap, qemu-user through binfmt_misc or the cross compiler cannot be
@@ -84,35 +83,22 @@ fi
   skip "cannot register qemu-aarch64 with binfmt_misc"
 
 # --- The package -------------------------------------------------------------------------
-# DEB as given when it exists. Otherwise (a pattern that matched nothing, such as
-# build/aarch64/refocusd_*_arm64.deb: a cross build against the unit tests' sysroot makes no
-# package since the packages are built per release) the release's own package from
-# build/packages, made by scripts/package.sh SUITE arm64 when missing, or waited for while another
-# process makes it.
+# DEB as given when it exists. Otherwise (a pattern such as build/packages/refocusd_*_arm64.deb,
+# as the board tests pass it) the release's own package, made now by scripts/package.sh SUITE
+# arm64 from the source tree as it is (an unchanged tree rebuilds nothing), so a stale package
+# is never tested.
 case $suite in bookworm) release=deb12 ;; trixie) release=deb13 ;; esac
-find_deb() { ls -t "$top"/build/packages/refocusd_*+"$release"_arm64.deb 2>/dev/null | head -n1 || true; }
-packaging() { pgrep -f -- "scripts/package.sh (--root-only )?$suite arm64" >/dev/null; }
 deb=$deb_arg
 if [[ ! -f $deb ]]; then
-  [[ $deb_arg == *"*"* || $deb_arg == *build/aarch64/* || $deb_arg == *build/packages/* ]] ||
-    fail "no such package: $deb_arg"
-  log "no package at $deb_arg: using the $suite package from build/packages"
+  [[ $deb_arg == *"*"* ]] || fail "no such package: $deb_arg"
+  log "making the $suite package: scripts/package.sh $suite arm64 (log $cache/package.log)"
   exec 8>"$top/build/.board-package-$suite.lock"
   flock 8
-  waited=0
-  while packaging; do
-    ((waited % 120 == 0)) && log "another process is making the $suite package; waiting ($waited s)"
-    sleep 10
-    waited=$((waited + 10))
-  done
-  if [[ -z $(find_deb) ]]; then
-    log "making it: scripts/package.sh $suite arm64 (log $cache/package.log)"
-    bash "$top/scripts/package.sh" "$suite" arm64 >"$cache/package.log" 2>&1 ||
-      { tail -n 20 "$cache/package.log"; fail "scripts/package.sh $suite arm64"; }
-  fi
+  bash "$top/scripts/package.sh" "$suite" arm64 >"$cache/package.log" 2>&1 ||
+    { tail -n 20 "$cache/package.log"; fail "scripts/package.sh $suite arm64"; }
   flock -u 8
-  deb=$(find_deb)
-  [[ -n $deb ]] || fail "no refocusd_*+${release}_arm64.deb in build/packages"
+  deb=$(tail -n1 "$cache/package.log")
+  [[ -f $deb && $deb == *"+${release}_arm64.deb" ]] || fail "scripts/package.sh made no $release package"
 fi
 deb=$(cd "$(dirname "$deb")" && pwd)/$(basename "$deb")
 [[ $(dpkg-deb -f "$deb" Architecture) == arm64 ]] || fail "$deb is not an arm64 package"
