@@ -14,7 +14,11 @@ ok() { echo "scenario: ok: $*"; }
 bad() { echo "scenario: FAILED: $*"; status=1; }
 
 # count PATTERN: lines of the log matching PATTERN.
-count() { grep -c "$1" $log 2>/dev/null || true; }
+# (0 before the daemon has opened its log: a file not there yet is no match, not an error.)
+count() {
+  n=$(grep -c "$1" $log 2>/dev/null)
+  echo "${n:-0}"
+}
 # wait_for PATTERN N SECONDS: until the log has N lines matching PATTERN.
 wait_for() {
   i=0

@@ -7,7 +7,11 @@ photos=/tmp/photos
 log=/tmp/refocusd.log
 ok() { echo "scenario: ok: $*"; }
 bad() { echo "scenario: FAILED: $*"; status=1; }
-count() { grep -c "$1" $log 2>/dev/null || true; }
+# (0 before the daemon has opened its log: a file not there yet is no match, not an error.)
+count() {
+  n=$(grep -c "$1" $log 2>/dev/null)
+  echo "${n:-0}"
+}
 wait_for() {  # PATTERN SECONDS
   i=0
   while [ "$(count "$1")" -lt 1 ]; do
