@@ -1,8 +1,8 @@
-// The codecs as the file sensor's decoder (sim/files/image_decoder.h): PPM/PGM, PNG and JPEG
-// through image_file.h, the camera tags through exif.h.
+// The codecs as an ImageDecoder (hal/image_decoder.h), which the file sensor reads through:
+// PPM/PGM, PNG and JPEG through image_file.h, the camera tags through exif.h.
 #pragma once
 
-#include "sim/files/image_decoder.h"
+#include "hal/image_decoder.h"
 
 namespace lb {
 

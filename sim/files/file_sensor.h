@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "algo/core/status.h"
+#include "hal/image_decoder.h"
 #include "hal/sensor.h"
-#include "sim/files/image_decoder.h"
 
 namespace lb {
 

@@ -1,6 +1,8 @@
-// How the file sensor reads its image files. sim holds no decoder of its own: the product's
-// codecs implement this (firmware/codecs/codec_decoder.h) and whoever builds a FileSensor hands
-// one in, so the sensor reads files exactly as the product does and sim never includes firmware/.
+// The image decoder interface: how an image file is probed, streamed into a FrameSink and its
+// camera tags read. The product's codecs implement it (firmware/codecs/codec_decoder.h); the
+// file-backed sensor in sim/ reads its files through whichever one it is handed, so it reads them
+// exactly as the product does. It lives in hal so that neither the codecs nor the simulator need
+// to include the other.
 #pragma once
 
 #include <cstdint>
