@@ -40,12 +40,12 @@ report() {
   crossings=$((crossings + 1))
 }
 
-# The folder a path's rules follow: algo/X and firmware/X, or the top folder.
+# The folder a path's rules follow, into $key: algo/X and firmware/X, or the top folder.
 key_of() {
   local top=${1%%/*} rest=${1#*/}
+  key=$top
   case $top in
-    algo | firmware) [ "$rest" != "${rest#*/}" ] && echo "$top/${rest%%/*}" || echo "$top" ;;
-    *) echo "$top" ;;
+    algo | firmware) [ "$rest" != "${rest#*/}" ] && key=$top/${rest%%/*} ;;
   esac
 }
 
@@ -82,9 +82,11 @@ may_use() {
       ;;
   esac
 }
+declare -A rules_of  # may_use's answers, read once per folder
 allowed() {  # allowed FROM_KEY TO_PATH [folder]: TO_PATH a header, or a library's folder
   local to=$2 f
-  for f in $(may_use "$1"); do
+  [ -n "${rules_of[$1]+set}" ] || rules_of[$1]=$(may_use "$1")
+  for f in ${rules_of[$1]}; do
     if [[ $f == *'*'* || $f == *.h ]]; then
       # A header pattern: a library's folder is never one header.
       # shellcheck disable=SC2053 # the pattern is meant to glob
@@ -102,7 +104,8 @@ uses() {  # the rules of a folder, for a report
 }
 declare -A unplaced
 placed() {  # placed KEY WHERE: reports a folder without rules once
-  [ -n "$(may_use "$1")" ] && return 0
+  [ -n "${rules_of[$1]+set}" ] || rules_of[$1]=$(may_use "$1")
+  [ -n "${rules_of[$1]}" ] && return 0
   [ -n "${unplaced[$1]:-}" ] && return 1
   unplaced[$1]=1
   report "$2: $1 is not placed in the layers (tests/layering/check_layers.sh's header)"
@@ -116,14 +119,17 @@ for top in algo hal sim firmware; do
     file=${hit%%:*}
     rest=${hit#*:}
     line=${rest%%:*}
-    inc=$(sed -n 's/^[[:space:]]*#[[:space:]]*include[[:space:]]*"\([^"]*\)".*/\1/p' <<<"${rest#*:}")
+    [[ ${rest#*:} =~ include[[:space:]]*\"([^\"]*)\" ]] || continue
+    inc=${BASH_REMATCH[1]}
     case $inc in algo/* | hal/* | sim/* | firmware/* | tests/*) ;; *) continue ;; esac
     rel=${file#"$root"/}
-    from=$(key_of "$rel")
+    key_of "$rel"
+    from=$key
     placed "$from" "$rel" || continue
+    key_of "$inc"
     if ! allowed "$from" "$inc"; then
       report "$rel:$line includes \"$inc\" ($from may use: $(uses "$from"))"
-    elif [ "$top" = algo ] && [ "$from" != algo/pipeline ] && [ "$(key_of "$inc")" != "$from" ] &&
+    elif [ "$top" = algo ] && [ "$from" != algo/pipeline ] && [ "$key" != "$from" ] &&
       [[ $inc == algo/*/*_stage.h ]]; then
       report "$rel:$line includes \"$inc\" (only algo/pipeline composes stages)"
     fi
@@ -135,7 +141,8 @@ declare -A home
 while IFS= read -r hit; do
   file=${hit%%:*}
   lib=$(sed -n 's/.*add_library(\([A-Za-z0-9_]*\).*/\1/p' <<<"${hit#*:}")
-  [ -n "$lib" ] && home[$lib]=$(key_of "${file#"$root"/}")
+  key_of "${file#"$root"/}"
+  [ -n "$lib" ] && home[$lib]=$key
 done < <(grep -rn --include=CMakeLists.txt 'add_library(' "$root/algo" "$root/hal" "$root/sim" \
   "$root/firmware" "$root/tests" 2>/dev/null)
 # Both are added in algo/CMakeLists.txt: the vocabulary, which hal may link, and the stages with
@@ -147,7 +154,8 @@ for top in algo hal sim firmware; do
   [ -d "$root/$top" ] || continue
   while IFS= read -r file; do
     rel=${file#"$root"/}
-    dir=$(key_of "$rel")
+    key_of "$rel"
+    dir=$key
     placed "$dir" "$rel" || continue
     # target_link_libraries(TARGET ...) calls, joined onto one line each.
     while IFS= read -r call; do

@@ -1,12 +1,16 @@
 #!/usr/bin/env bash
 # The layering check on a small tree laid out like this repository: without crossings it must
 # pass; with one crossing of each rule it must fail and name every one of them, and nothing else.
-# The repository itself is checked by the ctest layering_tree (check_layers.sh ROOT).
-#   tests/layering/check_layers_test.sh
+# Given ROOT, the same crossings go into a copy of ROOT's sources too, as new files and appended
+# lines, and the check must name each of them and nothing else new: the rules fit the real
+# layout, whatever crossings ROOT has today. ROOT itself is checked by the ctest layers_tree.
+#   tests/layering/check_layers_test.sh [ROOT]
 set -u
+root=${1:-}
 check=$(dirname "$0")/check_layers.sh
 tree=$(mktemp -d)
-trap 'rm -rf "$tree"' EXIT
+copy=$(mktemp -d)
+trap 'rm -rf "$tree" "$copy"' EXIT
 fail() {
   echo "check_layers_test: $1"
   exit 1
@@ -71,7 +75,6 @@ put tests/CMakeLists.txt 'add_library(lb_test_images STATIC)'
 out=$(bash "$check" "$tree") || fail "a tree without crossings fails: $out"
 
 # One crossing of each rule: file:line or CMake file, and what it reaches.
-expected=()
 inject() {  # inject FILE LINE: appends the line and expects FILE:N to be named with it
   put "$1" "$2"
   if [ "${1##*/}" = CMakeLists.txt ]; then
@@ -80,37 +83,65 @@ inject() {  # inject FILE LINE: appends the line and expects FILE:N to be named 
     expected+=("$1:$(wc -l <"$tree/$1") includes $(sed -n 's/#include //p' <<<"$2")")
   fi
 }
-# Between the top folders.
-inject algo/core/status.cc '#include "firmware/app/job.h"'
-inject hal/v4l2.cc '#include "algo/pipeline/pipeline.h"'
-inject firmware/app/job.cc '#include "tests/sim/files/test_images.h"'
-inject hal/CMakeLists.txt 'target_link_libraries(lb_hal PUBLIC lb_algo)'
-inject firmware/app/CMakeLists.txt 'target_link_libraries(lb_app PRIVATE lb_test_images)'
-# Inside algo: a stage using a later one, a stage composing another, the vocabulary linking the
-# stages.
-inject algo/motion/motion_stage.cc '#include "algo/depth/planes.h"'
-inject algo/render/render_stage.cc '#include "algo/depth/depth_stage.h"'
-inject algo/CMakeLists.txt 'target_link_libraries(lb_core PUBLIC lb_algo)'
-# Inside firmware: against the order, web into daemon, between the programs, a link.
-inject firmware/codecs/exif.cc '#include "firmware/app/settings.h"'
-inject firmware/web/web_server.h '#include "firmware/daemon/config.h"'
-inject firmware/cli/depth_command.cc '#include "firmware/web/thumbnail.h"'
-inject firmware/storage/atomic_file.cc '#include "firmware/platform/worker_pool.h"'
-inject firmware/web/CMakeLists.txt 'target_link_libraries(lb_web PUBLIC lb_daemon)'
-# Firmware wiring stages instead of going through the pipeline.
-inject firmware/cli/depth_command.cc '#include "algo/depth/depth_stage.h"'
-inject firmware/app/job.cc '#include "algo/depth/depth_order.h"'
-# Shipped code using the simulator.
-inject firmware/codecs/exif.cc '#include "sim/files/image_decoder.h"'
-inject firmware/app/CMakeLists.txt 'target_link_libraries(lb_app PRIVATE lb_sim)'
-# A folder nobody placed.
-put firmware/extras/extra.cc '#include "firmware/app/job.h"'
-expected+=("firmware/extras/extra.cc: firmware/extras is not placed in the layers")
-
+# One crossing of each rule, into $tree.
+inject_all() {
+  expected=()
+  # Between the top folders.
+  inject algo/core/status.cc '#include "firmware/app/job.h"'
+  inject hal/v4l2.cc '#include "algo/pipeline/pipeline.h"'
+  inject firmware/app/job.cc '#include "tests/sim/files/test_images.h"'
+  inject hal/CMakeLists.txt 'target_link_libraries(lb_hal PUBLIC lb_algo)'
+  inject firmware/app/CMakeLists.txt 'target_link_libraries(lb_app PRIVATE lb_test_images)'
+  # Inside algo: a stage using a later one, a stage composing another, the vocabulary linking the
+  # stages.
+  inject algo/motion/motion_stage.cc '#include "algo/depth/planes.h"'
+  inject algo/render/render_stage.cc '#include "algo/depth/depth_stage.h"'
+  inject algo/CMakeLists.txt 'target_link_libraries(lb_core PUBLIC lb_algo)'
+  # Inside firmware: against the order, web into daemon, between the programs, between storage
+  # and platform, links.
+  inject firmware/codecs/exif.cc '#include "firmware/app/settings.h"'
+  inject firmware/web/web_server.h '#include "firmware/daemon/config.h"'
+  inject firmware/cli/depth_command.cc '#include "firmware/web/thumbnail.h"'
+  inject firmware/storage/atomic_file.cc '#include "firmware/platform/worker_pool.h"'
+  inject firmware/web/CMakeLists.txt 'target_link_libraries(lb_web PUBLIC lb_daemon)'
+  inject firmware/codecs/CMakeLists.txt 'target_link_libraries(lb_codecs PRIVATE lb_app)'
+  # Firmware wiring stages instead of going through the pipeline.
+  inject firmware/cli/depth_command.cc '#include "algo/depth/depth_stage.h"'
+  inject firmware/app/job.cc '#include "algo/depth/depth_order.h"'
+  # Shipped code using the simulator.
+  inject firmware/codecs/exif.cc '#include "sim/files/image_decoder.h"'
+  inject firmware/app/CMakeLists.txt 'target_link_libraries(lb_app PRIVATE lb_sim)'
+  # A folder nobody placed.
+  put firmware/extras/extra.cc '#include "firmware/app/job.h"'
+  expected+=("firmware/extras/extra.cc: firmware/extras is not placed in the layers")
+}
+inject_all
 if out=$(bash "$check" "$tree"); then fail "${#expected[@]} crossings pass"; fi
 for what in "${expected[@]}"; do
   grep -qF "$what" <<<"$out" || fail "not reported: $what (got: $out)"
 done
 [ "$(grep -c '^layering:' <<<"$out")" -eq "${#expected[@]}" ] ||
   fail "not ${#expected[@]} lines: $out"
-echo "check_layers_test: ok (${#expected[@]} crossings named)"
+
+[ -n "$root" ] || {
+  echo "check_layers_test: ok (${#expected[@]} crossings named)"
+  exit 0
+}
+
+# The same on a copy of ROOT's sources, with its CMake files for the libraries' homes.
+cp -r "$root"/{algo,hal,sim,firmware} "$copy"/
+(cd "$root" && find tests -name CMakeLists.txt -exec cp --parents {} "$copy" \;)
+before=$(bash "$check" "$copy")
+tree=$copy
+inject_all
+after=$(bash "$check" "$copy") && fail "${#expected[@]} crossings pass in a copy of $root"
+for what in "${expected[@]}"; do
+  grep -qF "$what" <<<"$after" || fail "not reported in a copy of $root: $what (got: $after)"
+done
+while IFS= read -r line; do
+  for what in "${expected[@]}"; do
+    [[ $line == *"$what"* ]] && continue 2
+  done
+  fail "reported in a copy of $root, not injected: $line"
+done < <(comm -13 <(sort <<<"$before") <(sort <<<"$after"))
+echo "check_layers_test: ok (${#expected[@]} crossings named, in a small tree and in a copy of $root)"
