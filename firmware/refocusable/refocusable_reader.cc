@@ -14,6 +14,7 @@
 #include "firmware/codecs/exif.h"
 #include "firmware/refocusable/base64.h"
 #include "firmware/refocusable/depth_image.h"
+#include "firmware/refocusable/xmp_lookup.h"
 
 namespace lb {
 namespace {
@@ -29,68 +30,6 @@ uint32_t BigEndian32(const uint8_t* p) {
 
 bool StartsWith(const uint8_t* p, size_t n, const char* sig, size_t sig_size) {
   return n >= sig_size && memcmp(p, sig, sig_size) == 0;
-}
-
-bool IsSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; }
-
-// XMP lookups over a packet's text, without copying it (no allocation): a field is an attribute
-// prefix:name="value" or a simple element <prefix:name>value</prefix:name>, the prefix the one an
-// xmlns attribute binds to the namespace (none bound: nothing matches).
-bool Quoted(std::string_view text, size_t pos, std::string_view* value) {
-  while (pos < text.size() && IsSpace(text[pos])) ++pos;
-  if (pos >= text.size() || (text[pos] != '"' && text[pos] != '\'')) return false;
-  const size_t end = text.find(text[pos], pos + 1);
-  if (end == std::string_view::npos) return false;
-  *value = text.substr(pos + 1, end - pos - 1);
-  return true;
-}
-
-std::string_view PrefixOf(std::string_view text, std::string_view uri) {
-  size_t pos = 0;
-  while ((pos = text.find("xmlns:", pos)) != std::string_view::npos) {
-    pos += 6;
-    const size_t eq = text.find('=', pos);
-    if (eq == std::string_view::npos || eq - pos > 64) continue;
-    size_t end = eq;
-    while (end > pos && IsSpace(text[end - 1])) --end;
-    std::string_view value;
-    if (Quoted(text, eq + 1, &value) && value == uri) return text.substr(pos, end - pos);
-  }
-  return {};
-}
-
-bool FindIn(std::string_view text, std::string_view uri, std::string_view name,
-            std::string_view* value) {
-  const std::string_view prefix = PrefixOf(text, uri);
-  if (prefix.empty()) return false;
-  const size_t qsize = prefix.size() + 1 + name.size();
-  size_t pos = 0;
-  while ((pos = text.find(prefix, pos)) != std::string_view::npos) {
-    const size_t start = pos, after = pos + qsize;
-    pos += prefix.size();
-    if (start == 0 || after >= text.size() || text[start + prefix.size()] != ':' ||
-        text.substr(start + prefix.size() + 1, name.size()) != name) {
-      continue;
-    }
-    const bool element = text[start - 1] == '<';
-    if (!element && !IsSpace(text[start - 1])) continue;  // part of a longer name
-    if (element) {
-      if (text[after] != '>') continue;
-      size_t close = after + 1;
-      while ((close = text.find("</", close)) != std::string_view::npos) {
-        if (text.substr(close + 2, qsize) == text.substr(start, qsize)) break;
-        close += 2;
-      }
-      if (close == std::string_view::npos) return false;
-      *value = text.substr(after + 1, close - after - 1);
-      return true;
-    }
-    size_t eq = after;
-    while (eq < text.size() && IsSpace(text[eq])) ++eq;
-    if (eq >= text.size() || text[eq] != '=') continue;
-    return Quoted(text, eq + 1, value);
-  }
-  return false;
 }
 
 // Looks a field up in the main packet, then in the extended one. `prefix` (the usual one) only
@@ -115,18 +54,7 @@ class Fields {
   Status Number(const char* uri, const char* prefix, const char* field, double* out) const {
     std::string_view v;
     LB_RETURN_IF_ERROR(Text(uri, prefix, field, &v));
-    while (!v.empty() && IsSpace(v.front())) v.remove_prefix(1);
-    while (!v.empty() && IsSpace(v.back())) v.remove_suffix(1);
-    char text[64];
-    bool ok = !v.empty() && v.size() < sizeof(text);
-    if (ok) {
-      memcpy(text, v.data(), v.size());
-      text[v.size()] = '\0';
-      char* end = nullptr;
-      errno = 0;
-      *out = strtod(text, &end);
-      ok = end == text + v.size() && errno == 0 && std::isfinite(*out);
-    }
+    const bool ok = ParseXmpNumber(v, out);
     if (!ok) {
       return Status(Code::kCorruptData, "%s: %s:%s is not a number: '%.*s'", name_, prefix, field,
                     static_cast<int>(v.size() < 24 ? v.size() : 24), v.data());
@@ -153,7 +81,7 @@ class Fields {
 
  private:
   bool Lookup(const char* uri, const char* field, std::string_view* v) const {
-    return FindIn(main_, uri, field, v) || FindIn(extended_, uri, field, v);
+    return FindXmpField(main_, uri, field, v) || FindXmpField(extended_, uri, field, v);
   }
 
   const char* name_;
@@ -396,17 +324,16 @@ uint8_t* RefocusableBuffers::Bytes(Part part, size_t count) {
   return nullptr;
 }
 
-Status ReadRefocusableFields(const uint8_t* data, size_t size, const char* name,
-                             RefocusableMemory& memory, RefocusableFields* out) {
-  *out = RefocusableFields();
+Status ReadXmpPackets(const uint8_t* data, size_t size, const char* name, RefocusableMemory& memory,
+                      RefocusableFields* out, std::string_view* main, std::string_view* extended) {
+  *main = *extended = std::string_view();
   if (size < 4 || data[0] != 0xFF || data[1] != 0xD8) {
     return Status(Code::kCorruptData, "%s: not a JPEG", name);
   }
-  std::string_view main, extended;
   size_t count = 0;
-  LB_RETURN_IF_ERROR(WalkSegments(data, size, name, out, &main, nullptr, &count));
+  LB_RETURN_IF_ERROR(WalkSegments(data, size, name, out, main, nullptr, &count));
   std::string_view guid;
-  if (FindIn(main, kXmpNoteNs, "HasExtendedXMP", &guid)) {
+  if (FindXmpField(*main, kXmpNoteNs, "HasExtendedXMP", &guid)) {
     if (guid.size() != 32) {
       return Status(Code::kCorruptData, "%s: xmpNote:HasExtendedXMP is not an MD5", name);
     }
@@ -415,9 +342,17 @@ Status ReadRefocusableFields(const uint8_t* data, size_t size, const char* name,
       return Status(Code::kOutOfMemory, "%s: %zu extended XMP chunks, more than the reader takes",
                     name, count);
     }
-    LB_RETURN_IF_ERROR(WalkSegments(data, size, name, out, &main, chunks, &count));
-    LB_RETURN_IF_ERROR(Reassemble(name, guid, chunks, count, memory, &extended));
+    LB_RETURN_IF_ERROR(WalkSegments(data, size, name, out, main, chunks, &count));
+    LB_RETURN_IF_ERROR(Reassemble(name, guid, chunks, count, memory, extended));
   }
+  return Status::Ok();
+}
+
+Status ReadRefocusableFields(const uint8_t* data, size_t size, const char* name,
+                             RefocusableMemory& memory, RefocusableFields* out) {
+  *out = RefocusableFields();
+  std::string_view main, extended;
+  LB_RETURN_IF_ERROR(ReadXmpPackets(data, size, name, memory, out, &main, &extended));
   const Fields fields(name, main, extended);
   if (!fields.Has(kGDepthNs, "GDepth", "Format") && !fields.Has(kGDepthNs, "GDepth", "Data")) {
     return Status(Code::kNotFound, "%s: XMP has no depth map (GDepth)", name);

@@ -73,6 +73,11 @@ struct RefocusableFields {
   GFocusInfo focus;
 };
 
+// The file's main XMP packet and its extended one, reassembled into `memory` ("" when the file has
+// none); the photo's size from its frame header into out->width and out->height.
+Status ReadXmpPackets(const uint8_t* data, size_t size, const char* name, RefocusableMemory& memory,
+                      RefocusableFields* out, std::string_view* main, std::string_view* extended);
+
 Status ReadRefocusableFields(const uint8_t* data, size_t size, const char* name,
                              RefocusableMemory& memory, RefocusableFields* out);
 
