@@ -2,12 +2,16 @@
 # The structure check on a small tree: within the limits it must pass (a file of 600 lines, a
 # class over two .cc files, calls and declarations that only look like definitions); with one
 # file too long and one class over three files it must fail and name both, and nothing else.
-# The repository itself is checked by the ctest structure_tree (check_structure.sh ROOT).
-#   tests/layering/check_structure_test.sh
+# Given ROOT, a copy of its sources gets a new file too long and a new class over three files,
+# and the check must name both and nothing else new, whatever ROOT holds today. ROOT itself is
+# checked by the ctest structure_tree (check_structure.sh ROOT).
+#   tests/layering/check_structure_test.sh [ROOT]
 set -u
+root=${1:-}
 check=$(dirname "$0")/check_structure.sh
 tree=$(mktemp -d)
-trap 'rm -rf "$tree"' EXIT
+copy=$(mktemp -d)
+trap 'rm -rf "$tree" "$copy"' EXIT
 fail() {
   echo "check_structure_test: $1"
   exit 1
@@ -42,4 +46,21 @@ for what in 'structure: algo/depth/grid_maxflow.cc has 601 lines (at most 600)' 
   grep -qF "$what" <<<"$out" || fail "not reported: $what (got: $out)"
 done
 [ "$(grep -c '^structure:' <<<"$out")" -eq 2 ] || fail "not two lines: $out"
-echo "check_structure_test: ok"
+[ -n "$root" ] || {
+  echo "check_structure_test: ok"
+  exit 0
+}
+
+cp -r "$root"/{algo,firmware,hal,sim} "$copy"/
+before=$(bash "$check" "$copy")
+for i in $(seq 601); do echo "// $i"; done >"$copy/firmware/app/long_injected.cc"
+n=0
+for f in algo/depth/knot_a.cc firmware/app/knot_b.cc sim/knot_c.cc; do
+  printf '%s\n' 'namespace lb {' "void InjectedKnot::Part$((++n))() {}" '}  // namespace lb' >"$copy/$f"
+done
+after=$(bash "$check" "$copy") && fail "two violations pass in a copy of $root"
+expected='structure: class InjectedKnot has member functions defined in 3 .cc files (at most 2): algo/depth/knot_a.cc firmware/app/knot_b.cc sim/knot_c.cc
+structure: firmware/app/long_injected.cc has 601 lines (at most 600)'
+new=$(comm -13 <(sort <<<"$before") <(sort <<<"$after"))
+[ "$new" = "$expected" ] || fail "in a copy of $root, reported: $new (expected: $expected)"
+echo "check_structure_test: ok (in a small tree and in a copy of $root)"
