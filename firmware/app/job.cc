@@ -1,7 +1,6 @@
 #include "firmware/app/job.h"
 
 #include <cstdio>
-#include <cstdlib>
 #include <ctime>
 #include <utility>
 
@@ -150,8 +149,6 @@ class DepthProgress final : public ProgressSink {
 
 }  // namespace
 
-void Job::FreeDeleter::operator()(void* p) const { free(p); }
-
 Job::Job() : pipeline_(std::make_unique<Pipeline>()), pool_(std::make_unique<WorkerPool>()) {}
 Job::~Job() = default;
 
@@ -177,12 +174,9 @@ Status Job::Configure(Sensor* sensor, const JobOptions& options) {
   pc.workers = WorkerPool::CountFor(options.threads);
   size_t bytes = 0;
   LB_RETURN_IF_ERROR(Pipeline::RequiredBytes(pc, &bytes));
-  if (bytes != arena_bytes_) {
-    arena_.reset(static_cast<uint8_t*>(aligned_alloc(Arena::kAlign, Arena::RoundUp(bytes))));
-    if (!arena_) return Status(Code::kOutOfMemory, "cannot allocate the %zu-byte arena", bytes);
-    arena_bytes_ = bytes;
-  }
-  LB_RETURN_IF_ERROR(pipeline_->Configure(pc, arena_.get(), arena_bytes_));
+  LB_RETURN_IF_ERROR(arena_.Reserve(bytes, "for the pipeline"));
+  arena_bytes_ = bytes;
+  LB_RETURN_IF_ERROR(pipeline_->Configure(pc, arena_.data(), arena_.size()));
   if (pool_->workers() != pc.workers) LB_RETURN_IF_ERROR(pool_->Start(pc.workers));
   pipeline_->SetRunner(pool_.get());
   // The XMP is built beside the render only when threads were given to the job: one thread

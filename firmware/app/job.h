@@ -12,6 +12,7 @@
 #include "algo/pipeline/pipeline.h"
 #include "firmware/app/progress.h"
 #include "firmware/app/side_task.h"
+#include "firmware/platform/arena_block.h"
 #include "firmware/storage/atomic_file.h"
 #include "hal/sensor.h"
 
@@ -104,9 +105,6 @@ class Job {
   const SensorMode& mode() const { return mode_; }
 
  private:
-  struct FreeDeleter {
-    void operator()(void* p) const;
-  };
   Sensor* sensor_ = nullptr;
   JobOptions options_;
   SensorMode mode_;
@@ -115,8 +113,8 @@ class Job {
   // With more than one worker: where the refocusable XMP is built while the render runs.
   SideTask side_;
   Progress* progress_ = nullptr;
-  std::unique_ptr<uint8_t, FreeDeleter> arena_;
-  size_t arena_bytes_ = 0;
+  ArenaBlock arena_;
+  size_t arena_bytes_ = 0;  // what the pipeline asked for
 };
 
 }  // namespace lb

@@ -8,7 +8,6 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <string_view>
@@ -24,8 +23,6 @@
 #include "firmware/storage/input_file.h"
 
 namespace lb {
-
-void RefocusEngine::FreeDeleter::operator()(void* p) const { free(p); }
 
 namespace {
 
@@ -131,12 +128,8 @@ Status RefocusEngine::Configure(const RefocusEngineConfig& config) {
   prc.workers = workers;
   LB_RETURN_IF_ERROR(RenderStage::Validate(prc));
   preview_bytes_ = Arena::RoundUp(RenderStage::RequiredBytes(prc));
-  full_block_.reset(static_cast<uint8_t*>(aligned_alloc(Arena::kAlign, full_bytes_)));
-  preview_block_.reset(static_cast<uint8_t*>(aligned_alloc(Arena::kAlign, preview_bytes_)));
-  if (!full_block_ || !preview_block_) {
-    return Status(Code::kOutOfMemory, "refocus engine: cannot allocate %zu bytes to render",
-                  full_bytes_ + preview_bytes_);
-  }
+  LB_RETURN_IF_ERROR(full_block_.Reserve(full_bytes_, "for the refocus engine's render"));
+  LB_RETURN_IF_ERROR(preview_block_.Reserve(preview_bytes_, "for the refocus engine's preview"));
   full_ = std::make_unique<RenderStage>();
   preview_ = std::make_unique<RenderStage>();
   writer_ = std::make_unique<JpegWriter>();
@@ -346,7 +339,7 @@ Status RefocusEngine::RenderInto(RenderStage* stage, const RenderParams& params,
     return Status(Code::kOutOfMemory, "refocus engine: render needs more than its %zu bytes",
                   capacity);
   }
-  Arena arena(preview ? preview_block_.get() : full_block_.get(), capacity);
+  Arena arena = (preview ? preview_block_ : full_block_).arena();
   LB_RETURN_IF_ERROR(stage->Configure(rc, arena));
   stage->SetRunner(pool_.get());
   ConstPlanarU8 ref;

@@ -21,6 +21,7 @@
 
 #include "algo/core/status.h"
 #include "algo/render/render_stage.h"
+#include "firmware/platform/arena_block.h"
 #include "firmware/refocusable/depth_encoding.h"
 #include "firmware/refocusable/refocusable_reader.h"
 
@@ -125,10 +126,7 @@ class RefocusEngine {
   std::vector<uint16_t> pdisp_q8_;
   const uint16_t* preview_disp_ = nullptr;
 
-  struct FreeDeleter {
-    void operator()(void* p) const;
-  };
-  std::unique_ptr<uint8_t, FreeDeleter> full_block_, preview_block_;
+  ArenaBlock full_block_, preview_block_;
   size_t full_bytes_ = 0, preview_bytes_ = 0;
   std::unique_ptr<RenderStage> full_, preview_;
   std::unique_ptr<WorkerPool> pool_;

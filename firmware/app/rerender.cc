@@ -11,6 +11,7 @@
 #include "firmware/app/refocusable.h"
 #include "firmware/codecs/image_file.h"
 #include "firmware/codecs/jpeg_writer.h"
+#include "firmware/platform/arena_block.h"
 #include "firmware/platform/worker_pool.h"
 #include "firmware/refocusable/depth_image.h"
 #include "firmware/refocusable/refocusable_reader.h"
@@ -213,11 +214,9 @@ Status Rerenderer::Render(const RerenderOptions& options, const char* out_path,
   rc.max_radius = options.max_blur_radius;
   rc.workers = WorkerPool::CountFor(options.threads);
   LB_RETURN_IF_ERROR(RenderStage::Validate(rc));
-  const size_t bytes = RenderStage::RequiredBytes(rc);
-  std::unique_ptr<void, decltype(&free)> block(aligned_alloc(Arena::kAlign, Arena::RoundUp(bytes)),
-                                               &free);
-  if (!block) return Status(Code::kOutOfMemory, "cannot allocate %zu bytes to render", bytes);
-  Arena arena(block.get(), Arena::RoundUp(bytes));
+  ArenaBlock block;
+  LB_RETURN_IF_ERROR(block.Reserve(RenderStage::RequiredBytes(rc), "to render"));
+  Arena arena = block.arena();
   RenderStage render;
   LB_RETURN_IF_ERROR(render.Configure(rc, arena));
   WorkerPool pool;
