@@ -19,7 +19,10 @@
 
 namespace lb {
 
-struct GridMaxflowRows;  // what InitRow reads (grid_maxflow.cc)
+struct GridMaxflowRows;  // what InitRow reads (grid_maxflow_setup.h)
+namespace gmf {
+struct Kernels;  // the row kernel InitRow runs (grid_maxflow_setup.h)
+}
 
 class GridMaxflow {
  public:
@@ -145,9 +148,8 @@ class GridMaxflow {
   // width_ again, in a type the staging stores cannot alias: SetNode's callers keep it in a
   // register instead of reloading it after every store.
   ptrdiff_t stage_width_ = 0;
-  bool staged_ = false;    // false for GridMaxflowProbe's graphs, set on the nodes directly
-  bool avx2_ = false;      // InitRow's eight-lane copy can run (asked once, at Carve)
-  bool cpu_avx2_ = false;  // what the CPU has (avx2_ follows it unless a test turns it off)
+  bool staged_ = false;  // false for GridMaxflowProbe's graphs, set on the nodes directly
+  const gmf::Kernels* kernels_ = nullptr;  // picked once, at Carve
   // Augment's record of the two paths' first nodes (each kPath, and a slot that takes the rest).
   static constexpr int32_t kPath = 255;
   int32_t path_[2 * (kPath + 1)] = {};
@@ -189,9 +191,10 @@ struct GridMaxflowProbe {
   // within a small graph's search.
   static void StartTime(GridMaxflow& mf, int32_t time) { mf.first_time_ = time; }
   static int32_t Time(const GridMaxflow& mf) { return mf.time_; }
-  // Whether the passes before the search may use their eight-lane copy (when the CPU has it):
-  // off, they take the four-lane one, which must give the same nodes.
-  static void UseEightLanes(GridMaxflow& mf, bool on) { mf.avx2_ = on && mf.cpu_avx2_; }
+  // Whether the passes before the search may use the SIMD twin of their row kernel that the CPU
+  // runs (grid_maxflow_setup.h; Carve turns it on): off, they take the C reference, which must
+  // give the same nodes.
+  static void UseSimd(GridMaxflow& mf, bool on);
   // Fills all node storage with `byte`, as if another graph had left garbage everywhere: a caller
   // that sets only the nodes its graph can reach must then still get the same cut.
   static void Poison(GridMaxflow& mf, uint8_t byte) {

@@ -293,11 +293,11 @@ TEST_F(MaxflowTest, StreamedRowsWithIdleNodesMatchTextbook) {
   }
 }
 
-// Rows as wide as the solver's vector passes take (eight and four nodes at a time, with the rest
-// one by one), graphs truncated after Begin, storage full of garbage before each graph and only
-// the nodes a free node can reach set (as the depth stage does): the flow and the least source
-// side against the textbook, and the same residual on every arc whether the passes before the
-// search ran eight or four lanes at a time.
+// Rows as wide as the solver's row kernels take (several steps of eight or four nodes, with the
+// rest one by one), graphs truncated after Begin, storage full of garbage before each graph and
+// only the nodes a free node can reach set (as the depth stage does): the flow and the least
+// source side against the textbook, and the same residual on every arc whether the passes
+// before the search ran the SIMD twin of their row kernel or the C reference.
 TEST_F(MaxflowTest, WideStreamedRowsMatchTextbookWithAnyLanes) {
   std::mt19937 rng(31337);
   std::uniform_int_distribution<int32_t> width(9, 33), height(1, 6), tail(0, 3), byte(0, 255);
@@ -305,7 +305,7 @@ TEST_F(MaxflowTest, WideStreamedRowsMatchTextbookWithAnyLanes) {
   std::vector<uint8_t> memory(Planned());
   Arena arena(memory.data(), memory.size());
   four.Carve(arena, kMaxSide, kMaxSide);
-  GridMaxflowProbe::UseEightLanes(four, false);
+  GridMaxflowProbe::UseSimd(four, false);
   for (int trial = 0; trial < 300; ++trial) {
     const int32_t w = width(rng), h = height(rng), extra = tail(rng);
     Graph g = RandomGraph(rng, w, h, trial % 2 ? 7 : 800);
