@@ -14,6 +14,7 @@
 #include "firmware/codecs/exif.h"
 #include "firmware/refocusable/base64.h"
 #include "firmware/refocusable/depth_image.h"
+#include "firmware/refocusable/dynamic_depth.h"
 #include "firmware/refocusable/xmp_lookup.h"
 
 namespace lb {
@@ -354,11 +355,17 @@ Status ReadRefocusableFields(const uint8_t* data, size_t size, const char* name,
   std::string_view main, extended;
   LB_RETURN_IF_ERROR(ReadXmpPackets(data, size, name, memory, out, &main, &extended));
   const Fields fields(name, main, extended);
-  if (!fields.Has(kGDepthNs, "GDepth", "Format") && !fields.Has(kGDepthNs, "GDepth", "Data")) {
-    return Status(Code::kNotFound, "%s: XMP has no depth map (GDepth)", name);
+  if (fields.Has(kGDepthNs, "GDepth", "Format") || fields.Has(kGDepthNs, "GDepth", "Data")) {
+    LB_RETURN_IF_ERROR(ReadDepth(name, fields, memory, out));
+    LB_RETURN_IF_ERROR(ReadImage(name, fields, memory, out));
+  } else if (HasDynamicDepth(main, extended)) {
+    DynamicDepthFields dd;
+    LB_RETURN_IF_ERROR(
+        ReadDynamicDepthFields(data, size, name, main, extended, out->width, out->height, &dd));
+    DynamicDepthAsRefocusable(dd, out);
+  } else {
+    return Status(Code::kNotFound, "%s: XMP has no depth map (GDepth or Dynamic Depth)", name);
   }
-  LB_RETURN_IF_ERROR(ReadDepth(name, fields, memory, out));
-  LB_RETURN_IF_ERROR(ReadImage(name, fields, memory, out));
   LB_RETURN_IF_ERROR(ReadFocus(fields, out));
   // From the bytes in hand: a re-render must not open the file a second time.
   out->orientation = ExifOrientation(data, size);
@@ -376,8 +383,16 @@ Status ReadRefocusable(const uint8_t* data, size_t size, const char* name, Refoc
   Status s = ReadRefocusableFields(data, size, name, memory, &f);
   // The fields point into the file and `memory`: copied out before it goes.
   GDepthInfo& d = out->xmp.depth;
-  d.data.resize(f.depth_png_size);
-  out->xmp.image.resize(f.image_size);
+  // A Dynamic Depth file's items are in its bytes, not in `memory`.
+  const auto keep = [](const uint8_t* p, size_t n, std::vector<uint8_t>* v) {
+    if (p != nullptr && p != v->data()) {
+      v->assign(p, p + n);
+    } else {
+      v->resize(n);
+    }
+  };
+  keep(f.depth_png, f.depth_png_size, &d.data);
+  keep(f.image, f.image_size, &out->xmp.image);
   if (!s.ok()) return s;
   out->width = f.width;
   out->height = f.height;

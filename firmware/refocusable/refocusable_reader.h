@@ -71,6 +71,7 @@ struct RefocusableFields {
   size_t image_size = 0;
   bool has_focus = false;
   GFocusInfo focus;
+  bool dynamic_depth = false;  // the depth and the image from Dynamic Depth's items (no GDepth)
 };
 
 // The file's main XMP packet and its extended one, reassembled into `memory` ("" when the file has

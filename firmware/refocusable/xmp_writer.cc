@@ -91,7 +91,9 @@ std::string Packet(const RefocusableXmp& xmp, bool fields, bool data, const char
     AppendBase64("GDepth:Data", xmp.depth.data, &p);
     if (!xmp.image.empty()) AppendBase64("GImage:Data", xmp.image, &p);
   }
-  p += "/>\n </rdf:RDF>\n</x:xmpmeta>";
+  p += "/>\n";
+  if (fields) p += xmp.extra_description;
+  p += " </rdf:RDF>\n</x:xmpmeta>";
   if (wrapper) p += "\n<?xpacket end=\"w\"?>";
   return p;
 }

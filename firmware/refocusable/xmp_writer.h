@@ -50,6 +50,8 @@ struct RefocusableXmp {
   std::vector<uint8_t> image;  // the all-in-focus JPEG; empty = no GImage
   bool has_focus = false;
   GFocusInfo focus;
+  // More of the main packet: whole rdf:Description elements (Dynamic Depth's Device), "" = none.
+  std::string extra_description;
 };
 
 // Fills `xmp->depth` from a working-resolution disparity map: RangeInverse, `bits` (8 or 16) bit
