@@ -117,8 +117,8 @@ fi
 # Recommends are not installed (mmdebstrap's default): only what the board needs. The initramfs
 # holds the modules the board boots from (virtio disk, ext4: MODULES=list, as a board's image
 # names its own) rather than Debian's generic MODULES=most: mkinitramfs runs under qemu-user
-# here, where the generic one took 10 minutes a run (twice in a root) and 35 MB, slow to unpack
-# in the emulated board too.
+# here, where the generic one is slow to build (twice in a root) and large, slow to unpack in the
+# emulated board too.
 packages="systemd,systemd-sysv,udev,kmod,initramfs-tools,linux-image-arm64,curl"
 initramfs_modules="virtio_pci virtio_blk ext4"
 initramfs_hook='mkdir -p "$1/etc/initramfs-tools/conf.d" "$1/usr/share/initramfs-tools/modules.d" &&

@@ -15,7 +15,7 @@ host_pkgs=(
   libjpeg-turbo-progs libimage-exiftool-perl time
   g++-aarch64-linux-gnu g++-arm-linux-gnueabihf qemu-user-static
   libcamera-dev libcamera-ipa
-  # refocusd's web page (issue 16): the HTTP library, and the browser, its driver and the load
+  # refocusd's web page: the HTTP library, and the browser, its driver and the load
   # generator the page's browser test and the web load test use.
   libmicrohttpd-dev chromium chromium-driver python3-selenium wrk
   # The throw-away VM that tests the real kernel drivers (tests/vm/run_vm.sh).

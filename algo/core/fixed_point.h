@@ -1,5 +1,6 @@
-// Fixed-point helpers. Formats are named in the CMSIS style: Qm.n has n fractional bits, and a
-// variable says its format in its name (`weightQ15`, `dispQ8`). Every helper states its rounding.
+// Fixed-point helpers. Qm.n has n fractional bits, and a name ends with its format's fractional
+// bits: variables and members `_qN` (`disp_q8`, `x_q16`, `recip_q15_`), functions and constants
+// `QN` (`LabelDispQ8`, `RecipQ15`, `kHalfQ16`). Every helper states its rounding.
 #pragma once
 
 #include <cstdint>

@@ -298,7 +298,7 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
   // pixel: real frames can slide along that valley to a turned, depth-shifted fit. A burst whose
   // frames lie on one line at equal steps came from a rail (a slider, a rig) that holds the
   // camera's orientation: it is solved again with that turn held, and with the lens's radial
-  // distortion, which the turn no longer absorbs (on tsukuba it is k1 = -0.046).
+  // distortion, which the turn no longer absorbs.
   result->rail = IsRail(result->motion, result->views, result->reference,
                         {c.rail_off_axis, c.rail_spacing}, in.prior_axis);
   if (result->rail && c.rail_rotation_prior > 0) {

@@ -56,8 +56,7 @@ struct MotionConfig {
   // then runs once more, with radial k1, and with this prior weight (bundle.h) on the turn that
   // shifts the image along the rail, which holds it at ~0. rail_off_axis 0: never a rail. Only a
   // rail's adjustment fits k1: on a handheld burst k1, the turn across the baseline and the depth
-  // offset share one flat valley, and real frames can slide along it (README, "Motion and auto
-  // geometry").
+  // offset share one flat valley, and real frames can slide along it (motion_stage.cc).
   double rail_off_axis = 0.05;  // ~2.9 degrees
   double rail_spacing = 0.1;
   double rail_rotation_prior = 1000;

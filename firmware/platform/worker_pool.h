@@ -4,8 +4,8 @@
 // task has returned, not when every worker has woken: a run whose tasks the caller finished
 // alone does not wait for a sleeping worker. Between runs a worker spins a few tens of
 // microseconds before it parks on the condition variable (the stages run many short runs back
-// to back, and waking a parked thread costs about 25 us); the caller spins as long for the last
-// task before it parks. Nothing is allocated after Start.
+// to back, and waking a parked thread costs more than a short run); the caller spins as long for
+// the last task before it parks. Nothing is allocated after Start.
 #pragma once
 
 #include <pthread.h>

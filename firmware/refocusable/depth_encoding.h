@@ -29,11 +29,11 @@ Status DisparityRangeFromNearFar(double near_depth, double far_depth, DisparityR
 // Disparity 0 (infinity) is taken as 1/256 px.
 double DepthForDisparity(int32_t disp_q8);
 
-// dispQ8 -> RangeInverse value of `bits` (8 or 16) bits, rounded to nearest; disparities outside
+// disp_q8 -> RangeInverse value of `bits` (8 or 16) bits, rounded to nearest; disparities outside
 // the range clamp to its ends. The range must have passed DepthNearFar.
 uint16_t EncodeRangeInverse(int32_t disp_q8, const DisparityRange& range, int bits);
 
-// RangeInverse value -> dispQ8, rounded to nearest. With 16 bits and a range of at most 65535
+// RangeInverse value -> disp_q8, rounded to nearest. With 16 bits and a range of at most 65535
 // Q8 steps, Decode(Encode(d)) == d for every d in the range.
 int32_t DecodeRangeInverse(uint16_t value, const DisparityRange& range, int bits);
 

@@ -20,11 +20,12 @@ namespace {
 // alignment keeps to both.
 constexpr size_t kAlign = 64;
 // What does not grow with the width (colour conversion, range limit, derived Huffman and
-// dequantisation tables, the MCU's blocks, the standard Huffman tables): about 15 KB measured.
+// dequantisation tables, the MCU's blocks, the standard Huffman tables), with room for other
+// libjpeg-turbo versions.
 constexpr size_t kFixedArenaBytes = size_t{64} << 10;
-// Sample rows kept per column, measured with libjpeg-turbo 2.1: 4:2:2 about 25 bytes, 4:2:0
-// about 35 (context rows for its smooth upsampling), luma sampled 1x4, the tallest layout, about
-// 60. mjpeg_decoder_test checks every layout peaks under two thirds of the arena.
+// Sample rows kept per column: more for 4:2:0 than 4:2:2 (context rows for its smooth
+// upsampling), most for luma sampled 1x4, the tallest layout, with a third to spare.
+// mjpeg_decoder_test checks every layout peaks under two thirds of the arena.
 constexpr size_t kArenaBytesPerColumn = 96;
 
 size_t RoundUp(size_t n, size_t to) { return (n + to - 1) / to * to; }

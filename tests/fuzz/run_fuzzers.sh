@@ -7,9 +7,9 @@
 #       (libFuzzer -merge=1: only inputs that add coverage to what DIR/<reader>/ already has are
 #       copied; nothing is removed).
 #     --only NAME: run one fuzzer (fuzz_jpeg, ...).
-# CI (scripts/test.sh, ctest -L fuzz) runs `run_fuzzers.sh 20 build/fuzz`. The long runs of
-# issue 13 are the `fuzz-long` target (600 s each, LB_FUZZ_LONG_SECONDS, then --merge-into
-# tests/fuzz/corpus), by hand:
+# CI (scripts/test.sh, ctest -L fuzz) runs `run_fuzzers.sh 20 build/fuzz`. The long runs that
+# grow the committed corpus are the `fuzz-long` target (600 s each, LB_FUZZ_LONG_SECONDS, then
+# --merge-into tests/fuzz/corpus), by hand:
 #   cmake --preset fuzz && cmake --build --preset fuzz --target fuzz-long
 # or one reader: nice -n 10 bash tests/fuzz/run_fuzzers.sh --only fuzz_conf 600 build/fuzz
 # To refresh the committed corpus from scratch, empty tests/fuzz/corpus/<reader>/ before merging.

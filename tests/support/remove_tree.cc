@@ -1,6 +1,6 @@
 // With nftw, not a shell running rm: under qemu-user (the aarch64 and armhf CI runs), the child
-// of a fork right after a test's threads ended once hung on a lock, and the whole CI stage with it
-// (14 minutes). No shell, no fork.
+// of a fork right after a test's threads end can hang on a lock, and the whole CI stage with it.
+// No shell, no fork.
 #include "tests/support/remove_tree.h"
 
 #include <ftw.h>

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The camera's page in a real browser (issue 16), against the real refocusd.
+"""The camera's page in a real browser, against the real refocusd.
 
 refocusd runs with the synthetic sensor, the button as a FIFO and the web page on 127.0.0.1:<a
 free port> behind a token. The test presses the button, opens the page in headless Chromium
@@ -180,8 +180,9 @@ def main():
     ap.add_argument("--www", required=True)
     ap.add_argument("--out", required=True, help="where the screenshot goes (build tree)")
     ap.add_argument("--resolution", default="2048x1536")
-    # The latency is a measurement (README, under chrt -f 10), not a pass mark: CI machines are
-    # shared, and the renderer runs at low priority by design. A bound given here is checked.
+    # The latency is a measurement (docs/performance.md, under chrt -f 10), not a pass mark: CI
+    # machines are shared, and the renderer runs at low priority by design. A bound given here is
+    # checked.
     ap.add_argument("--max-latency-ms", type=float,
                     default=float(os.environ.get("LB_BROWSER_MAX_LATENCY_MS", "inf")))
     args = ap.parse_args()

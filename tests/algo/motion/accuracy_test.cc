@@ -1,10 +1,11 @@
 // Motion accuracy over many seeded handheld bursts (640x480, 5-7 frames, rotations up to 1
 // degree, translations up to 1 % of the scene depth), against the scene's true poses. Prints
-// the distributions; LB_MOTION_SEEDS sets the number of bursts (the README's figures use 30).
-// The bounds are issue 6's, on frames whose pixels integrate their area (4 x 4 samples, as a
+// the distributions; LB_MOTION_SEEDS sets the number of bursts (docs/accuracy.md's figures use
+// 30). The bounds are the motion stage's targets (rotation within 0.05 degree, translation
+// direction within 2 degrees), on frames whose pixels integrate their area (4 x 4 samples, as a
 // sensor's do). Point-sampled frames of the scene's hard-edged patterns move the tracked corners
-// by up to ~0.3 px, so on those the worst directions reach ~4 degrees: printed beside, with a
-// looser guard against regressions.
+// by a fraction of a pixel, so on those the worst directions miss the target: printed beside,
+// with a looser guard against regressions.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-// The web page's renders of a 12 MP photo (issue 16): the tap -> preview render (longer side
+// The web page's renders of a 12 MP photo: the tap -> preview render (longer side
 // 1024 px, from the downscaled original and depth map, encoded to JPEG in memory), the full-size
 // re-render (encoded in memory, as the page receives it) and loading the photo (read, XMP walk,
 // GImage and depth decode, preview inputs). The photo is the synthetic camera's own (made once,

@@ -1,4 +1,4 @@
-// Writing a 12 MP photo (issue 15): the rendered strips encoded as they come, the all-in-focus
+// Writing a 12 MP photo: the rendered strips encoded as they come, the all-in-focus
 // original encoded whole (GImage), the refocusable XMP built (the depth map as a 16-bit PNG,
 // base64, extended-XMP segments) and the finished file written, fsynced and renamed. The
 // pictures are the synthetic burst's own reference frame and depth (computed once, before

@@ -290,7 +290,7 @@ void BM_OpenCvSgbmTeddy(benchmark::State& state) {
 BENCHMARK(BM_OpenCvSgbmTeddy)->Unit(benchmark::kMillisecond)->MinTime(3.0);
 
 // The ratio the bound is stated for, taken so that a busy machine slows both sides alike: one
-// depth compute (one thread, with the sub-label fit the renderer's pipeline runs: about 2 % more
+// depth compute (one thread, with the sub-label fit the renderer's pipeline runs: a little more
 // than the label disparities alone, BM_DepthStageTeddy/1 against /0) and one SGBM compute by
 // turns, each timed on its own; the counters are each side's median and the median of the
 // per-turn ratios.

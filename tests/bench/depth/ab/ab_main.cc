@@ -2,9 +2,9 @@
 // (scripts/ab_depth.sh), one compute of each by turns on teddy (rectified shifts, 64 labels)
 // and on a synthetic handheld burst (640x480, 7 views: the plane sweep, then the rectified shifts
 // over the same labels, the two sides of depth_bench's PlanesOverRectified). A busy host slows both
-// sides of a turn alike, so the median of the per-turn ratios shows 1 % changes that separate
-// benchmark runs do not. Prints each side's median time, that ratio and whether the maps are
-// the same bit for bit.
+// sides of a turn alike, so the median of the per-turn ratios shows changes too small for
+// separate benchmark runs to tell apart. Prints each side's median time, that ratio and whether the
+// maps are the same bit for bit.
 //   ab_depth [turns [scene]]   (scene: teddy, handheld or handheld-r alone, e.g. under callgrind)
 #include <algorithm>
 #include <cstdio>
