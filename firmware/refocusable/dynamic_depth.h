@@ -91,6 +91,9 @@ struct DynamicDepthExtras {
   std::string units = "Diopters";
   std::vector<uint8_t> confidence;  // an 8-bit grey PNG or JPEG the depth's size; empty = none
   std::string confidence_mime = "image/png";
+  // GImage's original as an item too: Dynamic Depth readers refocus from it, at the cost of its
+  // bytes a second time.
+  bool original = true;
   DdImagingModel imaging_model;
 };
 
@@ -110,7 +113,9 @@ Status WriteDynamicDepthItems(const RefocusableXmp& xmp, const DynamicDepthExtra
   if (!extras.confidence.empty()) {
     LB_RETURN_IF_ERROR(write(extras.confidence.data(), extras.confidence.size()));
   }
-  if (!xmp.image.empty()) LB_RETURN_IF_ERROR(write(xmp.image.data(), xmp.image.size()));
+  if (extras.original && !xmp.image.empty()) {
+    LB_RETURN_IF_ERROR(write(xmp.image.data(), xmp.image.size()));
+  }
   return Status::Ok();
 }
 

@@ -64,7 +64,8 @@ Status SetDynamicDepth(const DynamicDepthExtras& extras, RefocusableXmp* xmp) {
       !std::isfinite(m.principal_point_x) || !std::isfinite(m.principal_point_y)) {
     return Status(Code::kInvalidArgument, "dynamic depth: fields must be finite");
   }
-  const bool original = !xmp->image.empty(), confidence = !extras.confidence.empty();
+  const bool original = extras.original && !xmp->image.empty(),
+             confidence = !extras.confidence.empty();
   std::string& p = xmp->extra_description;
   p = "  <rdf:Description rdf:about=\"\"";
   const std::pair<const char*, const char*> spaces[] = {
@@ -122,7 +123,8 @@ Status AppendDynamicDepthItems(const RefocusableXmp& xmp, const DynamicDepthExtr
   if (n < 4 || (*jpeg)[n - 2] != 0xFF || (*jpeg)[n - 1] != 0xD9) {
     return Status(Code::kInvalidArgument, "dynamic depth: the primary does not end with its EOI");
   }
-  jpeg->reserve(n + xmp.depth.data.size() + extras.confidence.size() + xmp.image.size());
+  jpeg->reserve(n + xmp.depth.data.size() + extras.confidence.size() +
+                (extras.original ? xmp.image.size() : 0));
   return WriteDynamicDepthItems(xmp, extras, [jpeg](const uint8_t* data, size_t size) {
     jpeg->insert(jpeg->end(), data, data + size);
     return Status::Ok();

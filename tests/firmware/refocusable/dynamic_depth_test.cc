@@ -163,6 +163,23 @@ TEST_P(DynamicDepthTest, ReadsWithoutGDepth) {
             f.sample.xmp.depth.data);
 }
 
+// Without the original as an item (its bytes once, in GImage only): the directory lists the
+// primary, the depth and the confidence, and the Camera's Image names the primary.
+TEST(DynamicDepthWriterTest, OriginalMayStayInGImageOnly) {
+  DdFile f = MakeDdFile(true);
+  f.extras.original = false;
+  ASSERT_TRUE(SetDynamicDepth(f.extras, &f.sample.xmp).ok());
+  const std::vector<uint8_t> bytes = DdOnly(f, f.sample.xmp.extra_description);
+  DynamicDepthFields dd;
+  const Status status = ReadDd(bytes, &dd);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(dd.item_count, 3u);
+  EXPECT_EQ(dd.original, -1);
+  EXPECT_EQ(Bytes(dd.items[dd.depth]), f.sample.xmp.depth.data);
+  EXPECT_NE(f.sample.xmp.extra_description.find("Image:ItemURI=\"primary_image\""),
+            std::string::npos);
+}
+
 INSTANTIATE_TEST_SUITE_P(Sizes, DynamicDepthTest, ::testing::Values(false, true),
                          [](const auto& info) { return info.param ? "Extended" : "OnePacket"; });
 
