@@ -180,6 +180,75 @@ TEST(DynamicDepthWriterTest, OriginalMayStayInGImageOnly) {
             std::string::npos);
 }
 
+// A directory as some phones write it: GContainer's namespaces, items named by Item:Semantic
+// (no DataURI), fields as elements, a gain map between the primary and the depth: the depth, the
+// confidence and the original are found by what names them, not by their position.
+TEST(DynamicDepthReaderTest, GContainerDirectoryBySemantic) {
+  const DdFile f = MakeDdFile(true);
+  const RefocusableXmp& x = f.sample.xmp;
+  const auto item = [](const char* mime, const char* semantic, size_t length) {
+    return std::string("     <rdf:li rdf:parseType=\"Resource\">\n      <Container:Item>\n") +
+           "       <Item:Mime>" + mime + "</Item:Mime>\n       <Item:Semantic>" + semantic +
+           "</Item:Semantic>\n       <Item:Length>" + std::to_string(length) +
+           "</Item:Length>\n      </Container:Item>\n     </rdf:li>\n";
+  };
+  const std::string description =
+      std::string("  <rdf:Description rdf:about=\"\"\n") + "    xmlns:Container=\"" +
+      kGContainerNs + "\" xmlns:Item=\"" + kGContainerItemNs + "\"\n    xmlns:Device=\"" +
+      kDdDeviceNs + "\" xmlns:Camera=\"" + kDdCameraNs + "\"\n    xmlns:DepthMap=\"" +
+      kDdDepthMapNs + "\" xmlns:Image=\"" + kDdImageNs + "\">\n" +
+      "   <Container:Directory>\n    <rdf:Seq>\n" + item("image/jpeg", "Primary", 0) +
+      item("image/jpeg", "GainMap", x.image.size()) +
+      item("image/png", "Depth", x.depth.data.size()) +
+      item("image/png", "Confidence", f.extras.confidence.size()) +
+      item("image/jpeg", "Original", x.image.size()) +
+      "    </rdf:Seq>\n   </Container:Directory>\n   <Device:Cameras><rdf:Seq><rdf:li "
+      "rdf:parseType=\"Resource\"><Device:Camera rdf:parseType=\"Resource\">\n"
+      "    <Camera:DepthMap rdf:parseType=\"Resource\">\n"
+      "     <DepthMap:Format>RangeLinear</DepthMap:Format><DepthMap:Near>0.5</DepthMap:Near>\n"
+      "     <DepthMap:Far>4</DepthMap:Far><DepthMap:Units>Meters</DepthMap:Units>\n"
+      "     <DepthMap:DepthURI>android/depthmap</DepthMap:DepthURI>\n"
+      "     <DepthMap:ConfidenceURI>android/confidencemap</DepthMap:ConfidenceURI>\n"
+      "    </Camera:DepthMap>\n"
+      "    <Camera:Image Image:ItemSemantic=\"Original\" Image:ItemURI=\"android/original\"/>\n"
+      "   </Device:Camera></rdf:li></rdf:Seq></Device:Cameras>\n  </rdf:Description>\n";
+  JpegSegment main;
+  test::SetPayloadText(&main, std::string(kXmpSignature, sizeof(kXmpSignature)) +
+                                  "<x:xmpmeta xmlns:x=\"adobe:ns:meta/\"><rdf:RDF xmlns:rdf=\""
+                                  "http://www.w3.org/1999/02/22-rdf-syntax-ns#\">\n" +
+                                  description + "</rdf:RDF></x:xmpmeta>");
+  std::vector<uint8_t> bytes = test::WriteRefocusJpeg(f.sample, {main});
+  for (const std::vector<uint8_t>* part : {&x.image, &x.depth.data, &f.extras.confidence, &x.image})
+    bytes.insert(bytes.end(), part->begin(), part->end());
+  DynamicDepthFields dd;
+  const Status status = ReadDd(bytes, &dd);
+  ASSERT_TRUE(status.ok()) << status.message();
+  EXPECT_EQ(dd.item_count, 5u);
+  EXPECT_EQ(dd.depth, 2);
+  EXPECT_EQ(dd.confidence, 3);
+  EXPECT_EQ(dd.original, 4);
+  EXPECT_EQ(dd.format, "RangeLinear");
+  EXPECT_EQ(dd.units, "Meters");
+  EXPECT_EQ(dd.near_depth, 0.5);
+  EXPECT_EQ(dd.far_depth, 4.0);
+  EXPECT_EQ(Bytes(dd.items[dd.depth]), x.depth.data);
+  EXPECT_EQ(Bytes(dd.items[dd.original]), x.image);
+  if (test::HaveTool("python3")) {
+    test::ScratchDir dir;
+    const std::string path = WriteFile(dir, bytes);
+    const char* source = getenv("LB_SOURCE_DIR");
+    int code = 0;
+    const std::string out =
+        test::RunTool(std::string("python3 '") + (source != nullptr ? source : ".") +
+                          "/tests/firmware/refocusable/dd_slice.py' '" + path + "' 2>&1",
+                      &code);
+    // The independent parser slices the same items (it resolves URIs only, so stops there).
+    EXPECT_NE(out.find("2 image/png " + std::to_string(x.depth.data.size()) + " Depth "),
+              std::string::npos)
+        << out;
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Sizes, DynamicDepthTest, ::testing::Values(false, true),
                          [](const auto& info) { return info.param ? "Extended" : "OnePacket"; });
 
