@@ -16,8 +16,8 @@ constexpr std::string_view kKnownMimes[] = {"image/jpeg", "image/png",  "image/t
 
 int Shown(std::string_view v) { return static_cast<int>(std::min<size_t>(v.size(), 40)); }
 
-// A Length or Padding: decimal digits only, at most `limit`.
-bool ParseCount(std::string_view v, uint64_t limit, uint64_t* out) {
+// A Length or Padding: decimal digits only, at most 19 of them (no overflow).
+bool ParseCount(std::string_view v, uint64_t* out) {
   while (!v.empty() && IsXmpSpace(v.front())) v.remove_prefix(1);
   while (!v.empty() && IsXmpSpace(v.back())) v.remove_suffix(1);
   if (v.empty() || v.size() > 19) return false;
@@ -27,7 +27,7 @@ bool ParseCount(std::string_view v, uint64_t limit, uint64_t* out) {
     n = n * 10 + static_cast<uint64_t>(c - '0');
   }
   *out = n;
-  return n <= limit;
+  return true;
 }
 
 // One of the two directory namespaces, resolved in one packet.
@@ -76,19 +76,21 @@ Status ReadItems(const Directory& dir, const uint8_t* data, size_t size, const c
     std::string_view text;
     uint64_t length = 0, padding = 0;
     const bool has_length = FindXmpFieldByPrefix(li, dir.item_prefix, "Length", &text);
-    if ((index > 0 && !has_length) || (has_length && !ParseCount(text, UINT64_MAX, &length))) {
+    if ((index > 0 && !has_length) || (has_length && !ParseCount(text, &length))) {
       return Status(Code::kCorruptData, "%s: Container item %zu: no valid Item:Length", name,
                     index);
     }
     if (FindXmpFieldByPrefix(li, dir.item_prefix, "Padding", &text) &&
-        !ParseCount(text, UINT64_MAX, &padding)) {
+        !ParseCount(text, &padding)) {
       return Status(Code::kCorruptData, "%s: Container item %zu: Item:Padding '%.*s'", name, index,
                     Shown(text), text.data());
     }
     if (length > size || padding > size) {
       return Status(Code::kCorruptData,
-                    "%s: Container item %zu: Item:Length %llu past the end of the %zu-byte file",
-                    name, index, static_cast<unsigned long long>(length), size);
+                    "%s: Container item %zu: Item:Length %llu (Padding %llu) past the end of the "
+                    "%zu-byte file",
+                    name, index, static_cast<unsigned long long>(length),
+                    static_cast<unsigned long long>(padding), size);
     }
     item.length = static_cast<size_t>(length);
     item.padding = static_cast<size_t>(padding);
