@@ -40,8 +40,11 @@ static DepthConfig MakeDepthConfig(const PipelineConfig& c, int32_t w, int32_t h
   d.disp_min_q8 = c.disp_min_q8;
   d.disp_max_q8 = c.disp_max_q8;
   d.workers = c.workers;
-  if (c.geometry == ViewGeometry::kAuto) {
-    d.geometry = ViewGeometry::kKnownPoses;
+  d.smooth_weight = c.smooth_weight;
+  d.max_cycles = c.max_cycles;
+  d.subpixel = c.subpixel;
+  if (c.geometry == ViewGeometry::kAuto) d.geometry = ViewGeometry::kKnownPoses;
+  if (c.geometry == ViewGeometry::kAuto && c.plan_range) {
     // Placeholder range for sizing; every burst sets its own (auto_geometry.h).
     d.disp_min_q8 = 0;
     d.disp_max_q8 = 16 << 8;
@@ -79,10 +82,12 @@ static RenderConfig MakeRenderConfig(const PipelineConfig& c, int32_t s, int32_t
 
 Status Pipeline::RequiredBytes(const PipelineConfig& c, size_t* bytes) {
   *bytes = 0;
-  if (c.width < 16 || c.height < 16 || c.width > PipelineConfig::kMaxWidth ||
+  const int32_t min_side = c.render ? 16 : DepthConfig::kMinSize;
+  if (c.width < min_side || c.height < min_side || c.width > PipelineConfig::kMaxWidth ||
       c.height > PipelineConfig::kMaxHeight) {
-    return Status(Code::kInvalidArgument, "frame size %dx%d outside 16x16 .. %dx%d", c.width,
-                  c.height, PipelineConfig::kMaxWidth, PipelineConfig::kMaxHeight);
+    return Status(Code::kInvalidArgument, "frame size %dx%d outside %dx%d .. %dx%d", c.width,
+                  c.height, min_side, min_side, PipelineConfig::kMaxWidth,
+                  PipelineConfig::kMaxHeight);
   }
   if (c.frames < 2) {
     return Status(Code::kInvalidArgument, "a burst of %d frame%s: depth needs at least 2", c.frames,
@@ -109,7 +114,9 @@ Status Pipeline::RequiredBytes(const PipelineConfig& c, size_t* bytes) {
   if (HasDepth(l.work_w, l.work_h)) {
     LB_RETURN_IF_ERROR(DepthStage::Validate(MakeDepthConfig(c, l.work_w, l.work_h)));
   }
-  LB_RETURN_IF_ERROR(RenderStage::Validate(MakeRenderConfig(c, l.scale, l.work_w, l.work_h)));
+  if (c.render) {
+    LB_RETURN_IF_ERROR(RenderStage::Validate(MakeRenderConfig(c, l.scale, l.work_w, l.work_h)));
+  }
   if (UsesMotion(c, l.work_w, l.work_h)) {
     LB_RETURN_IF_ERROR(MotionStage::Validate(MakeMotionConfig(c, l.work_w, l.work_h)));
     if (!(c.focal_px >= 0)) {
@@ -153,7 +160,7 @@ Status Pipeline::Carve(Arena& arena) {
   // Each stage starts on a fresh alignment boundary: kAlign of slack per stage.
   const size_t analysis = (depth ? DepthStage::RequiredBytes(dc) + Arena::kAlign : 0) +
                           (motion ? MotionStage::RequiredBytes(mc) + Arena::kAlign : 0);
-  const size_t render = RenderStage::RequiredBytes(rc) + Arena::kAlign;
+  const size_t render = c.render ? RenderStage::RequiredBytes(rc) + Arena::kAlign : 0;
   const size_t shared = analysis > render ? analysis : render;
   uint8_t* region = arena.Allocate<uint8_t>(shared);
   if (arena.planning()) return Status::Ok();
@@ -164,6 +171,7 @@ Status Pipeline::Carve(Arena& arena) {
   Arena analysis_arena(region, shared);
   if (depth) LB_RETURN_IF_ERROR(depth_.Configure(dc, analysis_arena));
   if (motion) LB_RETURN_IF_ERROR(motion_.Configure(mc, analysis_arena));
+  if (!c.render) return Status::Ok();
   Arena render_arena(region, shared);
   return render_.Configure(rc, render_arena);
 }
@@ -384,10 +392,12 @@ Status Pipeline::EstimateGeometry(const ConstImageU8* views) {
   if (config_.focal_px > 0) k.fx = k.fy = config_.focal_px / scale_;
   LB_RETURN_IF_ERROR(motion_.Estimate(views, config_.reference, k, &motion_result_));
   LabelRange range;
-  return SetDepthGeometry(motion_result_, false, &depth_, planes_, &range);
+  return SetDepthGeometry(motion_result_, !config_.plan_range, &depth_, planes_, &range);
 }
 
 Status Pipeline::BeginRender(const RenderParams& params) {
+  if (!config_.render)
+    return Status(Code::kInvalidArgument, "a depth-only pipeline renders no photo");
   if (!depth_ready_) return Status(Code::kInvalidArgument, "render before depth was computed");
   LB_RETURN_IF_ERROR(render_.Begin(ref_.AsConst(), disp_q8_.AsConst(), params));
   render_started_ = true;

@@ -8,6 +8,7 @@
 //   Pipeline p;  s = p.Configure(config, block, bytes);  // block: 64-byte aligned
 //   sensor.CaptureBurst(p)  // p is a FrameSink: BeginFrame / Rows... / EndFrame per frame
 //   s = p.ComputeDepth();   // Ok with p.depth_warning() set when the burst gave no depth
+//   (config.render false: a depth-only run ends here, the map in p.disparity_q8())
 
 //   s = p.BeginRender(params);  while (p.NextStrip(&strip, &y0, &rows), rows > 0) encode(strip);
 #pragma once
@@ -52,6 +53,17 @@ struct PipelineConfig {
   int32_t max_blur_radius = 32;  // full-resolution px
   // Workers the stages carve scratch for (task_runner.h): the most SetRunner may hand in.
   int32_t workers = 1;
+  // The depth stage's tuning (depth_stage.h): its own defaults unless a caller chooses.
+  int32_t smooth_weight = DepthConfig{}.smooth_weight;
+  int32_t max_cycles = DepthConfig{}.max_cycles;
+  bool subpixel = DepthConfig{}.subpixel;
+  // kAuto: the label range planned from the tracked points; false: disp_min_q8..disp_max_q8
+  // as given, only the planes follow the motion.
+  bool plan_range = true;
+  // false: a depth-only run (`refocus depth`): nothing is carved for the render, ComputeDepth
+  // is the last step and disparity_q8() its result, and frames may be as small as the depth
+  // stage takes (DepthConfig::kMinSize a side).
+  bool render = true;
 };
 
 class Pipeline : public FrameSink {

@@ -10,16 +10,13 @@
 #include <utility>
 #include <vector>
 
-#include "algo/core/color.h"
-#include "algo/depth/depth_order.h"
-#include "algo/depth/depth_stage.h"
-#include "algo/motion/motion_stage.h"
-#include "algo/pipeline/auto_geometry.h"
+#include "algo/pipeline/pipeline.h"
 #include "firmware/cli/commands.h"
 #include "firmware/cli/options.h"
 #include "firmware/codecs/exif.h"
 #include "firmware/codecs/image_file.h"
 #include "firmware/depth_out/depth_out.h"
+#include "firmware/platform/arena_block.h"
 #include "firmware/storage/atomic_file.h"
 #include "firmware/storage/output_target.h"
 
@@ -75,59 +72,6 @@ int Help() {
   return 0;
 }
 
-// Reads an image file of any supported format as tightly packed RGB8.
-Status ReadRgb(const char* path, int32_t* width, int32_t* height, std::vector<uint8_t>* rgb) {
-  ImageFileInfo info;
-  std::vector<uint8_t> pixels;
-  LB_RETURN_IF_ERROR(ReadImageFile(path, &info, &pixels));
-  const int bpp = BytesPerPixel(info.format);
-  *width = info.width;
-  *height = info.height;
-  rgb->resize(static_cast<size_t>(info.width) * info.height * 3);
-  for (int32_t y = 0; y < info.height; ++y) {
-    RowToRgb8(info.format, YuvRange::kLimited,
-              pixels.data() + static_cast<size_t>(y) * info.width * bpp, nullptr, nullptr,
-              info.width, rgb->data() + static_cast<size_t>(y) * info.width * 3);
-  }
-  return Status::Ok();
-}
-
-// Auto geometry's state for one run: the motion stage and its memory, its estimate and the
-// label planes the depth stage sweeps.
-struct AutoGeometry {
-  std::vector<uint8_t> memory;
-  MotionStage motion;
-  MotionResult result;
-  std::vector<PlaneHomography> planes;
-};
-
-// Auto geometry: the views' motion, then (unless the range was given) the label range from the
-// tracked points, and the planes' homographies. Updates `c` to the range used.
-Status EstimatePlanes(const std::vector<ConstImageU8>& views, double focal_px, bool range_given,
-                      DepthStage* stage, DepthConfig* c, AutoGeometry* g) {
-  MotionConfig mc;
-  mc.width = c->width;
-  mc.height = c->height;
-  mc.views = c->views;
-  mc.estimate_focal = !(focal_px > 0);  // nobody told the lens: the frames may
-  LB_RETURN_IF_ERROR(MotionStage::Validate(mc));
-  g->memory.assign(MotionStage::RequiredBytes(mc) + Arena::kAlign, 0);
-  void* const base = Arena::AlignUp(g->memory.data());
-  Arena arena(base, g->memory.size() - Arena::kAlign);
-  LB_RETURN_IF_ERROR(g->motion.Configure(mc, arena));
-  CameraIntrinsics k = DefaultIntrinsics(c->width, c->height);
-  if (focal_px > 0) k.fx = k.fy = focal_px;
-  LB_RETURN_IF_ERROR(g->motion.Estimate(views.data(), c->reference, k, &g->result));
-  g->planes.assign(static_cast<size_t>(c->views) * c->labels, PlaneHomography{});
-  LabelRange range;
-  LB_RETURN_IF_ERROR(SetDepthGeometry(g->result, range_given, stage, g->planes.data(), &range));
-  if (!range_given) {
-    c->disp_min_q8 = range.disp_min_q8;
-    c->disp_max_q8 = range.disp_max_q8;
-  }
-  return Status::Ok();
-}
-
 }  // namespace
 
 int DepthCommand(int argc, char** argv) {
@@ -135,11 +79,13 @@ int DepthCommand(int argc, char** argv) {
   const char* pfm = nullptr;
   const char* preview = nullptr;
   int32_t ref = -1;
-  DepthConfig c;
-  c.subpixel = false;
-  bool range_given = false;
   JobOptions settings;  // --geometry, --focal-35mm and --labels, as run takes them
   settings.pipeline.geometry = ViewGeometry::kAuto;
+  // The depth stage at the views' full size, with its map as the result.
+  PipelineConfig& c = settings.pipeline;
+  c.subpixel = false;
+  c.render = false;
+  bool range_given = false;
   std::string error;
   std::vector<option> table = WithSettings(
       {
@@ -207,17 +153,16 @@ int DepthCommand(int argc, char** argv) {
   for (int i = options.rest(); i < argc; ++i) {
     if (!view(argv[i])) return Usage(error);
   }
-  const ViewGeometry geometry = settings.pipeline.geometry;
-  const int32_t focal_35mm = settings.focal_35mm;
-  c.labels = settings.pipeline.labels;
+  const ViewGeometry geometry = c.geometry;
+  c.plan_range = !range_given;
   if (files.size() < 2) return Usage("--views needs at least two files");
   if (files.size() > static_cast<size_t>(DepthConfig::kMaxViews)) {
     return Usage("--views takes at most 16 files");
   }
   if (!pfm) return Usage("--disparity-out is required");
-  c.views = static_cast<int32_t>(files.size());
-  c.reference = ref < 0 ? c.views / 2 : ref;
-  if (c.reference >= c.views) return Usage("--ref is past the last view");
+  c.frames = static_cast<int32_t>(files.size());
+  c.reference = ref < 0 ? c.frames / 2 : ref;
+  if (c.reference >= c.frames) return Usage("--ref is past the last view");
   if (!range_given) c.disp_max_q8 = (c.labels - 1) * 64;  // quarter-pixel labels from 0
 
   // Both outputs are checked before any work: devices, links, a missing folder, an input.
@@ -266,72 +211,54 @@ int DepthCommand(int argc, char** argv) {
              DepthConfig::kMinSize, DepthConfig::kMinSize);
     return Fail(msg);
   }
-  if (geometry == ViewGeometry::kAuto) c.geometry = ViewGeometry::kKnownPoses;
-  const Status valid = DepthStage::Validate(c);
-  if (!valid.ok()) {
-    snprintf(msg, sizeof(msg), "%s: %s", files[0], valid.message());
+  c.max_working_width = c.width;
+  c.max_working_height = c.height;
+  if (geometry == ViewGeometry::kAuto) {
+    c.focal_px = settings.focal_35mm > 0 ? FocalPxFrom35mm(settings.focal_35mm, c.width, c.height)
+                                         : ExifFocalPx(files[0], c.width, c.height);
+  }
+  size_t bytes = 0;
+  Status s = Pipeline::RequiredBytes(c, &bytes);
+  if (!s.ok()) {
+    snprintf(msg, sizeof(msg), "%s: %s", files[0], s.message());
     return Fail(msg);
   }
-  std::vector<std::vector<uint8_t>> pixels(files.size());
+  ArenaBlock arena;
+  Pipeline pipeline;
+  s = arena.Reserve(bytes, "for the depth");
+  if (s.ok()) s = pipeline.Configure(c, arena.data(), arena.size());
+  if (!s.ok()) return Fail(s.message());
+  // Each view straight from its file into the pipeline, a strip of rows at a time.
   for (size_t v = 0; v < files.size(); ++v) {
-    int32_t w = 0, h = 0;
-    const Status read = ReadRgb(files[v], &w, &h, &pixels[v]);
-    if (!read.ok()) return Fail(read.message());
-    if (w != c.width || h != c.height) {
-      char msg[512];
-      snprintf(msg, sizeof(msg), "%s: the header said %dx%d, the pixels are %dx%d", files[v],
-               c.width, c.height, w, h);
-      return Fail(msg);
-    }
-  }
-
-  const size_t bytes = DepthStage::RequiredBytes(c);
-  std::vector<uint8_t> memory(bytes + Arena::kAlign);
-  void* const base = Arena::AlignUp(memory.data());
-  Arena arena(base, bytes);
-  DepthStage stage;
-  Status s = stage.Configure(c, arena);
-  if (!s.ok()) return Fail(s.message());
-  std::vector<ConstImageU8> views;
-  for (const auto& p : pixels) views.push_back(MakeView(p.data(), c.width, c.height, 3));
-  AutoGeometry geometry_state;
-  if (geometry == ViewGeometry::kAuto) {
-    const double focal = focal_35mm > 0 ? FocalPxFrom35mm(focal_35mm, c.width, c.height)
-                                        : ExifFocalPx(files[0], c.width, c.height);
-    s = EstimatePlanes(views, focal, range_given, &stage, &c, &geometry_state);
+    s = StreamImageFile(files[v], static_cast<int32_t>(v), pipeline);
     if (!s.ok()) return Fail(s.message());
   }
-  std::vector<uint16_t> disp(static_cast<size_t>(c.width) * c.height);
-  const ImageU16 out = MakeView(disp.data(), c.width, c.height);
-  s = stage.Compute(views.data(), out);
+  s = pipeline.ComputeDepth();
+  // A burst the motion cannot give depth for is a warning to run (the photo stays sharp), and
+  // here the end: there is no map to write.
+  if (s.ok()) s = pipeline.depth_warning();
   if (!s.ok()) return Fail(s.message());
-  if (geometry == ViewGeometry::kAuto) {
-    std::vector<uint8_t> scratch(DepthOrderScratchBytes(c.width, c.height));
-    s = OrderDepth(views.data(), geometry_state.planes.data(), scratch.data(), &stage,
-                   &geometry_state.motion, &geometry_state.result, out, nullptr);
-    if (!s.ok()) return Fail(s.message());
-    c.disp_min_q8 = stage.config().disp_min_q8;
-    c.disp_max_q8 = stage.config().disp_max_q8;
-  }
+  const ConstImageU16 out = pipeline.disparity_q8();
+  const DepthConfig& d = pipeline.depth().config();
   // Both outputs are written in full before either is renamed into place: a failed preview
   // leaves no PFM behind.
-  const int32_t bias = DepthStage::MapBiasQ8(c);
+  const int32_t bias = DepthStage::MapBiasQ8(d);
   AtomicFile pfm_file, preview_file;
   s = pfm_file.Open(pfm);
   if (s.ok()) s = EncodeDisparityPfm(&pfm_file, out, bias);
   if (s.ok() && preview) s = preview_file.Open(preview);
   if (s.ok() && preview) {
-    s = EncodeDisparityPreview(&preview_file, out, c.disp_min_q8 + bias, c.disp_max_q8 + bias);
+    s = EncodeDisparityPreview(&preview_file, out, pipeline.disp_min_q8(), pipeline.disp_max_q8());
   }
   if (s.ok() && preview) s = preview_file.Commit();
   if (s.ok()) s = pfm_file.Commit();
   if (!s.ok()) return Fail(s.message());
-  const DepthStats& st = stage.stats();
+  const DepthStats& st = pipeline.depth().stats();
   printf(
       "%s: %dx%d, %d views (reference %d), %d labels %.2f..%.2f px/step, %d cycles, %zu arena "
       "bytes\n",
-      pfm, c.width, c.height, c.views, c.reference, c.labels, c.disp_min_q8 / 256.0,
-      c.disp_max_q8 / 256.0, st.cycles, st.arena_bytes);
+      pfm, d.width, d.height, d.views, d.reference, d.labels, d.disp_min_q8 / 256.0,
+      d.disp_max_q8 / 256.0, st.cycles, st.arena_bytes);
   return 0;
 }
 
