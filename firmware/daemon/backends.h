@@ -6,7 +6,7 @@
 
 #include "algo/core/status.h"
 #include "firmware/daemon/config.h"
-#include "firmware/daemon/log.h"
+#include "firmware/platform/log.h"
 #include "hal/button.h"
 #include "hal/sensor.h"
 

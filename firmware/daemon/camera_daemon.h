@@ -33,8 +33,8 @@
 #include "firmware/app/job.h"
 #include "firmware/daemon/clock.h"
 #include "firmware/daemon/config.h"
-#include "firmware/daemon/log.h"
 #include "firmware/daemon/photo_namer.h"
+#include "firmware/platform/log.h"
 #include "hal/button.h"
 #include "hal/sensor.h"
 

@@ -8,7 +8,7 @@
 
 #include "algo/core/status.h"
 #include "firmware/app/job.h"
-#include "firmware/daemon/log.h"
+#include "firmware/platform/log.h"
 
 namespace lb {
 

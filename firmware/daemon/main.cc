@@ -15,9 +15,9 @@
 #include "firmware/daemon/camera_daemon.h"
 #include "firmware/daemon/clock.h"
 #include "firmware/daemon/config.h"
-#include "firmware/daemon/log.h"
 #include "firmware/daemon/startup_checks.h"
 #include "firmware/platform/cpu_features.h"
+#include "firmware/platform/log.h"
 #include "firmware/web/web_server.h"
 
 namespace {

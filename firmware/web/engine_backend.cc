@@ -14,7 +14,7 @@
 #include "firmware/app/focus.h"
 #include "firmware/codecs/exif.h"
 #include "firmware/codecs/image_file.h"
-#include "firmware/daemon/log.h"
+#include "firmware/platform/log.h"
 
 namespace lb {
 

@@ -47,7 +47,7 @@
 
 #include "algo/core/status.h"
 #include "firmware/daemon/config.h"
-#include "firmware/daemon/log.h"
+#include "firmware/platform/log.h"
 #include "firmware/web/refocus_backend.h"
 
 struct MHD_Daemon;

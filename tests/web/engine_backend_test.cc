@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "firmware/app/job.h"
-#include "firmware/daemon/log.h"
+#include "firmware/platform/log.h"
 #include "sim/synthetic/synthetic_sensor.h"
 #include "tests/firmware/codecs/jpeg_test_util.h"
 

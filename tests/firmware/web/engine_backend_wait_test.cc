@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "firmware/app/job.h"
-#include "firmware/daemon/log.h"
+#include "firmware/platform/log.h"
 #include "firmware/web/engine_backend.h"
 #include "sim/synthetic/synthetic_sensor.h"
 #include "tests/firmware/codecs/jpeg_test_util.h"

@@ -1,5 +1,5 @@
 // Log lines as a person (terminal) or journald (priority prefix) reads them.
-#include "firmware/daemon/log.h"
+#include "firmware/platform/log.h"
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>

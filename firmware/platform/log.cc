@@ -1,4 +1,4 @@
-#include "firmware/daemon/log.h"
+#include "firmware/platform/log.h"
 
 #include <sys/stat.h>
 #include <time.h>

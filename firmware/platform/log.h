@@ -1,8 +1,8 @@
-// The daemon's log: one line per event, with a level, written to stderr so journald keeps it.
-// Under systemd (stderr is the journal stream named by JOURNAL_STREAM) each line carries the
-// "<N>" priority prefix journald understands; on a terminal it carries the local time and the
-// level in words instead. Safe to call from several threads; formats into a fixed buffer, so
-// logging never allocates.
+// The programs' log (refocusd and the web page it serves): one line per event, with a level,
+// written to stderr so journald keeps it. Under systemd (stderr is the journal stream named by
+// JOURNAL_STREAM) each line carries the "<N>" priority prefix journald understands; on a
+// terminal it carries the local time and the level in words instead. Safe to call from several
+// threads; formats into a fixed buffer, so logging never allocates.
 #pragma once
 
 #include <cstdint>
