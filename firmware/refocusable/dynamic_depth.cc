@@ -14,7 +14,16 @@ constexpr int32_t kMaxSide = 8192;  // the GDepth reader's limit on a depth map'
 constexpr std::string_view kKnownMimes[] = {"image/jpeg", "image/png",  "image/tiff", "image/gif",
                                             "image/heic", "text/plain", "video/mp4"};
 
-int Shown(std::string_view v) { return static_cast<int>(std::min<size_t>(v.size(), 40)); }
+// A value from the file as a message shows it: at most 40 characters, each unprintable one as
+// '?', so that the message stays one line.
+struct Shown {
+  explicit Shown(std::string_view v) {
+    size_t n = 0;
+    for (; n < v.size() && n < 40; ++n) text[n] = v[n] >= 0x20 && v[n] < 0x7F ? v[n] : '?';
+    text[n] = '\0';
+  }
+  char text[41];
+};
 
 // A Length or Padding: decimal digits only, at most 19 of them (no overflow).
 bool ParseCount(std::string_view v, uint64_t* out) {
@@ -68,8 +77,8 @@ Status ReadItems(const Directory& dir, const uint8_t* data, size_t size, const c
     }
     if (std::find(std::begin(kKnownMimes), std::end(kKnownMimes), item.mime) ==
         std::end(kKnownMimes)) {
-      return Status(Code::kUnsupported, "%s: Container item %zu: unknown Item:Mime '%.*s'", name,
-                    index, Shown(item.mime), item.mime.data());
+      return Status(Code::kUnsupported, "%s: Container item %zu: unknown Item:Mime '%s'", name,
+                    index, Shown(item.mime).text);
     }
     FindXmpFieldByPrefix(li, dir.item_prefix, "Semantic", &item.semantic);
     FindXmpFieldByPrefix(li, dir.item_prefix, "DataURI", &item.uri);
@@ -82,8 +91,8 @@ Status ReadItems(const Directory& dir, const uint8_t* data, size_t size, const c
     }
     if (FindXmpFieldByPrefix(li, dir.item_prefix, "Padding", &text) &&
         !ParseCount(text, &padding)) {
-      return Status(Code::kCorruptData, "%s: Container item %zu: Item:Padding '%.*s'", name, index,
-                    Shown(text), text.data());
+      return Status(Code::kCorruptData, "%s: Container item %zu: Item:Padding '%s'", name, index,
+                    Shown(text).text);
     }
     if (length > size || padding > size) {
       return Status(Code::kCorruptData,
@@ -167,8 +176,8 @@ Status ReadDepthMap(const char* name, std::string_view main, std::string_view ex
   std::string_view text, uri;
   if (!FindXmpFieldByPrefix(dm, prefix, "Format", &out->format) ||
       (out->format != "RangeInverse" && out->format != "RangeLinear")) {
-    return Status(Code::kUnsupported, "%s: DepthMap:Format '%.*s' (RangeInverse or RangeLinear)",
-                  name, Shown(out->format), out->format.data());
+    return Status(Code::kUnsupported, "%s: DepthMap:Format '%s' (RangeInverse or RangeLinear)",
+                  name, Shown(out->format).text);
   }
   const char* names[2] = {"Near", "Far"};
   double* values[2] = {&out->near_depth, &out->far_depth};
@@ -186,21 +195,21 @@ Status ReadDepthMap(const char* name, std::string_view main, std::string_view ex
   FindXmpFieldByPrefix(dm, prefix, "Units", &out->units);
   if (!out->units.empty() && out->units != "Meters" && out->units != "Diopters" &&
       out->units != "None") {
-    return Status(Code::kUnsupported, "%s: DepthMap:Units '%.*s' (Meters, Diopters or None)", name,
-                  Shown(out->units), out->units.data());
+    return Status(Code::kUnsupported, "%s: DepthMap:Units '%s' (Meters, Diopters or None)", name,
+                  Shown(out->units).text);
   }
   FindXmpFieldByPrefix(dm, prefix, "MeasureType", &out->measure_type);
   FindXmpFieldByPrefix(dm, prefix, "DepthURI", &uri);
   out->depth = ItemFor(*out, uri, "Depth");
   if (out->depth < 0) {
-    return Status(Code::kNotFound, "%s: DepthMap:DepthURI '%.*s' names no Container item", name,
-                  Shown(uri), uri.data());
+    return Status(Code::kNotFound, "%s: DepthMap:DepthURI '%s' names no Container item", name,
+                  Shown(uri).text);
   }
   if (FindXmpFieldByPrefix(dm, prefix, "ConfidenceURI", &uri) && !uri.empty()) {
     out->confidence = ItemFor(*out, uri, "Confidence");
     if (out->confidence < 0) {
-      return Status(Code::kNotFound, "%s: DepthMap:ConfidenceURI '%.*s' names no Container item",
-                    name, Shown(uri), uri.data());
+      return Status(Code::kNotFound, "%s: DepthMap:ConfidenceURI '%s' names no Container item",
+                    name, Shown(uri).text);
     }
   }
   return Status::Ok();
@@ -264,8 +273,8 @@ Status ReadDynamicDepthFields(const uint8_t* data, size_t size, const char* name
   if (out->original >= 0) {
     const DynamicDepthItem& original = out->items[out->original];
     if (original.mime != "image/jpeg") {
-      return Status(Code::kUnsupported, "%s: Dynamic Depth original item: '%.*s', not a JPEG", name,
-                    Shown(original.mime), original.mime.data());
+      return Status(Code::kUnsupported, "%s: Dynamic Depth original item: '%s', not a JPEG", name,
+                    Shown(original.mime).text);
     }
     LB_RETURN_IF_ERROR(CheckImageItem(original, name, "original", out->depth_max_side, &header));
   }

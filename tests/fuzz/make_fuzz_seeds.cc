@@ -1,8 +1,9 @@
 // Writes small seeds for the reader fuzzers, one folder per fuzzer: OUT/pnm, OUT/png, OUT/jpeg
 // (some with EXIF: focal length, 35 mm focal length, orientation), OUT/xmp (refocusable JPEGs
-// and XMP packets, with fuzz_xmp's mode byte first) and OUT/conf (the packaged refocusd.conf and
-// variants). Generated at run time with the reference encoders and the firmware's own EXIF and
-// XMP writers, so no third-party file is committed (tests/fuzz/corpus/ holds what fuzzing found).
+// and XMP packets, with fuzz_xmp's mode byte first), OUT/dd (the same with Dynamic Depth, for
+// fuzz_dd) and OUT/conf (the packaged refocusd.conf and variants). Generated at run time with
+// the reference encoders and the firmware's own EXIF and XMP writers, so no third-party file is
+// committed (tests/fuzz/corpus/ holds what fuzzing found).
 #include <png.h>
 #include <sys/stat.h>
 
@@ -15,6 +16,7 @@
 
 #include "algo/core/image.h"
 #include "firmware/codecs/jpeg_writer.h"
+#include "firmware/refocusable/dynamic_depth.h"
 #include "firmware/refocusable/refocusable_reader.h"
 #include "firmware/refocusable/xmp_writer.h"
 #include "tests/firmware/codecs/test_images.h"
@@ -193,7 +195,39 @@ std::string PacketText(const lb::JpegSegment& seg) {
                                    : std::string(seg.payload.begin() + skip, seg.payload.end());
 }
 
-void XmpSeeds(const std::string& dir) {
+// fuzz_dd's: Dynamic Depth beside GDepth, the whole file (mode 0), and the main packet, NUL, the
+// items that follow the primary (mode 1); with a confidence map in the 8-bit one.
+void DdSeeds(const std::string& dir, const std::string& suffix, const Bytes& picture,
+             const lb::JpegSegment& exif, lb::RefocusableXmp* xmp) {
+  lb::DynamicDepthExtras extras;
+  if (suffix == "8") extras.confidence = xmp->depth.data;  // an 8-bit grey PNG the depth's size
+  std::vector<lb::JpegSegment> segments;
+  Bytes items;
+  const auto append = [&items](const uint8_t* data, size_t size) {
+    items.insert(items.end(), data, data + size);
+    return lb::Status::Ok();
+  };
+  if (!lb::SetDynamicDepth(extras, xmp).ok() || !lb::BuildXmpSegments(*xmp, &segments).ok() ||
+      !lb::WriteDynamicDepthItems(*xmp, extras, append).ok()) {
+    ++failures;
+    return;
+  }
+  segments.insert(segments.begin(), exif);
+  Bytes file = {0};
+  const Bytes jpeg = WithSegments(picture, segments);
+  file.insert(file.end(), jpeg.begin(), jpeg.end());
+  file.insert(file.end(), items.begin(), items.end());
+  Save(dir, "file_dd" + suffix + ".bin", file);
+  Bytes device =
+      Mode(1, std::string("<x:xmpmeta xmlns:x=\"adobe:ns:meta/\"><rdf:RDF xmlns:rdf=\"") +
+                  "http://www.w3.org/1999/02/22-rdf-syntax-ns#\">" + xmp->extra_description +
+                  "</rdf:RDF></x:xmpmeta>");
+  device.push_back(0);
+  device.insert(device.end(), items.begin(), items.end());
+  Save(dir, "device_dd" + suffix + ".bin", device);
+}
+
+void XmpSeeds(const std::string& dir, const std::string& dd_dir) {
   const Bytes picture = Jpeg(24, 16, 3, false);
   for (int bits : {8, 16}) {
     const int32_t w = 12, h = 8;
@@ -235,6 +269,7 @@ void XmpSeeds(const std::string& dir) {
     // The same fields as extended XMP behind an empty main packet.
     Save(dir, "extended_depth" + suffix + ".bin",
          Mode(2, std::string("<x:xmpmeta xmlns:x=\"adobe:ns:meta/\"/>") + '\0' + main));
+    DdSeeds(dd_dir, suffix, picture, all[0], &xmp);
   }
 }
 
@@ -293,7 +328,7 @@ int main(int argc, char** argv) {
   Pnm(out + "/pnm");
   PngSeeds(out + "/png");
   JpegSeeds(out + "/jpeg");
-  XmpSeeds(out + "/xmp");
+  XmpSeeds(out + "/xmp", out + "/dd");
   ConfSeeds(out + "/conf");
   return failures == 0 ? 0 : 1;
 }
