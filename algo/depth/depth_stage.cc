@@ -1,9 +1,11 @@
 // Depth by graph cuts: alpha-expansion moves lower E(f) = sum D_p(f_p) + sum w_pq
-// min(|f_p - f_q|, K), each move an exact minimum cut (expansion_move.cc). Coarse to fine (the
-// default): the best of every coarse_step-th label per 2x2 block, full moves over those labels
-// on the blocks (coarse_grid.cc), then cycles of moves over every label restricted to pixels
+// min(|f_p - f_q|, K), each move an exact minimum cut. Coarse to fine (the default): the best
+// of every coarse_step-th label per 2x2 block, full moves over those labels on the blocks
+// (coarse_pass.h), then cycles of moves over every label restricted to pixels
 // near labels within fine_window of alpha, until a cycle changes nothing or the cycle cap.
 // With coarse_step 1: the winner-take-all labels, then cycles of full moves over every label.
+// The stage composes the pieces: a move's rectangles and record (MoveBook), its graph and cut
+// (ExpansionMove), and the blocks of the coarse pass (CoarsePass), over the grids of move_grid.h.
 #include "algo/depth/depth_stage.h"
 
 #include "algo/core/clones.h"
@@ -77,62 +79,27 @@ size_t DepthStage::RequiredBytes(const DepthConfig& config) {
   return plan.used();
 }
 
-void DepthStage::CarveGrid(Arena& arena, Grid& g, int32_t width, int32_t height, bool prev_alpha) {
-  const size_t n = static_cast<size_t>(width) * height, rows = static_cast<size_t>(height);
-  g.width = width;
-  g.height = height;
-  g.labels = arena.Allocate<uint8_t>(n);
-  g.cost = arena.Allocate<uint16_t>(n);
-  g.cost_alpha = arena.Allocate<uint16_t>(n);
-  g.prev_alpha = prev_alpha ? arena.Allocate<uint16_t>(n) : nullptr;
-  g.weight_right = arena.Allocate<uint16_t>(n);
-  g.weight_down = arena.Allocate<uint16_t>(n);
-  g.state = arena.Allocate<uint8_t>(n);
-  g.row_labels = arena.Allocate<uint64_t>(4 * rows);
-  g.label_count = arena.Allocate<int32_t>(rows * static_cast<size_t>(config_.labels));
-  g.span = arena.Allocate<int32_t>(2 * rows);
-  g.prev_span = arena.Allocate<int32_t>(2 * rows);
-  g.near_span = arena.Allocate<int32_t>(2 * rows);
-  // A restricted move's runs of rows are at most one per 2 rows; the splits of each run into
-  // smaller rectangles stop when the list is full (a larger rectangle is as exact).
-  g.rect_capacity = 4 * height + 64;
-  g.rects = arena.Allocate<Rect>(static_cast<size_t>(g.rect_capacity));
-  g.rect_count = 0;
-  g.written_capacity = prev_alpha ? g.rect_capacity + height : 0;
-  g.written = arena.Allocate<Rect>(static_cast<size_t>(g.written_capacity));
-  g.prev_written = arena.Allocate<Rect>(static_cast<size_t>(g.written_capacity));
-  g.written_count = g.prev_written_count = 0;
-  g.row_took = arena.Allocate<uint8_t>(rows);
-}
-
 Status DepthStage::Carve(Arena& arena) {
   const size_t start = arena.used();
   const int32_t w = config_.width, h = config_.height;
   const size_t n = static_cast<size_t>(w) * h;
   data_.Carve(arena, w, h, config_.views, config_.workers);
-  // The coarse pass's costs, rings and winners ride in the solver's spare (CoarseLayout): room
-  // for them whatever the labels and workers, or the pass computes the costs again per move.
+  // The coarse pass's costs, rings and winners ride in the solver's spare: room for them
+  // whatever the labels and workers, or the pass computes the costs again per move.
   const bool coarse = config_.coarse_step > 1 && config_.max_cycles > 0 && config_.coarse_blocks;
-  const size_t room = coarse ? CoarseLayout(CoarseStripes(config_.workers)).end : 0;
-  maxflow_.Carve(arena, w, h, room, (w + 1) / 2, (h + 1) / 2);
-  CarveGrid(arena, fine_, w, h, true);
-  move_rows_ = arena.Allocate<int32_t>(11 * static_cast<size_t>(w));
-  keep_row_ = arena.Allocate<uint8_t>(static_cast<size_t>(w));
-  free_span_ = arena.Allocate<int32_t>(2 * static_cast<size_t>(h));
-  want_span_ = arena.Allocate<int32_t>(2 * static_cast<size_t>(h));
-  split_ = arena.Allocate<uint8_t>(static_cast<size_t>(w > h ? w : h) + 2);
-  runs_ = arena.Allocate<RowRuns>(static_cast<size_t>(h));
-  run_marks_ = arena.Allocate<uint8_t>(2 * (static_cast<size_t>(w) + 2));
-  // The coarse grid is done with before the fine moves record anything in below_ and above_,
-  // so it lives in their memory (enlarged for the smallest images, where alignment dominates).
+  const size_t room = coarse ? CoarsePass::SpareBytes(config_, data_.CarriedRingSize()) : 0;
+  move_.Carve(arena, config_, room);
+  CarveGrid(arena, fine_, w, h, config_.labels, true);
+  book_.Carve(arena, config_);
+  // The coarse grid is done with before the fine moves record anything in the fit's costs, so
+  // it lives in their memory (enlarged for the smallest images, where alignment dominates).
   Arena plan;
-  CarveGrid(plan, coarse_, (w + 1) / 2, (h + 1) / 2, false);
+  coarse_.CarveGrid(plan, config_);
   const size_t refine_bytes = 4 * n > plan.used() ? 4 * n : plan.used();
   uint8_t* refine = arena.Allocate<uint8_t>(refine_bytes);
-  below_ = reinterpret_cast<uint16_t*>(refine);
-  above_ = below_ + n;
+  book_.SetFitMemory(reinterpret_cast<uint16_t*>(refine));
   Arena blocks(refine, refine == nullptr ? 0 : refine_bytes);
-  CarveGrid(blocks, coarse_, (w + 1) / 2, (h + 1) / 2, false);
+  coarse_.CarveGrid(blocks, config_);
   planes_ = nullptr;
   if (config_.geometry == ViewGeometry::kKnownPoses) {
     planes_ = arena.Allocate<PlaneHomography>(static_cast<size_t>(config_.labels) * config_.views);
@@ -153,9 +120,6 @@ Status DepthStage::Configure(const DepthConfig& config, Arena& arena) {
   data_.SetParams(params, config.reference);
   data_.SetPlanes(nullptr);
   planes_set_ = false;
-  for (int32_t d = 0; d < DepthConfig::kMaxLabels; ++d) {
-    smooth_[d] = d < config.smooth_trunc ? d : config.smooth_trunc;
-  }
   return Carve(arena);
 }
 
@@ -182,20 +146,11 @@ Status DepthStage::SetDisparityRange(int32_t disp_min_q8, int32_t disp_max_q8) {
   return Status::Ok();
 }
 
-void DepthStage::LabelCosts(int32_t label, uint16_t* out) {
-  UseLabelPlanes(label);
-  data_.ComputeRows(LabelDispQ8(label), 0, config_.height, out, config_.width);
-}
+int32_t LabelTerm::DispQ8(int32_t label) const { return DepthStage::LabelDispQ8(config, label); }
 
-void DepthStage::RowLabels(Grid& g, int32_t y) {
-  const int32_t w = g.width, labels = config_.labels;
-  uint64_t* m = g.row_labels + 4 * y;
-  int32_t* count = g.label_count + y * labels;
-  for (int32_t l = 0; l < labels; ++l) count[l] = 0;
-  const uint8_t* f = g.labels + y * w;
-  for (int32_t x = 0; x < w; ++x) ++count[f[x]];
-  m[0] = m[1] = m[2] = m[3] = 0;
-  for (int32_t l = 0; l < labels; ++l) m[l >> 6] |= uint64_t{count[l] > 0} << (l & 63);
+void DepthStage::LabelCosts(int32_t label, uint16_t* out) {
+  Term().Use(label);
+  data_.ComputeRows(LabelDispQ8(label), 0, config_.height, out, config_.width);
 }
 
 // The pair weight of two RGB pixels: edge across a colour step (largest channel) above the
@@ -234,41 +189,6 @@ void DepthStage::EdgeWeights(const ConstImageU8& ref) {
   }
 }
 
-// Energy of a grid's labels from its stored D_p(f_p) and edge weights. A row's costs, pairs
-// right and pairs down in loops of their own, so that each vectorizes.
-LB_CLONES_AVX2 static int64_t LabelEnergy(const uint8_t* __restrict labels,
-                                          const uint16_t* __restrict cost,
-                                          const uint16_t* __restrict right,
-                                          const uint16_t* __restrict down, int32_t w, int32_t h,
-                                          int32_t trunc) {
-  int64_t e = 0;
-  for (int32_t y = 0; y < h; ++y) {
-    const uint8_t* f = labels + y * w;
-    const uint8_t* fd = f + w;
-    const ptrdiff_t row = static_cast<ptrdiff_t>(y) * w;
-    // Each term is below 2^20 (8192 * 64, 9180): int64 sums never overflow.
-    int64_t sum = 0;
-    for (int32_t x = 0; x < w; ++x) sum += cost[row + x];
-    for (int32_t x = 0; x + 1 < w; ++x) {
-      const int32_t d = f[x] > f[x + 1] ? f[x] - f[x + 1] : f[x + 1] - f[x];
-      sum += int64_t{right[row + x]} * (d < trunc ? d : trunc);
-    }
-    if (y + 1 < h) {
-      for (int32_t x = 0; x < w; ++x) {
-        const int32_t d = f[x] > fd[x] ? f[x] - fd[x] : fd[x] - f[x];
-        sum += int64_t{down[row + x]} * (d < trunc ? d : trunc);
-      }
-    }
-    e += sum;
-  }
-  return e;
-}
-
-int64_t DepthStage::GridEnergy(const Grid& g) const {
-  return LabelEnergy(g.labels, g.cost, g.weight_right, g.weight_down, g.width, g.height,
-                     config_.smooth_trunc);
-}
-
 void DepthStage::WinnerTakeAll() {
   const int32_t n = config_.width * config_.height;
   uint8_t* labels = fine_.labels;
@@ -288,7 +208,7 @@ void DepthStage::WinnerTakeAll() {
 int64_t DepthStageProbe::Energy(DepthStage& s, const uint8_t* labels) {
   const int32_t w = s.config_.width, h = s.config_.height;
   uint16_t* scratch = s.fine_.cost_alpha;
-  s.prev_label_ = -1;  // cost_alpha is used as scratch below
+  s.book_.ForgetPrevious();  // cost_alpha is used as scratch below
   int64_t data = 0;
   for (int32_t label = 0; label < s.config_.labels; ++label) {
     s.LabelCosts(label, scratch);
@@ -296,13 +216,56 @@ int64_t DepthStageProbe::Energy(DepthStage& s, const uint8_t* labels) {
       if (labels[p] == label) data += scratch[p];
     }
   }
-  // The smoothness part with zero data costs: reuse LabelEnergy over a zero cost image.
+  // The smoothness part: the energy of the labels over a zero cost image.
   for (int32_t p = 0; p < w * h; ++p) scratch[p] = 0;
-  const int64_t e = data + LabelEnergy(labels, scratch, s.fine_.weight_right, s.fine_.weight_down,
-                                       w, h, s.config_.smooth_trunc);
-  for (int32_t p = 0; p < w * h; ++p) scratch[p] = DepthStage::kNotComputed;  // as the moves expect
+  MoveGrid g = s.fine_;
+  g.labels = const_cast<uint8_t*>(labels);
+  g.cost = scratch;
+  const int64_t e = data + GridEnergy(g, s.config_.smooth_trunc);
+  for (int32_t p = 0; p < w * h; ++p) scratch[p] = MoveGrid::kNotComputed;  // as the moves expect
   s.fine_.written_count = 0;
   return e;
+}
+
+// One move: where it looks, the D of alpha there, the cut of each rectangle, and the record.
+bool DepthStage::Expand(int32_t alpha) {
+  MoveGrid& g = on_coarse_ ? coarse_.grid() : fine_;
+  const LabelTerm term = Term();
+  const int32_t count = book_.MoveRects(g, alpha, window_, !on_coarse_);
+  term.Use(alpha);
+  const int32_t disp_q8 = LabelDispQ8(alpha);
+  const bool near = !on_coarse_ && window_ < config_.labels - 1;
+  if (near && count > 0) book_.ComputeNear(fine_, term, disp_q8);
+  for (int32_t i = 0; i < count; ++i) {
+    const MoveRect& r = g.rects[i];
+    if (on_coarse_) {
+      coarse_.MoveCosts(alpha, r, fine_, term);
+    } else if (!near) {
+      data_.ComputeRect(disp_q8, r.x0, r.x1, r.y0, r.y1, g.cost_alpha + r.y0 * g.width, g.width);
+      MoveBook::Written(fine_, r);
+    }
+    stats_.cut_pixels += move_.Cut(g, alpha, r, window_);
+  }
+  const int64_t delta = book_.Record(g, alpha, !on_coarse_, term);
+  energy_ += delta;
+  return delta < 0;
+}
+
+void DepthStage::CoarseMoves() {
+  const LabelTerm term = Term();
+  coarse_.Start(fine_, term, move_.solver());
+  energy_ = GridEnergy(coarse_.grid(), config_.smooth_trunc);
+  stats_.initial_energy = energy_;
+  on_coarse_ = true;
+  window_ = DepthConfig::kMaxLabels;
+  for (int32_t alpha = 0; alpha < config_.labels; alpha += config_.coarse_step) {
+    if (Expand(alpha)) ++stats_.moves;
+  }
+  stats_.coarse_energy = energy_;
+  on_coarse_ = false;
+  coarse_.Finish(fine_, term, book_.runs(), book_.run_marks());
+  energy_ = GridEnergy(fine_, config_.smooth_trunc);
+  stats_.handover_energy = energy_;
 }
 
 // Sub-label disparity: a parabola through D at f_p - 1, f_p, f_p + 1 (as recorded by the
@@ -315,6 +278,8 @@ void DepthStage::Refine(ImageU16 disp_q8) {
   // pixel.
   int32_t disp[DepthConfig::kMaxLabels], half_span[DepthConfig::kMaxLabels];
   for (int32_t l = 0; l < config_.labels; ++l) disp[l] = LabelDispQ8(l);
+  const uint16_t* below = book_.FitBelow();
+  const uint16_t* above = book_.FitAbove();
   for (int32_t l = 1; l + 1 < config_.labels; ++l) half_span[l] = (disp[l + 1] - disp[l - 1]) / 2;
   for (int32_t y = 0; y < h; ++y) {
     uint16_t* out = disp_q8.Row(y);
@@ -323,7 +288,7 @@ void DepthStage::Refine(ImageU16 disp_q8) {
       const int32_t f = fine_.labels[p];
       int32_t d_q8 = disp[f];
       if (config_.subpixel && f > 0 && f + 1 < config_.labels) {
-        const int32_t cm = below_[p], c0 = fine_.cost[p], cp = above_[p];
+        const int32_t cm = below[p], c0 = fine_.cost[p], cp = above[p];
         const int32_t curvature = cm + cp - 2 * c0;
         if (cm != 0xffff && cp != 0xffff && c0 <= cm && c0 <= cp && curvature > 0) {
           const int32_t step_q8 = half_span[f];
@@ -354,19 +319,14 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
     if (!planes_set_) return Status(Code::kInvalidArgument, "depth: no planes set for this burst");
     planes_set_ = false;
   }
-  const int32_t w = c.width, h = c.height;
+  const int32_t h = c.height;
   // Units: the costs' preparation and the first labeling, then one per move of every cycle.
   const int32_t total = 1 + c.max_cycles * c.labels;
   if (progress_ != nullptr) progress_->Report(0, total);
   data_.Prepare(views);
   EdgeWeights(views[c.reference]);
-  for (int32_t x = 0; x < w; ++x) keep_row_[x] = kKeep;
-  for (int32_t x = 0; x < w; ++x) move_rows_[9 * w + x] = 0;  // ZeroRow
-  prev_label_ = -1;
-  for (int32_t y = 0; y < h; ++y) {
-    want_span_[2 * y] = w;
-    want_span_[2 * y + 1] = 0;
-  }
+  move_.Start();
+  book_.Start();
   stats_.cycles = 0;
   stats_.moves = 0;
   stats_.cut_pixels = 0;
@@ -374,22 +334,14 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
   window_ = DepthConfig::kMaxLabels;
   const bool coarse = c.coarse_step > 1 && c.max_cycles > 0;
   if (coarse && c.coarse_blocks) {
-    CoarsePass();  // ends with the pixels' labels, their row masks, costs and energy
+    CoarseMoves();  // ends with the pixels' labels, their row masks, costs and energy
   } else {
     WinnerTakeAll();
-    for (int32_t y = 0; y < h; ++y) RowLabels(fine_, y);
-    energy_ = GridEnergy(fine_);
+    for (int32_t y = 0; y < h; ++y) RowLabels(fine_, c.labels, y);
+    energy_ = GridEnergy(fine_, c.smooth_trunc);
     stats_.initial_energy = energy_;
   }
-  for (int32_t p = 0; p < w * h; ++p) {
-    below_[p] = above_[p] = 0xffff;
-    fine_.cost_alpha[p] = fine_.prev_alpha[p] = kNotComputed;  // as MoveRects keeps them
-  }
-  fine_.written_count = fine_.prev_written_count = 0;
-  for (int32_t y = 0; y < h; ++y) {
-    fine_.span[2 * y] = fine_.span[2 * y + 1] = 0;
-    fine_.row_took[y] = 0;
-  }
+  book_.StartFine(fine_);
   if (coarse && !c.coarse_blocks) {
     for (int32_t alpha = 0; alpha < c.labels; alpha += c.coarse_step) {
       if (Expand(alpha)) ++stats_.moves;

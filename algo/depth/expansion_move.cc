@@ -1,17 +1,38 @@
-// One alpha-expansion move of the depth stage: which pixels the move can change, the 2-label
-// graph over them, the cut, and the energy bookkeeping. The 2-label move energy per neighbour
+// One alpha-expansion move of the depth stage over a rectangle: which nodes the move can change,
+// the 2-label graph over them, and the cut. The 2-label move energy per neighbour
 // pair, with x = 1 meaning "switch to alpha", A = V(fp,fq), B = V(fp,alpha), C = V(alpha,fq),
 // V(alpha,alpha) = 0, is
 //   A + (C - A) x_p - C x_q + (B + C - A) (1 - x_p) x_q,
 // and B + C - A >= 0 because truncated linear is a metric, so every move is a graph cut.
-#include "algo/depth/depth_stage.h"
+#include "algo/depth/expansion_move.h"
 
 #include <cstring>
 
 #include "algo/core/clones.h"
-#include "algo/core/int_math.h"
 
 namespace lb {
+
+namespace {
+
+constexpr uint8_t kFree = MoveGrid::kFree, kKeep = MoveGrid::kKeep, kTake = MoveGrid::kTake;
+
+}  // namespace
+
+void ExpansionMove::Carve(Arena& arena, const DepthConfig& config, size_t spare_bytes) {
+  const int32_t w = config.width, h = config.height;
+  width_ = w;
+  labels_ = config.labels;
+  trunc_ = config.smooth_trunc;
+  maxflow_.Carve(arena, w, h, spare_bytes, (w + 1) / 2, (h + 1) / 2);
+  move_rows_ = arena.Allocate<int32_t>(11 * static_cast<size_t>(w));
+  keep_row_ = arena.Allocate<uint8_t>(static_cast<size_t>(w));
+  free_span_ = arena.Allocate<int32_t>(2 * static_cast<size_t>(h));
+}
+
+void ExpansionMove::Start() {
+  for (int32_t x = 0; x < width_; ++x) keep_row_[x] = kKeep;
+  for (int32_t x = 0; x < width_; ++x) move_rows_[9 * width_ + x] = 0;  // ZeroRow
+}
 
 // Pass 1: pixels whose choice does not depend on their neighbours are fixed before the cut.
 // Flipping p to alpha changes the energy by u_p plus, per neighbour q, C - A (q keeps its label)
@@ -27,27 +48,10 @@ namespace lb {
 //
 // Columns x0..x1-1 are classified (the caller fixed the others as far from alpha), and the pairs
 // down are kept over e0..e1-1, which also covers the next row's x0..x1-1 (its sums read them).
-namespace {
-
-// out[x] = 1 where column x of the rows up, f and down holds a label in base..base + width, for
-// x in a..b-1: one unsigned compare per label (a label below base wraps above the width).
-LB_CLONES_AVX2 void MarkNearLabels(const uint8_t* __restrict up, const uint8_t* __restrict f,
-                                   const uint8_t* __restrict down, uint8_t base, uint8_t width,
-                                   int32_t a, int32_t b, uint8_t* __restrict out) {
-  for (int32_t x = a; x < b; ++x) {
-    out[x] = static_cast<uint8_t>(static_cast<uint8_t>(up[x] - base) <= width) |
-             static_cast<uint8_t>(static_cast<uint8_t>(f[x] - base) <= width) |
-             static_cast<uint8_t>(static_cast<uint8_t>(down[x] - base) <= width);
-  }
-}
-
-}  // namespace
-
-LB_CLONES_AVX2 int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t x0, int32_t x1,
-                                               int32_t e0, int32_t e1) {
-  Grid& g = grid();
+LB_CLONES_AVX2 int32_t ExpansionMove::ClassifyRow(MoveGrid& g, int32_t alpha, int32_t y, int32_t x0,
+                                                  int32_t x1, int32_t e0, int32_t e1) {
   const int32_t w = g.width, h = g.height;
-  const int32_t k = config_.smooth_trunc;
+  const int32_t k = trunc_;
   const int32_t row = y * w;
   const uint8_t* f = g.labels + row;
   const uint8_t* fd = y + 1 < h ? f + w : f;  // the last row's down weights are 0
@@ -73,8 +77,8 @@ LB_CLONES_AVX2 int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t
   const uint16_t* wu = y > 0 ? wd - w : reinterpret_cast<const uint16_t*>(ZeroRow());
   const int32_t* eu = y > 0 ? Ring(y - 1, kPairDown) : ZeroRow();
   // Restricted moves: which columns hold a label near alpha in rows y - 1..y + 1.
-  uint8_t* near = reinterpret_cast<uint8_t*>(move_rows_ + 10 * config_.width) + 1;
-  const bool restricted = window_ < config_.labels - 1;
+  uint8_t* near = reinterpret_cast<uint8_t*>(move_rows_ + 10 * width_) + 1;
+  const bool restricted = !Full();
   if (restricted) {
     const int32_t lo = alpha - window_, top = alpha + window_;
     const uint8_t* fu = y > 0 ? f - w : f;
@@ -96,7 +100,7 @@ LB_CLONES_AVX2 int32_t DepthStage::ClassifyRow(int32_t alpha, int32_t y, int32_t
 // Pass 1's states of pixels x0..x1-1 of a row (ClassifyRow), without branches so that the loop
 // vectorizes (its own function: the pointers it is handed do not overlap); returns kRowFree |
 // kRowTake for the states present.
-LB_CLONES_AVX2 uint8_t DepthStage::StatesRow(
+LB_CLONES_AVX2 uint8_t ExpansionMove::StatesRow(
     const uint8_t* __restrict f, const uint16_t* __restrict wr, const uint16_t* __restrict wd,
     const uint16_t* __restrict wu, const int32_t* __restrict er, const int32_t* __restrict ed,
     const int32_t* __restrict eu, const uint16_t* __restrict ca, const uint16_t* __restrict cc,
@@ -127,9 +131,8 @@ LB_CLONES_AVX2 uint8_t DepthStage::StatesRow(
 }
 
 // The pairs from row y (fixed: above a rectangle) down into the rectangle's first row.
-void DepthStage::PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1) {
-  Grid& g = grid();
-  const int32_t w = g.width, k = config_.smooth_trunc;
+void ExpansionMove::PairsDown(const MoveGrid& g, int32_t alpha, int32_t y, int32_t x0, int32_t x1) {
+  const int32_t w = g.width, k = trunc_;
   const uint8_t* f = g.labels + y * w;
   const uint8_t* fd = f + w;
   const uint16_t* wd = g.weight_down + y * w;
@@ -147,7 +150,7 @@ void DepthStage::PairsDown(int32_t alpha, int32_t y, int32_t x0, int32_t x1) {
 // down), 0 for fixed pixels. The left neighbour of x0 and the right one of x1 - 1 are the row's
 // own when inside the rectangle's columns r0..r1-1, else they keep their labels: the first and
 // last pixel are peeled.
-LB_CLONES_AVX2 void DepthStage::BuildTerms(
+LB_CLONES_AVX2 void ExpansionMove::BuildTerms(
     const uint8_t* __restrict st, const uint8_t* __restrict up, const uint8_t* __restrict down,
     const int32_t* __restrict er, const int32_t* __restrict ed, const int32_t* __restrict eu,
     const int32_t* __restrict hi, int32_t x0, int32_t x1, int32_t r0, int32_t r1,
@@ -182,9 +185,9 @@ LB_CLONES_AVX2 void DepthStage::BuildTerms(
 //
 // The terms are computed for every pixel of the row without branches (BuildTerms) and are 0 for
 // fixed pixels, whose nodes are then the solver's idle nodes.
-int32_t DepthStage::BuildRow(const Rect& r, int32_t y, int32_t node_row) {
-  const int32_t w = grid().width;
-  const uint8_t* st = grid().state + y * w;
+int32_t ExpansionMove::BuildRow(const MoveGrid& g, const MoveRect& r, int32_t y, int32_t node_row) {
+  const int32_t w = g.width;
+  const uint8_t* st = g.state + y * w;
   // Rows outside the rectangle keep their labels: a row of kKeep stands for them.
   const uint8_t* up = y > r.y0 ? st - w : keep_row_;
   const uint8_t* down = y + 1 < r.y1 ? st + w : keep_row_;
@@ -227,11 +230,11 @@ int32_t DepthStage::BuildRow(const Rect& r, int32_t y, int32_t node_row) {
 
 // Row y's free pixels within r (after ClassifyRow): [first, last + 1) into free_span_, empty
 // at r.x0 when none.
-void DepthStage::FreeSpan(const Rect& r, int32_t y, bool any) {
+void ExpansionMove::FreeSpan(const MoveGrid& g, const MoveRect& r, int32_t y, bool any) {
   int32_t* span = free_span_ + 2 * y;
   span[0] = span[1] = r.x0;
   if (!any) return;
-  const uint8_t* st = grid().state + y * grid().width;
+  const uint8_t* st = g.state + y * g.width;
   const void* first = memchr(st + r.x0, kFree, static_cast<size_t>(r.x1 - r.x0));  // one there
   const int32_t a = static_cast<int32_t>(static_cast<const uint8_t*>(first) - st);
   const void* last = memrchr(st + a, kFree, static_cast<size_t>(r.x1 - a));
@@ -244,7 +247,7 @@ void DepthStage::FreeSpan(const Rect& r, int32_t y, bool any) {
 // pixels and those of the rows above and below, one column either side, as one interval. A row's
 // first and last node also neighbour the rows before and after in node order, so the caller
 // sets them as well.
-void DepthStage::Reach(const Rect& r, int32_t y, int32_t* x0, int32_t* x1) const {
+void ExpansionMove::Reach(const MoveRect& r, int32_t y, int32_t* x0, int32_t* x1) const {
   int32_t lo = r.x1, hi = r.x0;
   for (int32_t k = y > r.y0 ? y - 1 : y; k <= y + 1 && k < r.y1; ++k) {
     const int32_t* span = free_span_ + 2 * k;
@@ -256,34 +259,11 @@ void DepthStage::Reach(const Rect& r, int32_t y, int32_t* x0, int32_t* x1) const
   *x1 = hi < r.x1 ? hi : r.x1;
 }
 
-// The columns of row y (within r) that pass 1 may not fix as far from alpha: those within one of
-// a label near alpha (near_span) in the rows y - 1..y + 1; all of r for a full move. Empty at
-// r.x0 when none.
-void DepthStage::NearColumns(const Rect& r, int32_t y, int32_t* x0, int32_t* x1) const {
-  if (window_ >= config_.labels - 1) {
-    *x0 = r.x0;
-    *x1 = r.x1;
-    return;
-  }
-  const Grid& g = fine_;
-  int32_t lo = r.x1, hi = r.x0;
-  for (int32_t k = y > 0 ? y - 1 : 0; k <= y + 1 && k < g.height; ++k) {
-    const int32_t a = g.near_span[2 * k], b = g.near_span[2 * k + 1];
-    if (a >= b) continue;
-    lo = a - 1 < lo ? a - 1 : lo;
-    hi = b + 1 > hi ? b + 1 : hi;
-  }
-  lo = lo > r.x0 ? lo : r.x0;
-  hi = hi < r.x1 ? hi : r.x1;
-  *x0 = lo < hi ? lo : r.x0;
-  *x1 = lo < hi ? hi : r.x0;
-}
-
 // Classifies and builds the rectangle's rows, cuts the graph and settles its free pixels.
-void DepthStage::CutRect(int32_t alpha, const Rect& r) {
-  Grid& g = grid();
+int32_t ExpansionMove::Cut(MoveGrid& g, int32_t alpha, const MoveRect& r, int32_t window) {
+  window_ = window;
   const int32_t w = g.width, gw = r.x1 - r.x0;
-  if (r.y0 > 0) PairsDown(alpha, r.y0 - 1, r.x0, r.x1);
+  if (r.y0 > 0) PairsDown(g, alpha, r.y0 - 1, r.x0, r.x1);
   // Rows with free or switching pixels (y_lo..y_hi), and the graph's rows g_lo..: rows without
   // a free pixel are left out at either end, and written as empty rows only between two others.
   int32_t y_lo = r.y1, y_hi = -1, g_lo = -1, rows = 0, pending = 0, free_pixels = 0;
@@ -291,13 +271,13 @@ void DepthStage::CutRect(int32_t alpha, const Rect& r) {
   // Pass 1 looks only at the columns of each row that are not far from alpha (NearColumns); the
   // others keep their labels.
   int32_t next0 = r.x0, next1 = r.x1;
-  NearColumns(r, r.y0, &next0, &next1);
+  NearColumns(g, Full(), r, r.y0, &next0, &next1);
   for (int32_t y = r.y0; y <= r.y1; ++y) {
     const int32_t above = present;
     if (y < r.y1) {
       const int32_t c0 = next0, c1 = next1;
       next0 = next1 = r.x0;
-      if (y + 1 < r.y1) NearColumns(r, y + 1, &next0, &next1);
+      if (y + 1 < r.y1) NearColumns(g, Full(), r, y + 1, &next0, &next1);
       // The pairs down: over this row's columns and the next one's.
       int32_t e0 = c0, e1 = c1;
       if (next0 < next1) {
@@ -307,9 +287,9 @@ void DepthStage::CutRect(int32_t alpha, const Rect& r) {
       uint8_t* st = g.state + y * w;
       memset(st + r.x0, kKeep, static_cast<size_t>(c0 - r.x0));
       memset(st + c1, kKeep, static_cast<size_t>(r.x1 - c1));
-      present = ClassifyRow(alpha, y, c0, c1, e0, e1);
+      present = ClassifyRow(g, alpha, y, c0, c1, e0, e1);
       g.row_took[y] |= (present & kRowTake) != 0 ? 1 : 0;
-      FreeSpan(r, y, (present & kRowFree) != 0);
+      FreeSpan(g, r, y, (present & kRowFree) != 0);
       if (present != 0) {
         y_lo = y < y_lo ? y : y_lo;
         y_hi = y;
@@ -332,10 +312,9 @@ void DepthStage::CutRect(int32_t alpha, const Rect& r) {
       maxflow_.SetIdle(rows * gw + gw - 1);
       maxflow_.RowDone(rows, 0, 0);
     }
-    free_pixels += BuildRow(r, y - 1, rows++);
+    free_pixels += BuildRow(g, r, y - 1, rows++);
   }
-  if (y_hi < 0) return;
-  stats_.cut_pixels += free_pixels;
+  if (y_hi < 0) return 0;
   if (free_pixels > 0) {
     maxflow_.Truncate(rows);
     (void)maxflow_.Solve();
@@ -352,226 +331,7 @@ void DepthStage::CutRect(int32_t alpha, const Rect& r) {
       g.row_took[g_lo + gy] |= took;
     }
   }
-}
-
-bool DepthStage::Expand(int32_t alpha) {
-  Grid& g = grid();
-  const int32_t count = MoveRects(alpha);
-  UseLabelPlanes(alpha);
-  const int32_t disp_q8 = LabelDispQ8(alpha);
-  const bool near = !on_coarse_ && window_ < config_.labels - 1;
-  if (near && count > 0) ComputeNear(disp_q8);
-  for (int32_t i = 0; i < count; ++i) {
-    const Rect& r = g.rects[i];
-    if (on_coarse_ && block_costs_ != nullptr) {
-      g.cost_alpha = CoarseCosts(alpha);  // the whole grid, from the winner-take-all
-    } else if (on_coarse_) {
-      BlockCosts(alpha, r, g.cost_alpha);
-    } else if (!near) {
-      data_.ComputeRect(disp_q8, r.x0, r.x1, r.y0, r.y1, g.cost_alpha + r.y0 * g.width, g.width);
-      Written(r);
-    }
-    CutRect(alpha, r);
-  }
-  const int64_t delta = Record(alpha);
-  energy_ += delta;
-  return delta < 0;
-}
-
-// A restricted move needs D only at the pixels it may free: next to a label within the window of
-// alpha (near_lo_..near_hi_), in the row or the rows either side. Per row, the runs of such
-// columns (RowRuns: joined where close, at most a few), over the whole image in one pass of the
-// data term (its ring covers every row's runs, the image pays its 2 starting rows once, and each
-// view row is read once: the move's rectangles may share rows). The others keep kNotComputed,
-// which pass 1 never reads (they are fixed as far from alpha whatever their D); the sub-label
-// fit mostly finds its D(alpha) at hand, and Record has the rest computed (PastCosts). Written
-// records a rectangle per run of rows with the same single run, or each run, exactly where D
-// was computed.
-LB_CLONES_AVX2 void DepthStage::ComputeNear(int32_t disp_q8) {
-  const Grid& g = fine_;
-  const int32_t w = g.width, h = g.height;
-  const Rect whole{0, w, 0, h};
-  const uint8_t base = static_cast<uint8_t>(near_lo_);
-  const uint8_t width = static_cast<uint8_t>(near_hi_ - near_lo_);
-  uint8_t* const near = run_marks_ + 1;      // near[-1 .. w]: a label near in the column
-  uint8_t* const mark = run_marks_ + w + 3;  // mark[x]: one next to column x
-  for (int32_t y = 0; y < h; ++y) {
-    int32_t lo = 0, hi = 0;
-    NearColumns(whole, y, &lo, &hi);
-    if (lo >= hi) {
-      runs_[y].count = 0;
-      continue;
-    }
-    const uint8_t* f = g.labels + y * w;
-    const int32_t a = lo > 0 ? lo - 1 : 0, b = hi < w ? hi + 1 : w;
-    MarkNearLabels(y > 0 ? f - w : f, f, y + 1 < h ? f + w : f, base, width, a, b, near);
-    near[a - 1] = near[b] = 0;
-    for (int32_t x = lo; x < hi; ++x) {
-      mark[x] = static_cast<uint8_t>(near[x - 1] | near[x] | near[x + 1]);
-    }
-    runs_[y].FromMarks(mark, lo, hi, w, data_.RunJoin());
-  }
-  data_.ComputeRuns(disp_q8, runs_, 0, h, g.cost_alpha, w);
-  for (int32_t y0 = 0; y0 < h;) {
-    const RowRuns& a = runs_[y0];
-    int32_t y1 = y0 + 1;
-    if (a.count == 1) {
-      while (y1 < h && runs_[y1].count == 1 && runs_[y1].x[0] == a.x[0] &&
-             runs_[y1].x[1] == a.x[1]) {
-        ++y1;
-      }
-    }
-    for (int32_t k = 0; k < a.count; ++k) Written(Rect{a.x[2 * k], a.x[2 * k + 1], y0, y1});
-    y0 = y1;
-  }
-}
-
-// The sub-label fit's D of the pixels that keep a label next to alpha: D(alpha) is D(f + 1) of a
-// pixel of label alpha - 1 and D(f - 1) of one of label alpha + 1. Without branches, so that
-// the loop vectorizes.
-LB_CLONES_AVX2 void DepthStage::RecordNeighbours(int32_t alpha, const uint8_t* __restrict st,
-                                                 const uint8_t* __restrict f,
-                                                 const uint16_t* __restrict ca,
-                                                 uint16_t* __restrict below,
-                                                 uint16_t* __restrict above, int32_t x0,
-                                                 int32_t x1) {
-  // Label 255 has no alpha + 1 and label 0 no alpha - 1: 256 and -1 match no uint8_t.
-  const int32_t up = alpha + 1, down = alpha - 1;
-  for (int32_t x = x0; x < x1; ++x) {
-    const uint16_t keeps = st[x] != kTake ? 0xffff : 0;
-    const uint16_t b = f[x] == up ? keeps : 0, a = f[x] == down ? keeps : 0;
-    below[x] = static_cast<uint16_t>((ca[x] & b) | (below[x] & ~b));
-    above[x] = static_cast<uint16_t>((ca[x] & a) | (above[x] & ~a));
-  }
-}
-
-// Applies the move's switches. On the pixels it also keeps D_p(f_p - 1) and D_p(f_p + 1) for
-// the sub-label fit without another pass of the data term: moves run in label order, so a pixel
-// that keeps label f saw D(f - 1) and D(f + 1) in the moves before and after f, and one that
-// just took alpha saw D(alpha - 1) in the move before (kept in prev_alpha) when it lay in the
-// columns that move's run of rows looked at (prev_span), and will see D(alpha + 1) in the next.
-// A restricted move looks at every pixel within its window, so at every pixel of label alpha - 1
-// and alpha + 1. The move before computed D only next to labels within its window (and on its
-// split rectangles, move_rects.cc); a pixel of its columns that now took alpha without one gets
-// its D(alpha - 1) here, all such pixels of the move in one pass of the data term
-// (PastCosts), so the fit depends neither on how the rectangles were split nor on where the
-// move before looked.
-//
-// Returns the energy change: each switching pixel's D, and its pairs with the neighbours that
-// keep their labels; a pair of two switching pixels goes from V(fp, fq) to 0 and is counted once,
-// from its left or upper pixel, whose labels are still the old ones then (the rectangles' rings
-// never switch, so a neighbour outside the rectangle keeps its label).
-int64_t DepthStage::Record(int32_t alpha) {
-  Grid& g = grid();
-  const int32_t w = g.width, h = g.height;
-  int64_t delta = 0;
-  const bool refine = !on_coarse_ && config_.subpixel;  // the labels alone need none of it
-  const bool have_prev = refine && prev_label_ == alpha - 1;
-  for (int32_t i = 0; i < g.rect_count; ++i) {
-    const Rect& r = g.rects[i];
-    for (int32_t y = r.y0; y < r.y1; ++y) {
-      const uint8_t* st = g.state + y * w;
-      const uint8_t* f = g.labels + y * w;
-      const uint16_t* ca = g.cost_alpha + y * w;
-      if (refine) RecordNeighbours(alpha, st, f, ca, below_ + y * w, above_ + y * w, r.x0, r.x1);
-      if (g.row_took[y] == 0) continue;  // CutRect marks the rows where a pixel takes alpha
-      const int32_t px0 = have_prev ? g.prev_span[2 * y] : 0;
-      const int32_t px1 = have_prev ? g.prev_span[2 * y + 1] : 0;
-      for (int32_t x = r.x0; x < r.x1; ++x) {
-        const void* next = memchr(st + x, kTake, static_cast<size_t>(r.x1 - x));
-        if (next == nullptr) break;
-        x = static_cast<int32_t>(static_cast<const uint8_t*>(next) - st);
-        const int32_t p = y * w + x;
-        const int32_t fp = f[x];
-        delta += g.cost_alpha[p] - g.cost[p];
-        auto pair = [&](int32_t q, int32_t wpq, bool first, bool inside) {
-          const bool takes = inside && g.state[q] == kTake;
-          if (takes && !first) return;
-          const int32_t fq = g.labels[q];
-          const int32_t after = takes ? 0 : smooth_[Abs(alpha - fq)];
-          delta += int64_t{wpq} * (after - smooth_[Abs(fp - fq)]);
-        };
-        if (x + 1 < w) pair(p + 1, g.weight_right[p], true, x + 1 < r.x1);
-        if (x > 0) pair(p - 1, g.weight_right[p - 1], false, x > r.x0);
-        if (y + 1 < h) pair(p + w, g.weight_down[p], true, y + 1 < r.y1);
-        if (y > 0) pair(p - w, g.weight_down[p - w], false, y > r.y0);
-        g.labels[p] = static_cast<uint8_t>(alpha);
-        MoveLabel(g, config_.labels, y, fp, alpha);
-        g.cost[p] = g.cost_alpha[p];
-        if (!refine) continue;
-        below_[p] = kNotComputed;
-        if (x >= px0 && x < px1) {
-          below_[p] = g.prev_alpha[p];
-          if (below_[p] == kNotComputed) {  // PastCosts fills it in
-            below_[p] = kWanted;
-            int32_t* want = want_span_ + 2 * y;
-            want[0] = x < want[0] ? x : want[0];
-            want[1] = x + 1 > want[1] ? x + 1 : want[1];
-          }
-        }
-        above_[p] = kNotComputed;
-      }
-    }
-  }
-  for (int32_t i = 0; i < g.rect_count; ++i) {
-    for (int32_t y = g.rects[i].y0; y < g.rects[i].y1; ++y) {
-      g.row_took[y] = 0;
-    }
-  }
-  if (have_prev) PastCosts(alpha - 1);
-  if (refine) {
-    uint16_t* t = g.prev_alpha;
-    g.prev_alpha = g.cost_alpha;
-    g.cost_alpha = t;
-    Rect* tw = g.prev_written;
-    g.prev_written = g.written;
-    g.written = tw;
-    const int32_t count = g.prev_written_count;
-    g.prev_written_count = g.written_count;
-    g.written_count = count;
-    prev_label_ = alpha;
-  }
-  return delta;
-}
-
-// The D(label) that Record wanted (kWanted in below_, over want_span_): the rows' runs of them
-// in one pass of the data term, into prev_alpha, which holds D(label) (the same bits as any
-// other pass: a pixel's D depends only on the views around it); the columns the runs join
-// across get D(label) too, and prev_alpha's record of where it holds D grows by the runs, so
-// that MoveRects clears them in turn.
-void DepthStage::PastCosts(int32_t label) {
-  Grid& g = fine_;
-  const int32_t w = g.width, h = g.height;
-  uint8_t* const mark = run_marks_ + w + 3;
-  int32_t y0 = h, y1 = 0;
-  for (int32_t y = 0; y < h; ++y) {
-    int32_t* want = want_span_ + 2 * y;
-    if (want[0] >= want[1]) {
-      runs_[y].count = 0;
-      continue;
-    }
-    const uint16_t* b = below_ + y * w;
-    for (int32_t x = want[0]; x < want[1]; ++x) mark[x] = b[x] == kWanted ? 1 : 0;
-    runs_[y].FromMarks(mark, want[0], want[1], w, data_.RunJoin());
-    y0 = y < y0 ? y : y0;
-    y1 = y + 1;
-  }
-  if (y0 >= y1) return;
-  UseLabelPlanes(label);
-  data_.ComputeRuns(LabelDispQ8(label), runs_, y0, y1, g.prev_alpha + y0 * w, w);
-  for (int32_t y = y0; y < y1; ++y) {
-    int32_t* want = want_span_ + 2 * y;
-    uint16_t* b = below_ + y * w;
-    const uint16_t* d = g.prev_alpha + y * w;
-    for (int32_t x = want[0]; x < want[1]; ++x) b[x] = b[x] == kWanted ? d[x] : b[x];
-    want[0] = w;
-    want[1] = 0;
-    const RowRuns& r = runs_[y];
-    for (int32_t k = 0; k < r.count; ++k) {
-      NoteWritten(g.prev_written, &g.prev_written_count, g.written_capacity,
-                  Rect{r.x[2 * k], r.x[2 * k + 1], y, y + 1});
-    }
-  }
+  return free_pixels;
 }
 
 }  // namespace lb

@@ -1,11 +1,15 @@
-// Where an expansion move looks (DepthStage::MoveRects): the rectangles of grid() whose nodes it
+// Where an expansion move looks (MoveBook::MoveRects): the rectangles of a grid whose nodes it
 // may free, and per row the columns whose D it computes.
-#include "algo/depth/depth_stage.h"
+#include "algo/depth/move_book.h"
 
 #include <cstring>
 
+#include "algo/core/clones.h"
+
 namespace lb {
 namespace {
+
+constexpr uint16_t kNotComputed = MoveGrid::kNotComputed;
 
 // The first and the last column of a row whose label is in lo..hi, which the row holds: 16
 // labels at a time (one unsigned compare each, in the compiler's generic vectors: SSE2 or NEON),
@@ -35,12 +39,11 @@ void LabelsIn(const uint8_t* f, int32_t w, int32_t lo, int32_t hi, int32_t* x0, 
 }  // namespace
 
 // A move looks at rectangles: the whole grid for a full move. A restricted move frees only
-// nodes with a label within window_ of alpha in their 3x3 neighbourhood, so it looks at the runs
+// nodes with a label within `window` of alpha in their 3x3 neighbourhood, so it looks at the runs
 // of rows next to such a label, each over the columns from the first to the last of them. The
 // rows between runs keep their labels, which makes each rectangle's cut independent of the
 // others.
-int32_t DepthStage::MoveRects(int32_t alpha) {
-  Grid& g = grid();
+int32_t MoveBook::MoveRects(MoveGrid& g, int32_t alpha, int32_t window, bool fine) {
   const int32_t w = g.width, h = g.height;
   int32_t* t = g.prev_span;
   g.prev_span = g.span;
@@ -49,13 +52,13 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
   // The pixels' D of this move goes where the move before last left its own (Record swaps the
   // two buffers): back to "not computed" there, so that Record can tell which D the move before
   // this one computed (fine grid only; the coarse grid keeps no D for the refinement).
-  if (!on_coarse_ && !config_.subpixel) g.written_count = 0;  // no sub-label fit to feed
-  if (!on_coarse_ && config_.subpixel) {
+  if (fine && !subpixel_) g.written_count = 0;  // no sub-label fit to feed
+  if (fine && subpixel_) {
     if (g.written_count < 0) {
       for (int32_t p = 0; p < w * h; ++p) g.cost_alpha[p] = kNotComputed;
     }
     for (int32_t i = 0; i < g.written_count; ++i) {
-      const Rect& r = g.written[i];
+      const MoveRect& r = g.written[i];
       for (int32_t y = r.y0; y < r.y1; ++y) {
         uint16_t* d = g.cost_alpha + y * w;
         for (int32_t x = r.x0; x < r.x1; ++x) d[x] = kNotComputed;
@@ -63,17 +66,17 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
     }
     g.written_count = 0;
   }
-  if (window_ >= config_.labels - 1) {
+  if (window >= labels_ - 1) {
     for (int32_t y = 0; y < h; ++y) {
       span[2 * y] = 0;
       span[2 * y + 1] = w;
     }
-    g.rects[0] = Rect{0, w, 0, h};
+    g.rects[0] = MoveRect{0, w, 0, h};
     g.rect_count = 1;
     return 1;
   }
-  const int32_t lo = alpha - window_ > 0 ? alpha - window_ : 0;
-  const int32_t hi = alpha + window_ < config_.labels - 1 ? alpha + window_ : config_.labels - 1;
+  const int32_t lo = alpha - window > 0 ? alpha - window : 0;
+  const int32_t hi = alpha + window < labels_ - 1 ? alpha + window : labels_ - 1;
   uint64_t want[4] = {};
   for (int32_t l = lo; l <= hi; ++l) want[l >> 6] |= uint64_t{1} << (l & 63);
   // Each row's own columns with such a label: [w, 0) when none. Also where the move computes D
@@ -104,7 +107,7 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
       ++y;
       continue;
     }
-    Rect r{w, 0, y, y};
+    MoveRect r{w, 0, y, y};
     for (; y < h && row_near(y); ++y) {
       for (int32_t k = y > 0 ? y - 1 : 0; k <= y + 1 && k < h; ++k) {
         r.x0 = span[2 * k] < r.x0 ? span[2 * k] : r.x0;
@@ -128,7 +131,7 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
   // Each run's rectangle, split until no split is left (or the list is full): the cuts and the
   // data term then cover far fewer fixed pixels.
   for (int32_t i = 0; i < count;) {
-    const int32_t after = SplitRect(i, count, lo, hi);
+    const int32_t after = SplitRect(g, i, count, lo, hi);
     if (after < 0) {
       ++i;
     } else {
@@ -147,12 +150,11 @@ int32_t DepthStage::MoveRects(int32_t alpha) {
 // other columns (or rows), each again such a rectangle, and the cuts over them together are
 // the cut over R: the same labels. Returns the new count of rectangles when rects[i] changed
 // (it is to be looked at again), or -1 when it cannot be split.
-int32_t DepthStage::SplitRect(int32_t i, int32_t count, int32_t lo, int32_t hi) {
-  Grid& g = grid();
+int32_t MoveBook::SplitRect(MoveGrid& g, int32_t i, int32_t count, int32_t lo, int32_t hi) {
   const int32_t w = g.width;
   const uint8_t width = static_cast<uint8_t>(hi - lo);
   const uint8_t base = static_cast<uint8_t>(lo);
-  const Rect r = g.rects[i];
+  const MoveRect r = g.rects[i];
   uint8_t* mark = split_ + 1;  // mark[-1] and mark[n] are 0
   for (int pass = 0; pass < 2; ++pass) {
     const bool columns = pass == 0;
@@ -187,7 +189,7 @@ int32_t DepthStage::SplitRect(int32_t i, int32_t count, int32_t lo, int32_t hi) 
         first0 = k0;
         first1 = k;
       } else {
-        Rect piece = r;
+        MoveRect piece = r;
         (columns ? piece.x0 : piece.y0) = k0;
         (columns ? piece.x1 : piece.y1) = k;
         if (count < g.rect_capacity) {
@@ -206,13 +208,62 @@ int32_t DepthStage::SplitRect(int32_t i, int32_t count, int32_t lo, int32_t hi) 
       return count - 1;
     }
     if (first0 != a0 || first1 != a1) {
-      Rect& first = g.rects[i];
+      MoveRect& first = g.rects[i];
       (columns ? first.x0 : first.y0) = first0;
       (columns ? first.x1 : first.y1) = first1;
       return count;
     }
   }
   return -1;
+}
+
+// A restricted move needs D only at the pixels it may free: next to a label within the window of
+// alpha (near_lo_..near_hi_), in the row or the rows either side. Per row, the runs of such
+// columns (RowRuns: joined where close, at most a few), over the whole image in one pass of the
+// data term (its ring covers every row's runs, the image pays its 2 starting rows once, and each
+// view row is read once: the move's rectangles may share rows). The others keep kNotComputed,
+// which pass 1 never reads (they are fixed as far from alpha whatever their D); the sub-label
+// fit mostly finds its D(alpha) at hand, and Record has the rest computed (PastCosts). Written
+// records a rectangle per run of rows with the same single run, or each run, exactly where D
+// was computed.
+LB_CLONES_AVX2 void MoveBook::ComputeNear(MoveGrid& fine, const LabelTerm& term, int32_t disp_q8) {
+  const MoveGrid& g = fine;
+  const int32_t w = g.width, h = g.height;
+  const MoveRect whole{0, w, 0, h};
+  const uint8_t base = static_cast<uint8_t>(near_lo_);
+  const uint8_t width = static_cast<uint8_t>(near_hi_ - near_lo_);
+  uint8_t* const near = run_marks_ + 1;      // near[-1 .. w]: a label near in the column
+  uint8_t* const mark = run_marks_ + w + 3;  // mark[x]: one next to column x
+  for (int32_t y = 0; y < h; ++y) {
+    int32_t lo = 0, hi = 0;
+    NearColumns(g, false, whole, y, &lo, &hi);
+    if (lo >= hi) {
+      runs_[y].count = 0;
+      continue;
+    }
+    const uint8_t* f = g.labels + y * w;
+    const int32_t a = lo > 0 ? lo - 1 : 0, b = hi < w ? hi + 1 : w;
+    MarkNearLabels(y > 0 ? f - w : f, f, y + 1 < h ? f + w : f, base, width, a, b, near);
+    near[a - 1] = near[b] = 0;
+    for (int32_t x = lo; x < hi; ++x) {
+      mark[x] = static_cast<uint8_t>(near[x - 1] | near[x] | near[x + 1]);
+    }
+    runs_[y].FromMarks(mark, lo, hi, w, term.data.RunJoin());
+  }
+  term.data.ComputeRuns(disp_q8, runs_, 0, h, g.cost_alpha, w);
+  for (int32_t y0 = 0; y0 < h;) {
+    const RowRuns& a = runs_[y0];
+    int32_t y1 = y0 + 1;
+    if (a.count == 1) {
+      while (y1 < h && runs_[y1].count == 1 && runs_[y1].x[0] == a.x[0] &&
+             runs_[y1].x[1] == a.x[1]) {
+        ++y1;
+      }
+    }
+    for (int32_t k = 0; k < a.count; ++k)
+      Written(fine, MoveRect{a.x[2 * k], a.x[2 * k + 1], y0, y1});
+    y0 = y1;
+  }
 }
 
 }  // namespace lb

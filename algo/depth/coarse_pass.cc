@@ -1,9 +1,10 @@
 // The coarse pass of coarse-to-fine depth (DepthConfig::coarse_blocks): full expansion moves
-// over every coarse_step-th label on a grid of 2x2 pixel blocks. A block's D is the sum of its
+// over every coarse_step-th label on a grid of 2x2 pixel blocks (the moves are the stage's; this
+// is their grid, its start and its hand-over to the pixels). A block's D is the sum of its
 // pixels' D and the pair weight between two blocks the sum of the pixel pairs across their
 // edge, so the energy of block labels is exactly that of the same labels on the pixels: the
 // pass minimises the real energy over block-constant labels, on a quarter of the nodes.
-#include "algo/depth/depth_stage.h"
+#include "algo/depth/coarse_pass.h"
 
 #include <cstring>
 
@@ -17,50 +18,39 @@ namespace {
 constexpr int32_t kBandPixels = 16384;
 }  // namespace
 
-// Without branches, so that it vectorizes (a block's winner is a coin toss to a predictor).
-LB_CLONES_AVX2 void DepthStage::TakeBetter(const uint16_t* __restrict d, int32_t n, uint8_t label,
-                                           uint16_t* __restrict cost, uint8_t* __restrict labels) {
-  for (int32_t p = 0; p < n; ++p) {
-    const bool better = d[p] < cost[p];
-    cost[p] = better ? d[p] : cost[p];
-    labels[p] = better ? label : labels[p];
-  }
-}
-
-void DepthStage::BlockWeights() {
-  const int32_t w = config_.width, h = config_.height, bw = coarse_.width, bh = coarse_.height;
+void CoarsePass::BlockWeights(const MoveGrid& fine) {
+  const int32_t w = fine.width, h = fine.height, bw = grid_.width, bh = grid_.height;
   for (int32_t by = 0; by < bh; ++by) {
     for (int32_t bx = 0; bx < bw; ++bx) {
       const int32_t x = 2 * bx, y = 2 * by;
       int32_t right = 0, down = 0;  // at most 2 * 4096
       if (x + 2 < w) {
-        for (int32_t yy = y; yy < y + 2 && yy < h; ++yy)
-          right += fine_.weight_right[yy * w + x + 1];
+        for (int32_t yy = y; yy < y + 2 && yy < h; ++yy) right += fine.weight_right[yy * w + x + 1];
       }
       if (y + 2 < h) {
-        for (int32_t xx = x; xx < x + 2 && xx < w; ++xx)
-          down += fine_.weight_down[(y + 1) * w + xx];
+        for (int32_t xx = x; xx < x + 2 && xx < w; ++xx) down += fine.weight_down[(y + 1) * w + xx];
       }
-      coarse_.weight_right[by * bw + bx] = static_cast<uint16_t>(right);
-      coarse_.weight_down[by * bw + bx] = static_cast<uint16_t>(down);
+      grid_.weight_right[by * bw + bx] = static_cast<uint16_t>(right);
+      grid_.weight_down[by * bw + bx] = static_cast<uint16_t>(down);
     }
   }
 }
 
 // D of `label` for the blocks of rectangle b into out (block grid), through the pixels' D in
-// fine_.cost_alpha (scratch until the fine moves). At most 4 * 2295.
-void DepthStage::BlockCosts(int32_t label, const Rect& b, uint16_t* out, uint16_t* ring,
-                            bool continues, int32_t worker) {
-  const int32_t w = config_.width, h = config_.height, bw = coarse_.width;
+// the fine grid's cost_alpha (scratch until the fine moves). At most 4 * 2295.
+void CoarsePass::BlockCosts(const MoveGrid& fine, const LabelTerm& term, int32_t label,
+                            const MoveRect& b, uint16_t* out, uint16_t* ring, bool continues,
+                            int32_t worker) {
+  const int32_t w = fine.width, h = fine.height, bw = grid_.width;
   const int32_t x0 = 2 * b.x0, x1 = 2 * b.x1 < w ? 2 * b.x1 : w;
   const int32_t y0 = 2 * b.y0, y1 = 2 * b.y1 < h ? 2 * b.y1 : h;
-  uint16_t* d = fine_.cost_alpha;
+  uint16_t* d = fine.cost_alpha;
   if (ring != nullptr) {
-    data_.ComputeRowsCarried(LabelDispQ8(label), LabelPlanes(label), y0, y1, continues, ring,
-                             d + y0 * w, w, worker);
+    term.data.ComputeRowsCarried(term.DispQ8(label), term.Planes(label), y0, y1, continues, ring,
+                                 d + y0 * w, w, worker);
   } else {
-    UseLabelPlanes(label);
-    data_.ComputeRect(LabelDispQ8(label), x0, x1, y0, y1, d + y0 * w, w);
+    term.Use(label);
+    term.data.ComputeRect(term.DispQ8(label), x0, x1, y0, y1, d + y0 * w, w);
   }
   // Whole blocks in a loop that vectorizes; a last odd column or row holds half blocks.
   const int32_t whole = Min(b.x1, w / 2);
@@ -84,72 +74,85 @@ void DepthStage::BlockCosts(int32_t label, const Rect& b, uint16_t* out, uint16_
   }
 }
 
-DepthStage::CoarseRoom DepthStage::CoarseLayout(int32_t stripes) const {
-  const int32_t w = config_.width, h = config_.height;
+CoarsePass::Room CoarsePass::Layout(const DepthConfig& config, size_t ring_size, int32_t stripes) {
+  const int32_t w = config.width, h = config.height;
   const size_t n = static_cast<size_t>((w + 1) / 2) * ((h + 1) / 2);  // the coarse grid
   const size_t coarse_labels =
-      static_cast<size_t>((config_.labels + config_.coarse_step - 1) / config_.coarse_step);
-  CoarseRoom r;
+      static_cast<size_t>((config.labels + config.coarse_step - 1) / config.coarse_step);
+  Room r;
   r.block_bytes = sizeof(uint16_t) * n * coarse_labels;
   r.rings_at = Arena::RoundUp(r.block_bytes);
-  r.rings_end = r.rings_at + sizeof(uint16_t) * data_.CarriedRingSize() * coarse_labels *
-                                 static_cast<size_t>(stripes);
+  r.rings_end =
+      r.rings_at + sizeof(uint16_t) * ring_size * coarse_labels * static_cast<size_t>(stripes);
   r.winners_at = Arena::RoundUp(r.rings_end);
   r.labels_at = Arena::RoundUp(r.winners_at + sizeof(uint16_t) * static_cast<size_t>(w) * h);
   r.end = r.labels_at + n;
   return r;
 }
 
-int32_t DepthStage::CoarseStripes(int32_t workers) const {
-  const int32_t band = Max(1, kBandPixels / config_.width / 2);  // block rows
-  return Clamp(workers, 1, Max(1, (config_.height + 1) / 2 / band));
+int32_t CoarsePass::Stripes(const DepthConfig& config, int32_t workers) {
+  const int32_t band = Max(1, kBandPixels / config.width / 2);  // block rows
+  return Clamp(workers, 1, Max(1, (config.height + 1) / 2 / band));
 }
 
-void DepthStage::CoarseWinnerTakeAll() {
-  Grid& g = coarse_;
+size_t CoarsePass::SpareBytes(const DepthConfig& config, size_t ring_size) {
+  return Layout(config, ring_size, Stripes(config, config.workers)).end;
+}
+
+void CoarsePass::CarveGrid(Arena& arena, const DepthConfig& config) {
+  lb::CarveGrid(arena, grid_, (config.width + 1) / 2, (config.height + 1) / 2, config.labels,
+                false);
+}
+
+void CoarsePass::WinnerTakeAll(const MoveGrid& fine, const LabelTerm& term, GridMaxflow& solver) {
+  const DepthConfig& config = term.config;
+  const size_t ring_size = term.data.CarriedRingSize();
+  MoveGrid& g = grid_;
   const int32_t n = g.width * g.height;
   for (int32_t p = 0; p < n; ++p) {
     g.cost[p] = 0xffff;
     g.labels[p] = 0;
   }
-  // The moves would compute these costs again, label by label: kept when there is room (Carve
-  // makes it).
-  const int32_t coarse_labels = (config_.labels + config_.coarse_step - 1) / config_.coarse_step;
+  // The moves would compute these costs again, label by label: kept when there is room (the
+  // stage's Carve makes it).
+  const int32_t coarse_labels = (config.labels + config.coarse_step - 1) / config.coarse_step;
   size_t spare = 0;
-  uint8_t* room = maxflow_.Spare(g.width, g.height, &spare);
-  block_costs_ = spare >= CoarseLayout(1).block_bytes ? reinterpret_cast<uint16_t*>(room) : nullptr;
+  uint8_t* room = solver.Spare(g.width, g.height, &spare);
+  block_costs_ = spare >= Layout(config, ring_size, 1).block_bytes
+                     ? reinterpret_cast<uint16_t*>(room)
+                     : nullptr;
   // Stripes of block rows, one per worker, each going down in bands of `band` block rows with
   // its own ring of 3-sums per label carried from band to band (after the block costs, when
   // there is room; with fewer stripes if that is what fits).
-  int32_t stripes = striped_winners_ ? CoarseStripes(data_.runner().workers()) : 1;
-  while (stripes > 1 && spare < CoarseLayout(stripes).rings_end) --stripes;
-  const CoarseRoom at = CoarseLayout(stripes);
+  int32_t stripes = striped_winners_ ? Stripes(config, term.data.runner().workers()) : 1;
+  while (stripes > 1 && spare < Layout(config, ring_size, stripes).rings_end) --stripes;
+  const Room at = Layout(config, ring_size, stripes);
   uint16_t* rings = block_costs_ != nullptr && spare >= at.rings_end
                         ? reinterpret_cast<uint16_t*>(room + at.rings_at)
                         : nullptr;
   // The winners' pixel D and labels, after those: the coarse moves leave most blocks their
-  // label (89 % for the plane sweep on a handheld burst, 90 % on teddy, 58 % for the rectified
-  // shifts on that burst), so the hand-over finds their D here.
+  // label, so the hand-over finds their D here.
   const bool winners = keep_winners_ && rings != nullptr && spare >= at.end;
   winner_costs_ = winners ? reinterpret_cast<uint16_t*>(room + at.winners_at) : nullptr;
   winner_labels_ = winners ? room + at.labels_at : nullptr;
   winner_stripes_ = static_cast<int16_t>(rings != nullptr ? stripes : 0);
   if (rings != nullptr) {
     // Each stripe's blocks, pixels and rings are its own: the same bits for any number.
-    ParallelFor(data_.runner(), stripes, [&](int32_t s, int32_t worker) {
-      const Rect stripe{0, g.width, g.height * s / stripes, g.height * (s + 1) / stripes};
-      WinnersOfStripe(stripe, rings + data_.CarriedRingSize() * coarse_labels * s, worker);
+    ParallelFor(term.data.runner(), stripes, [&](int32_t s, int32_t worker) {
+      const MoveRect stripe{0, g.width, g.height * s / stripes, g.height * (s + 1) / stripes};
+      WinnersOfStripe(fine, term, stripe, rings + ring_size * coarse_labels * s, worker);
     });
   } else {
     // Band by band, every label in turn: the views' rows of a band stay in cache from one label
     // to the next (the data term streams every view once per call). A band costs the data
     // term two more rows, so bands are not too thin either. The labels come in order per block.
-    const int32_t band = Max(1, kBandPixels / config_.width / 2);  // block rows
+    const int32_t band = Max(1, kBandPixels / config.width / 2);  // block rows
     for (int32_t by0 = 0; by0 < g.height; by0 += band) {
-      const Rect rows{0, g.width, by0, Min(by0 + band, g.height)};
-      for (int32_t label = 0; label < config_.labels; label += config_.coarse_step) {
-        uint16_t* d = block_costs_ != nullptr ? CoarseCosts(label) : g.cost_alpha;
-        BlockCosts(label, rows, d);
+      const MoveRect rows{0, g.width, by0, Min(by0 + band, g.height)};
+      for (int32_t label = 0; label < config.labels; label += config.coarse_step) {
+        uint16_t* d =
+            block_costs_ != nullptr ? CoarseCosts(label, config.coarse_step) : g.cost_alpha;
+        BlockCosts(fine, term, label, rows, d);
         const int32_t p0 = rows.y0 * g.width;
         TakeBetter(d + p0, (rows.y1 - rows.y0) * g.width, static_cast<uint8_t>(label), g.cost + p0,
                    g.labels + p0);
@@ -159,16 +162,18 @@ void DepthStage::CoarseWinnerTakeAll() {
   if (winner_labels_ != nullptr) memcpy(winner_labels_, g.labels, static_cast<size_t>(n));
 }
 
-void DepthStage::WinnersOfStripe(const Rect& stripe, uint16_t* rings, int32_t worker) {
-  Grid& g = coarse_;
-  const int32_t band = Max(1, kBandPixels / config_.width / 2);
+void CoarsePass::WinnersOfStripe(const MoveGrid& fine, const LabelTerm& term,
+                                 const MoveRect& stripe, uint16_t* rings, int32_t worker) {
+  const DepthConfig& config = term.config;
+  MoveGrid& g = grid_;
+  const int32_t band = Max(1, kBandPixels / config.width / 2);
   for (int32_t by0 = stripe.y0; by0 < stripe.y1; by0 += band) {
-    const Rect rows{0, g.width, by0, Min(by0 + band, stripe.y1)};
-    for (int32_t label = 0; label < config_.labels; label += config_.coarse_step) {
-      uint16_t* d = CoarseCosts(label);
-      uint16_t* ring = rings + data_.CarriedRingSize() * (label / config_.coarse_step);
-      BlockCosts(label, rows, d, ring, by0 > stripe.y0, worker);
-      if (winner_costs_ != nullptr) KeepWinners(rows, d);
+    const MoveRect rows{0, g.width, by0, Min(by0 + band, stripe.y1)};
+    for (int32_t label = 0; label < config.labels; label += config.coarse_step) {
+      uint16_t* d = CoarseCosts(label, config.coarse_step);
+      uint16_t* ring = rings + term.data.CarriedRingSize() * (label / config.coarse_step);
+      BlockCosts(fine, term, label, rows, d, ring, by0 > stripe.y0, worker);
+      if (winner_costs_ != nullptr) KeepWinnerCosts(fine, rows, d);
       const int32_t p0 = rows.y0 * g.width;
       TakeBetter(d + p0, (rows.y1 - rows.y0) * g.width, static_cast<uint8_t>(label), g.cost + p0,
                  g.labels + p0);
@@ -177,16 +182,18 @@ void DepthStage::WinnersOfStripe(const Rect& stripe, uint16_t* rings, int32_t wo
 }
 
 // Before the winner-take-all takes a label's block costs d over the band b: the pixels' D
-// (fine_.cost_alpha, as BlockCosts left it) of the blocks the label wins, into winner_costs_.
+// (the fine grid's cost_alpha, as BlockCosts left it) of the blocks the label wins, into
+// winner_costs_.
 // A block's two pixels of a row as one 32-bit word, so the loop vectorizes.
-LB_CLONES_AVX2 void DepthStage::KeepWinners(const Rect& b, const uint16_t* d) {
-  const int32_t w = fine_.width, h = fine_.height, bw = coarse_.width;
+LB_CLONES_AVX2 void CoarsePass::KeepWinnerCosts(const MoveGrid& fine, const MoveRect& b,
+                                                const uint16_t* d) {
+  const int32_t w = fine.width, h = fine.height, bw = grid_.width;
   const int32_t whole = Min(b.x1, w / 2);  // blocks of two columns; an odd last one has one
   for (int32_t by = b.y0; by < b.y1; ++by) {
     const uint16_t* block_d = d + by * bw;
-    const uint16_t* best = coarse_.cost + by * bw;
+    const uint16_t* best = grid_.cost + by * bw;
     for (int32_t y = 2 * by; y < 2 * by + 2 && y < h; ++y) {
-      const uint16_t* from = fine_.cost_alpha + y * w;
+      const uint16_t* from = fine.cost_alpha + y * w;
       uint16_t* to = winner_costs_ + y * w;
       for (int32_t bx = b.x0; bx < whole; ++bx) {
         uint32_t a, k;
@@ -203,27 +210,30 @@ LB_CLONES_AVX2 void DepthStage::KeepWinners(const Rect& b, const uint16_t* d) {
   }
 }
 
-void DepthStage::CoarsePass() {
-  BlockWeights();
-  on_coarse_ = true;
-  CoarseWinnerTakeAll();
-  energy_ = GridEnergy(coarse_);
-  stats_.initial_energy = energy_;
-  for (int32_t y = 0; y < coarse_.height; ++y) {
-    RowLabels(coarse_, y);
-    coarse_.row_took[y] = 0;
-    coarse_.span[2 * y] = coarse_.span[2 * y + 1] = 0;
+void CoarsePass::Start(const MoveGrid& fine, const LabelTerm& term, GridMaxflow& solver) {
+  BlockWeights(fine);
+  WinnerTakeAll(fine, term, solver);
+  for (int32_t y = 0; y < grid_.height; ++y) {
+    RowLabels(grid_, term.config.labels, y);
+    grid_.row_took[y] = 0;
+    grid_.span[2 * y] = grid_.span[2 * y + 1] = 0;
   }
-  window_ = DepthConfig::kMaxLabels;
-  uint16_t* const scratch = coarse_.cost_alpha;
-  for (int32_t alpha = 0; alpha < config_.labels; alpha += config_.coarse_step) {
-    if (Expand(alpha)) ++stats_.moves;
+  scratch_ = grid_.cost_alpha;
+}
+
+void CoarsePass::MoveCosts(int32_t alpha, const MoveRect& r, MoveGrid& fine,
+                           const LabelTerm& term) {
+  if (block_costs_ != nullptr) {
+    grid_.cost_alpha = CoarseCosts(alpha, term.config.coarse_step);  // from the winner-take-all
+  } else {
+    BlockCosts(fine, term, alpha, r, grid_.cost_alpha);
   }
-  coarse_.cost_alpha = scratch;
+}
+
+void CoarsePass::Finish(MoveGrid& fine, const LabelTerm& term, RowRuns* runs, uint8_t* marks) {
+  grid_.cost_alpha = scratch_;
   block_costs_ = nullptr;
-  stats_.coarse_energy = energy_;
-  on_coarse_ = false;
-  FineFromBlocks();
+  FineFromBlocks(fine, term, runs, marks);
   winner_costs_ = nullptr;
   winner_labels_ = nullptr;
 }
@@ -231,22 +241,23 @@ void DepthStage::CoarsePass() {
 // Every pixel takes its block's label. Its D is the winner-take-all's where the block kept the
 // label it won there (when kept: winner_costs_), else it comes from one pass of the data term
 // per label those others hold, each row over the runs of its pixels of the label.
-void DepthStage::FineFromBlocks() {
-  const int32_t w = config_.width, h = config_.height, bw = coarse_.width;
+void CoarsePass::FineFromBlocks(MoveGrid& fine, const LabelTerm& term, RowRuns* runs,
+                                uint8_t* marks) {
+  const int32_t w = fine.width, h = fine.height, bw = grid_.width, labels = term.config.labels;
   uint64_t present[4] = {};  // the labels whose D is needed
   handover_kept_ = 0;
   for (int32_t y = 0; y < h; ++y) {
-    const uint8_t* block = coarse_.labels + (y / 2) * bw;
-    uint8_t* f = fine_.labels + y * w;
+    const uint8_t* block = grid_.labels + (y / 2) * bw;
+    uint8_t* f = fine.labels + y * w;
     for (int32_t x = 0; x < w; ++x) f[x] = block[x / 2];
-    RowLabels(fine_, y);
+    RowLabels(fine, labels, y);
     if (winner_costs_ == nullptr) {
-      for (int32_t i = 0; i < 4; ++i) present[i] |= fine_.row_labels[4 * y + i];
+      for (int32_t i = 0; i < 4; ++i) present[i] |= fine.row_labels[4 * y + i];
       continue;
     }
     const uint8_t* won = winner_labels_ + (y / 2) * bw;
     const uint16_t* kept = winner_costs_ + y * w;
-    uint16_t* cost = fine_.cost + y * w;
+    uint16_t* cost = fine.cost + y * w;
     for (int32_t x = 0; x < w; ++x) {
       if (won[x / 2] == f[x]) {
         cost[x] = kept[x];
@@ -257,15 +268,15 @@ void DepthStage::FineFromBlocks() {
     }
   }
   // Each row over the runs of its own pixels of the label.
-  uint8_t* const mark = run_marks_;
-  for (int32_t l = 0; l < config_.labels; ++l) {
+  uint8_t* const mark = marks;
+  for (int32_t l = 0; l < labels; ++l) {
     if (((present[l >> 6] >> (l & 63)) & 1) == 0) continue;
     const uint8_t label = static_cast<uint8_t>(l);
-    UseLabelPlanes(l);
+    term.Use(l);
     for (int32_t y = 0; y < h; ++y) {
-      runs_[y].count = 0;
-      if (((fine_.row_labels[4 * y + (l >> 6)] >> (l & 63)) & 1) == 0) continue;
-      const uint8_t* f = fine_.labels + y * w;
+      runs[y].count = 0;
+      if (((fine.row_labels[4 * y + (l >> 6)] >> (l & 63)) & 1) == 0) continue;
+      const uint8_t* f = fine.labels + y * w;
       const int32_t x0 = static_cast<int32_t>(
           static_cast<const uint8_t*>(memchr(f, label, static_cast<size_t>(w))) - f);
       const int32_t x1 = static_cast<int32_t>(static_cast<const uint8_t*>(memrchr(
@@ -278,22 +289,20 @@ void DepthStage::FineFromBlocks() {
         const uint8_t* won = winner_labels_ + (y / 2) * bw;
         for (int32_t x = x0; x < x1; ++x) mark[x] = f[x] == label && won[x / 2] != label ? 1 : 0;
       }
-      runs_[y].FromMarks(mark, x0, x1, w, data_.RunJoin());
+      runs[y].FromMarks(mark, x0, x1, w, term.data.RunJoin());
     }
-    data_.ComputeRuns(LabelDispQ8(l), runs_, 0, h, fine_.cost_alpha, w);
+    term.data.ComputeRuns(term.DispQ8(l), runs, 0, h, fine.cost_alpha, w);
     for (int32_t y = 0; y < h; ++y) {
-      const uint8_t* f = fine_.labels + y * w;
-      uint16_t* cost = fine_.cost + y * w;
-      const uint16_t* d = fine_.cost_alpha + y * w;
-      for (int32_t k = 0; k < runs_[y].count; ++k) {
-        for (int32_t x = runs_[y].x[2 * k]; x < runs_[y].x[2 * k + 1]; ++x) {
+      const uint8_t* f = fine.labels + y * w;
+      uint16_t* cost = fine.cost + y * w;
+      const uint16_t* d = fine.cost_alpha + y * w;
+      for (int32_t k = 0; k < runs[y].count; ++k) {
+        for (int32_t x = runs[y].x[2 * k]; x < runs[y].x[2 * k + 1]; ++x) {
           if (f[x] == label) cost[x] = d[x];
         }
       }
     }
   }
-  energy_ = GridEnergy(fine_);
-  stats_.handover_energy = energy_;
 }
 
 }  // namespace lb
