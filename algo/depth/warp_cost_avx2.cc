@@ -9,9 +9,10 @@
 // spans go one by one (AnySpan): their steps take their taps from byte shuffles of 32-byte
 // windows of the two rows when they share them, else from scalar loads (AVX2 gathers are slower
 // than those on some cores). Views narrower than a step or too large for 32-bit offsets, and
-// census weights over 31, take the reference. Also the anchors' exact divisions, four at a time
-// (PlaneAnchorsAvx2; the C reference is dtk::PlaneAnchorsC).
-#include "algo/depth/data_term_kernels.h"
+// census weights over 31, take the reference. The band tests, the reference lanes and the
+// anchors' divisions are in warp_cost_prep_avx2.cc, the pieces both files use in
+// warp_cost_avx2.h.
+#include "algo/depth/warp_cost_avx2.h"
 
 #if defined(__x86_64__)
 #include <immintrin.h>
@@ -19,56 +20,17 @@
 #include <cstring>
 
 #include "algo/core/int_math.h"
-#define LB_AVX2 __attribute__((target("avx2")))
 
 namespace lb::dtk {
 namespace {
 
-constexpr int32_t kLanes = 8;
-
-// Byte shuffles, per 32-bit lane: `pair` puts bytes 0 and 3 of a loaded RGBR / BRGB word in the
-// two 16-bit halves (the same channel of two neighbouring pixels); `pair_g` does so for bytes 1
-// and 2 (the green pair, after a blend of the two words). ref[c] picks channel c of pixels 0-3
-// from the low half of 24 reference bytes loaded as bytes 0-15 and 8-23 (pixels 4-7 from the
-// high half). nibble_bits: the bit count of each nibble.
-struct Masks {
-  alignas(32) int8_t pair[32], pair_g[32], ref[3][32], nibble_bits[32];
-  constexpr Masks() : pair(), pair_g(), ref(), nibble_bits() {
-    for (int32_t i = 0; i < 32; ++i) {
-      const int32_t k = i % 4, dword = (i % 16) & ~3;  // shuffles index within 128-bit halves
-      pair[i] = static_cast<int8_t>(k == 0 ? dword : k == 2 ? dword + 3 : -128);
-      pair_g[i] = static_cast<int8_t>(k == 0 ? dword + 1 : k == 2 ? dword + 2 : -128);
-      for (int32_t c = 0; c < 3; ++c) {
-        const int32_t pixel = (i % 16) / 4, first = i < 16 ? 0 : 4;  // high half: bytes 8-23
-        ref[c][i] = static_cast<int8_t>(k == 0 ? first + 3 * pixel + c : -128);
-      }
-      nibble_bits[i] = static_cast<int8_t>(__builtin_popcount(i % 16));
-    }
-  }
-};
-constexpr Masks kMasks;
-
-// Broadcast constants as tables, so the loop reads them as memory operands instead of rebuilding
-// them in registers it has too few of.
-struct Dup {
-  alignas(32) int32_t v[8];
-  constexpr explicit Dup(uint32_t x) : v() {
-    for (int32_t& e : v) e = static_cast<int32_t>(x);
-  }
-};
-struct Constants {
-  Dup q8_half{128}, near{127}, one{256}, half{32768}, max_cost{255};
-  Dup bytes15{0x0f0f0f0fu}, ones8{0x01010101u}, ones16{0x00010001u};
-  // Pair indices per channel: bytes [c, zero, c + 3, zero] (added to 3 x - start in both
-  // halves); census indices per plane: the byte in place, the others zero.
-  Dup pair_idx[3] = {Dup{0x80038000u}, Dup{0x80048001u}, Dup{0x80058002u}};
-  Dup census_idx[3] = {Dup{0x80008080u}, Dup{0x80800080u}, Dup{0x80808000u}};
-};
-constexpr Constants kC;
-
-LB_AVX2 inline __m256i Load(const void* p) {
-  return _mm256_load_si256(static_cast<const __m256i*>(p));
-}
+using plane_avx2::BandsOfRun;
+using plane_avx2::kC;
+using plane_avx2::kLanes;
+using plane_avx2::kMasks;
+using plane_avx2::kTwoCensus;
+using plane_avx2::kTwoRows;
+using plane_avx2::Load;
 
 // Dwords 0 and 2 (bits 0-31 and 16-47, or with shift 16 bits 16-47 and 32-63) of 8 quadwords,
 // in order.
@@ -83,11 +45,6 @@ LB_AVX2 inline void Dwords(const uint64_t* q, int32_t shift, __m256i* d0, __m256
       _mm256_castps_si256(_mm256_shuffle_ps(_mm256_castsi256_ps(lo2), _mm256_castsi256_ps(hi2),
                                             _MM_SHUFFLE(2, 0, 2, 0))),
       _MM_SHUFFLE(3, 1, 2, 0));
-}
-
-// 8 bytes of a plane, one per 32-bit lane.
-LB_AVX2 inline __m256i Widen8(const uint8_t* p) {
-  return _mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)));
 }
 
 // The taps of 8 pixels: per row and channel c, dwords [a_c 0 b_c 0] (the channel of the pair's
@@ -118,8 +75,8 @@ LB_AVX2 inline void Pairs(__m256i ab0, __m256i ab2, __m256i* pairs) {
 // every step (three instructions each).
 struct Consts {
   __m256i xmax, ymax, wm2, hm2, stride, census_row, trunc, invalid, lut, last_window;
-  const Constants* c;
-  const Masks* m;
+  const plane_avx2::Constants* c;
+  const plane_avx2::Masks* m;
 };
 
 template <typename T>
@@ -201,13 +158,6 @@ LB_AVX2 inline __attribute__((always_inline)) void WindowTaps(const WarpRow& r, 
 }
 
 // The costs of pixels x..x+7 from their truncated colour differences ad and their census taps.
-// The reference's census of pixels x..x+7, 24 bits a lane.
-LB_AVX2 inline __m256i RefCensus(const WarpRow& r, int32_t x) {
-  return _mm256_or_si256(_mm256_or_si256(_mm256_slli_epi32(Widen8(r.cref + x), 16),
-                                         _mm256_slli_epi32(Widen8(r.cref + r.width + x), 8)),
-                         Widen8(r.cref + 2 * r.width + x));
-}
-
 LB_AVX2 inline __attribute__((always_inline)) __m256i CostFromTaps(const Consts& k, __m256i ad,
                                                                    __m256i census,
                                                                    __m256i ref_bits) {
@@ -238,7 +188,7 @@ LB_AVX2 inline __attribute__((always_inline)) __m256i Cost(const WarpRow& r, con
     const __m256i rc = _mm256_shuffle_epi8(ref, Load(k.m->ref[c]));
     ad = _mm256_add_epi32(ad, _mm256_abs_epi32(_mm256_sub_epi32(rc, v)));
   }
-  return CostFromTaps(k, _mm256_min_epi32(ad, k.trunc), t.census, RefCensus(r, x));
+  return CostFromTaps(k, _mm256_min_epi32(ad, k.trunc), t.census, plane_avx2::RefCensus(r, x));
 }
 
 // 8 costs 0..255: two packs leave pixels 0-3 in dword 0 and 4-7 in dword 4, joined for one store.
@@ -533,206 +483,7 @@ LB_AVX2 void AnySpan(const WarpRow& r, const Consts& k, const WarpSpanJob* job, 
   }
 }
 
-// Unsigned v <= max per lane (AVX2 compares only signed).
-LB_AVX2 inline __m256i AtMost(__m256i v, __m256i max) {
-  return _mm256_cmpeq_epi32(_mm256_min_epu32(v, max), v);
-}
-
-// What the run's band spans need, 8 spans at once (BandOf's tests, lane by lane): a span of
-// kAnchorStep pixels (the row's short last span is not one), both anchors inside the view, its
-// tap rows and census rows each within two neighbouring rows, and the positions advancing at
-// most 9/8 px per pixel; not the row's last span when its end column is wanted, nor one the
-// wanted columns cut (AnySpan steps only their wanted part). For each: its
-// upper tap row and census row (and their offsets), its x and y change over the span (Q16), and
-// kind bits (kInBand, kTwoRows, kTwoCensus, kRising).
-enum : int32_t { kInBand = 1, kTwoRows = 2, kTwoCensus = 4, kRising = 8 };
-struct RunBands {
-  alignas(32) int32_t y[kRunSpans], cy[kRunSpans], dx[kRunSpans], dy[kRunSpans], kind[kRunSpans];
-  alignas(32) int32_t row[kRunSpans], crow[kRunSpans];  // y * stride, cy * 3 * width
-};
-
-// Spans first .. end - 1 (end - first <= kRunSpans) into b, indexed from `first`. Lanes past
-// `end` load nothing (masked loads: the anchors may end there).
-LB_AVX2 void BandsOfRun(const WarpRow& r, const WarpRun& run, int32_t first, int32_t end,
-                        RunBands* b) {
-  const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  const __m256i xmax = _mm256_set1_epi32((r.width - 1) * 256);
-  const __m256i ymax = _mm256_set1_epi32((r.height - 1) * 256);
-  const __m256i hm2 = _mm256_set1_epi32(r.height - 2);
-  const __m256i q8_half = _mm256_set1_epi32(128), one = _mm256_set1_epi32(1);
-  const __m256i reach = _mm256_set1_epi32(kAnchorStep * 73728);
-  // The row's last span, when its end anchor's column is wanted too (a 17th), is not stepped
-  // as one of the band, nor is a span the wanted columns lo..hi-1 cut.
-  const __m256i last = _mm256_set1_epi32(run.hi > run.last ? run.last - 1 : run.last);
-  const __m256i lo = _mm256_set1_epi32(run.lo), hi = _mm256_set1_epi32(run.hi);
-  const __m256i stride = _mm256_set1_epi32(static_cast<int32_t>(r.stride));
-  const __m256i census_row = _mm256_set1_epi32(3 * r.width);
-  for (int32_t g = first; g < end; g += kLanes) {
-    const __m256i lanes = _mm256_cmpgt_epi32(_mm256_set1_epi32(end - g), iota);
-    const __m256i ax = _mm256_maskload_epi32(run.x_q16 + g, lanes);
-    const __m256i bx = _mm256_maskload_epi32(run.x_q16 + g + 1, lanes);
-    const __m256i ay = _mm256_maskload_epi32(run.y_q16 + g, lanes);
-    const __m256i by = _mm256_maskload_epi32(run.y_q16 + g + 1, lanes);
-    // The span's end column x0 + kAnchorStep (k + 1) must be an anchor: not past `last`.
-    const __m256i span_end = _mm256_add_epi32(_mm256_set1_epi32(run.x0 + kAnchorStep * (g + 1)),
-                                              _mm256_slli_epi32(iota, 4));  // kAnchorStep = 16
-    __m256i bad =
-        _mm256_or_si256(_mm256_cmpgt_epi32(span_end, last), _mm256_cmpgt_epi32(span_end, hi));
-    bad = _mm256_or_si256(
-        bad, _mm256_cmpgt_epi32(lo, _mm256_sub_epi32(span_end, _mm256_set1_epi32(kAnchorStep))));
-    const __m256i dx = _mm256_sub_epi32(bx, ax), dy = _mm256_sub_epi32(by, ay);
-    bad = _mm256_or_si256(bad, _mm256_cmpgt_epi32(_mm256_abs_epi32(dx), reach));
-    const __m256i xa = _mm256_srai_epi32(_mm256_add_epi32(ax, q8_half), 8);
-    const __m256i xb = _mm256_srai_epi32(_mm256_add_epi32(bx, q8_half), 8);
-    const __m256i ya = _mm256_srai_epi32(_mm256_add_epi32(ay, q8_half), 8);
-    const __m256i yb = _mm256_srai_epi32(_mm256_add_epi32(by, q8_half), 8);
-    const __m256i inside = _mm256_and_si256(_mm256_and_si256(AtMost(xa, xmax), AtMost(xb, xmax)),
-                                            _mm256_and_si256(AtMost(ya, ymax), AtMost(yb, ymax)));
-    const __m256i row_a = _mm256_min_epi32(_mm256_srai_epi32(ya, 8), hm2);
-    const __m256i row_b = _mm256_min_epi32(_mm256_srai_epi32(yb, 8), hm2);
-    const __m256i near_a = _mm256_srai_epi32(_mm256_add_epi32(ya, q8_half), 8);
-    const __m256i near_b = _mm256_srai_epi32(_mm256_add_epi32(yb, q8_half), 8);
-    const __m256i row_d = _mm256_sub_epi32(row_a, row_b), near_d = _mm256_sub_epi32(near_a, near_b);
-    bad = _mm256_or_si256(bad, _mm256_cmpgt_epi32(_mm256_abs_epi32(row_d), one));
-    bad = _mm256_or_si256(bad, _mm256_cmpgt_epi32(_mm256_abs_epi32(near_d), one));
-    const __m256i in_band = _mm256_andnot_si256(bad, _mm256_and_si256(inside, lanes));
-    const __m256i zero = _mm256_setzero_si256();
-    __m256i kind = _mm256_and_si256(in_band, _mm256_set1_epi32(kInBand));
-    kind = _mm256_or_si256(
-        kind, _mm256_andnot_si256(_mm256_cmpeq_epi32(row_d, zero), _mm256_set1_epi32(kTwoRows)));
-    kind = _mm256_or_si256(
-        kind, _mm256_andnot_si256(_mm256_cmpeq_epi32(near_d, zero), _mm256_set1_epi32(kTwoCensus)));
-    kind = _mm256_or_si256(
-        kind, _mm256_andnot_si256(_mm256_cmpgt_epi32(zero, dx), _mm256_set1_epi32(kRising)));
-    const int32_t i = g - first;
-    const __m256i y = _mm256_min_epi32(row_a, row_b), cy = _mm256_min_epi32(near_a, near_b);
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->y + i), y);
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->cy + i), cy);
-    // Offsets of lanes in the band only (the view's bytes are below 2^31).
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->row + i),
-                        _mm256_and_si256(in_band, _mm256_mullo_epi32(y, stride)));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->crow + i),
-                        _mm256_and_si256(in_band, _mm256_mullo_epi32(cy, census_row)));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->dx + i), dx);
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->dy + i), dy);
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->kind + i), kind);
-  }
-}
-
 }  // namespace
-
-// RefLanes (warp_cost.h) of columns x0..x1-1: 8 columns a step from 24 bytes of the row and 8 of
-// each census plane (inside the row while x + 8 <= width), the rest one by one.
-LB_AVX2 void PlaneLanesAvx2(const uint8_t* ref, const uint8_t* cref, int32_t width, int32_t x0,
-                            int32_t x1, int32_t* lanes, ptrdiff_t stride) {
-  int32_t x = x0;
-  WarpRow r;
-  r.cref = cref;
-  r.width = width;
-  for (; x + kLanes <= x1 && x + kLanes <= width; x += kLanes) {
-    const __m128i lo = _mm_loadu_si128(reinterpret_cast<const __m128i*>(ref + 3 * x));
-    const __m128i hi = _mm_loadu_si128(reinterpret_cast<const __m128i*>(ref + 3 * x + 8));
-    const __m256i rgb = _mm256_inserti128_si256(_mm256_castsi128_si256(lo), hi, 1);
-    int32_t* const out = lanes + (x - x0);
-    for (int32_t c = 0; c < 3; ++c) {
-      _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + c * stride),
-                          _mm256_shuffle_epi8(rgb, Load(kMasks.ref[c])));
-    }
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + 3 * stride), RefCensus(r, x));
-  }
-  for (; x < x1; ++x) {
-    int32_t* const out = lanes + (x - x0);
-    for (int32_t c = 0; c < 3; ++c) out[c * stride] = ref[3 * x + c];
-    out[3 * stride] = static_cast<int32_t>((uint32_t{cref[x]} << 16) |
-                                           (uint32_t{cref[width + x]} << 8) | cref[2 * width + x]);
-  }
-}
-
-// Four anchors a step in 64-bit lanes, PlaneRowMap::FromSums's checks and exact quotients: |n|
-// < den 2^14 < 2^46 and den < 2^32 convert to double exactly (a value v < 2^52 ORed into 2^52's
-// bits is 2^52 + v), the quotient of num = |n| 2^16 + den / 2 is estimated through den's
-// reciprocal (three roundings: relative error under 2^-51, so within 1 of the floor for q <=
-// 2^30 + 1) and corrected by its remainder, which mul_epu32 gives exactly (q < 2^31, den <
-// 2^32). Lanes that fail a check take 0s, whatever their arithmetic gave.
-namespace {
-
-LB_AVX2 inline __m256d ExactDouble(__m256i v) {  // 0 <= v < 2^52
-  const __m256i bits = _mm256_set1_epi64x(0x4330000000000000);
-  return _mm256_sub_pd(_mm256_castsi256_pd(_mm256_or_si256(v, bits)), _mm256_castsi256_pd(bits));
-}
-
-// The rounded Q16 quotient n / den of 4 lanes (as PlaneRowMap's), given den's reciprocal.
-LB_AVX2 inline __m256i Quotient(__m256i n, __m256i den, __m256d den_half, __m256d inv) {
-  const __m256i zero = _mm256_setzero_si256();
-  const __m256i sign = _mm256_cmpgt_epi64(zero, n);
-  const __m256i a = _mm256_sub_epi64(_mm256_xor_si256(n, sign), sign);
-  const __m256i num = _mm256_add_epi64(_mm256_slli_epi64(a, 16), _mm256_srli_epi64(den, 1));
-  const __m256d num_d =
-      _mm256_add_pd(_mm256_mul_pd(ExactDouble(a), _mm256_set1_pd(65536.0)), den_half);
-  __m256i q = _mm256_cvtepi32_epi64(_mm256_cvttpd_epi32(_mm256_mul_pd(num_d, inv)));
-  const __m256i r = _mm256_sub_epi64(num, _mm256_mul_epu32(q, den));
-  q = _mm256_add_epi64(q, _mm256_cmpgt_epi64(zero, r));  // r < 0: one less
-  q = _mm256_sub_epi64(q, _mm256_cmpgt_epi64(r, _mm256_sub_epi64(den, _mm256_set1_epi64x(1))));
-  return _mm256_sub_epi64(_mm256_xor_si256(q, sign), sign);
-}
-
-// |n| < lim per lane (n = INT64_MIN fails: its |n| wraps negative).
-LB_AVX2 inline __m256i Within(__m256i n, __m256i lim) {
-  const __m256i sign = _mm256_cmpgt_epi64(_mm256_setzero_si256(), n);
-  const __m256i a = _mm256_sub_epi64(_mm256_xor_si256(n, sign), sign);
-  return _mm256_andnot_si256(_mm256_cmpgt_epi64(_mm256_setzero_si256(), a),
-                             _mm256_cmpgt_epi64(lim, a));
-}
-
-}  // namespace
-
-LB_AVX2 bool PlaneAnchorsAvx2(const int64_t* sums, const int64_t* changes, int32_t count,
-                              int32_t* x_q16, int32_t* y_q16, bool* ok) {
-  // Lane i holds anchor k + i: the sums at anchors 1..4, then 4 changes a step (the same
-  // integers as the reference's one change a step).
-  const __m256i step_den = _mm256_set1_epi64x(4 * changes[0]);
-  const __m256i step_nx = _mm256_set1_epi64x(4 * changes[1]);
-  const __m256i step_ny = _mm256_set1_epi64x(4 * changes[2]);
-  __m256i den = _mm256_setr_epi64x(sums[0] + changes[0], sums[0] + 2 * changes[0],
-                                   sums[0] + 3 * changes[0], sums[0] + 4 * changes[0]);
-  __m256i nx = _mm256_setr_epi64x(sums[1] + changes[1], sums[1] + 2 * changes[1],
-                                  sums[1] + 3 * changes[1], sums[1] + 4 * changes[1]);
-  __m256i ny = _mm256_setr_epi64x(sums[2] + changes[2], sums[2] + 2 * changes[2],
-                                  sums[2] + 3 * changes[2], sums[2] + 4 * changes[2]);
-  const __m256i min_den = _mm256_set1_epi64x((int64_t{1} << 20) - 1);
-  const __m256i max_den = _mm256_set1_epi64x(int64_t{1} << 32);
-  const __m256i low_dwords = _mm256_setr_epi32(0, 2, 4, 6, 0, 0, 0, 0);
-  int32_t bad = 0;
-  for (int32_t k = 0; k < count; k += 4) {
-    const __m256i lim = _mm256_slli_epi64(den, 14);
-    const __m256i valid = _mm256_and_si256(
-        _mm256_and_si256(_mm256_cmpgt_epi64(den, min_den), _mm256_cmpgt_epi64(max_den, den)),
-        _mm256_and_si256(Within(nx, lim), Within(ny, lim)));
-    // Invalid lanes' den may be anything: their quotients are dropped.
-    const __m256d den_d = ExactDouble(_mm256_and_si256(valid, den));
-    const __m256d inv = _mm256_div_pd(_mm256_set1_pd(1.0), den_d);
-    const __m256d den_half = ExactDouble(_mm256_and_si256(valid, _mm256_srli_epi64(den, 1)));
-    const __m256i qx = _mm256_and_si256(valid, Quotient(nx, den, den_half, inv));
-    const __m256i qy = _mm256_and_si256(valid, Quotient(ny, den, den_half, inv));
-    alignas(16) int32_t xs[4], ys[4];
-    _mm_store_si128(reinterpret_cast<__m128i*>(xs),
-                    _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(qx, low_dwords)));
-    _mm_store_si128(reinterpret_cast<__m128i*>(ys),
-                    _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(qy, low_dwords)));
-    const int32_t mask = _mm256_movemask_pd(_mm256_castsi256_pd(valid));
-    const int32_t n = Min(4, count - k);
-    for (int32_t i = 0; i < n; ++i) {
-      x_q16[k + i] = xs[i];
-      y_q16[k + i] = ys[i];
-      ok[k + i] = ((mask >> i) & 1) != 0;
-    }
-    bad |= ~mask & ((1 << n) - 1);
-    den = _mm256_add_epi64(den, step_den);
-    nx = _mm256_add_epi64(nx, step_nx);
-    ny = _mm256_add_epi64(ny, step_ny);
-  }
-  return bad == 0;
-}
 
 // A run at once: its spans' band tests 8 at a time (BandsOfRun), then each span of the band two
 // steps from its anchors, the rest (outside the view, partly, short, steep) one by one
@@ -762,7 +513,7 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpRun& run, uint8_t* out) 
   const __m256i eight = _mm256_set1_epi32(8);
   int32_t first = 0, end = 0;
   RunSpans(run, &first, &end);
-  RunBands bands;
+  plane_avx2::RunBands bands;
   // Without the caller's reference lanes, this kernel makes its own for each chunk of spans
   // (RefLanes' columns of at most kRunSpans spans: 16 kRunSpans + 1 + 16 + 39 < kLocalLanes).
   constexpr int32_t kLocalLanes = 16 * kRunSpans + 64;
@@ -794,7 +545,7 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpRun& run, uint8_t* out) 
     const ptrdiff_t lanes_stride = rl.lanes_stride;
     for (int32_t s = base; s < stop; ++s) {
       const int32_t i = s - base, kind = bands.kind[i];
-      if ((kind & kInBand) == 0) {
+      if ((kind & plane_avx2::kInBand) == 0) {
         const WarpSpanJob job = RunSpan(run, s);
         if (job.lo < job.hi) AnySpan(rl, k, &job, out);
         continue;
@@ -806,7 +557,7 @@ LB_AVX2 void PlaneSpansAvx2(const WarpRow& r, const WarpRun& run, uint8_t* out) 
                       bands.cy[i],
                       (kind & kTwoRows) != 0,
                       (kind & kTwoCensus) != 0,
-                      (kind & kRising) != 0,
+                      (kind & plane_avx2::kRising) != 0,
                       lanes_stride};
       const __m256i dx = _mm256_set1_epi32(bands.dx[i]), dy = _mm256_set1_epi32(bands.dy[i]);
       const __m256i tx = _mm256_add_epi32(_mm256_mullo_epi32(iota, dx), eight);
