@@ -8,6 +8,8 @@
 #if defined(__x86_64__)
 #include <immintrin.h>
 
+#include <cstddef>
+
 #define LB_AVX2 __attribute__((target("avx2")))
 
 namespace lb::gmf {
