@@ -6,20 +6,16 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
-#include <string_view>
 
 #include "firmware/app/focus.h"
 #include "firmware/app/job.h"
 #include "firmware/app/rerender.h"
 #include "firmware/codecs/image_file.h"
 #include "firmware/codecs/jpeg_writer.h"
-#include "firmware/codecs/png_reader.h"
 #include "firmware/platform/worker_pool.h"
-#include "firmware/refocusable/refocusable_reader.h"
 #include "firmware/storage/input_file.h"
 
 namespace lb {
@@ -79,28 +75,16 @@ Status RefocusEngine::Configure(const RefocusEngineConfig& config) {
   const size_t pixels = static_cast<size_t>(W) * H;
   if (config_.max_file_bytes == 0) config_.max_file_bytes = pixels + (size_t{1} << 20);
   const size_t file = config_.max_file_bytes;
-  const size_t cpx = static_cast<size_t>((W + 1) / 2) * ((H + 1) / 2);
   const int32_t pw = std::min(W, config.preview_side), ph = std::min(H, config.preview_side);
   const size_t ppx = static_cast<size_t>(pw) * ph;
   const size_t pcpx = static_cast<size_t>((pw + 1) / 2) * ((ph + 1) / 2);
   scratch_.reserve(file);
-  extended_.resize(file);
-  // As many chunks as the writer makes of a file this size (more: kOutOfMemory).
-  chunks_.resize(file / kExtendedXmpChunk + 2);
-  // Base64 in the extended XMP: at most 3/4 of the file; a 16-bit depth PNG, at most its
-  // values' bytes and a little (stored rows of 64 KiB deflate blocks).
-  const size_t depth_px =
-      std::min(pixels, static_cast<size_t>(std::max(1, config.max_depth_pixels)));
-  png_.reserve(std::min(file / 4 * 3, depth_px * 2 + depth_px / 64 + 65536));
-  original_.reserve(file / 4 * 3);
-  rgb_rows_.resize(static_cast<size_t>(W) * 6);
-  // The readers' strip: the original's RGB rows, then the depth PNG's 16-bit ones.
-  strip_.resize(ImageStripBytes(W, PixelFormat::kRgb8));
-  y_.resize(pixels);
-  cb_.resize(cpx);
-  cr_.resize(cpx);
-  depth_values_.resize(depth_px);
-  disp_q8_.resize(depth_values_.size());
+  RefocusableLimits limits;
+  limits.max_width = W;
+  limits.max_height = H;
+  limits.max_file_bytes = file;
+  limits.max_depth_pixels = config.max_depth_pixels;
+  LB_RETURN_IF_ERROR(file_.Configure(limits));
   py_.resize(ppx);
   pcb_.resize(pcpx);
   pcr_.resize(pcpx);
@@ -135,10 +119,8 @@ Status RefocusEngine::Configure(const RefocusEngineConfig& config) {
   writer_ = std::make_unique<JpegWriter>();
   pool_ = std::make_unique<WorkerPool>();
   LB_RETURN_IF_ERROR(pool_->Start(workers));
-  reserved_bytes_ = scratch_.capacity() + extended_.size() + png_.capacity() +
-                    original_.capacity() + rgb_rows_.size() + strip_.size() +
-                    chunks_.size() * sizeof(ExtendedXmpChunk) + pixels + 2 * cpx +
-                    4 * depth_values_.size() + ppx * 3 + 2 * pcpx + full_bytes_ + preview_bytes_;
+  reserved_bytes_ = scratch_.capacity() + file_.reserved_bytes() + ppx * 3 + 2 * pcpx +
+                    full_bytes_ + preview_bytes_;
   configured_ = true;
   return Status::Ok();
 }
@@ -164,7 +146,7 @@ Status RefocusEngine::LoadFile(const char* path) {
   }
   close(fd);
   if (done != size) return Status(Code::kIoError, "%s: read %zu of %zu bytes", path, done, size);
-  return ParseAndDecode(path, size);
+  return Decode(path, size);
 }
 
 Status RefocusEngine::Load(const char* path) {
@@ -180,92 +162,21 @@ Status RefocusEngine::Load(const char* path) {
   return Status::Ok();
 }
 
-Status RefocusEngine::ParseAndDecode(const char* path, size_t size) {
-  // The shared reader, into the buffers Configure sized (base64 outputs at full capacity, then
-  // cut to what was decoded: neither ever reallocates).
-  png_.resize(png_.capacity());
-  original_.resize(original_.capacity());
-  RefocusableBuffers memory;
-  memory.chunks = chunks_.data();
-  memory.chunk_capacity = chunks_.size();
-  memory.extended = extended_.data();
-  memory.extended_capacity = extended_.size();
-  memory.depth_png = png_.data();
-  memory.depth_png_capacity = png_.size();
-  memory.image = original_.data();
-  memory.image_capacity = original_.size();
-  RefocusableFields f;
-  Status s = ReadRefocusableFields(scratch_.data(), size, path, memory, &f);
-  png_.resize(f.depth_png_size);
-  original_.resize(f.image_size);
+Status RefocusEngine::Decode(const char* path, size_t size) {
+  Status s = file_.Decode(scratch_.data(), size, path);
   // No XMP or no depth map: a photo, but not one to refocus (kNotFound is for missing files).
   if (s.code() == Code::kNotFound) return Status(Code::kUnsupported, "%s", s.message());
   LB_RETURN_IF_ERROR(s);
-  if (f.depth_format != "RangeInverse") {
-    return Status(Code::kUnsupported, "%s: GDepth:Format '%.*s' (only RangeInverse)", path,
-                  static_cast<int>(std::min<size_t>(f.depth_format.size(), 32)),
-                  f.depth_format.data());
-  }
-  if (f.image == nullptr) {
-    return Status(Code::kUnsupported, "%s: no all-in-focus original (GImage)", path);
-  }
-  s = DisparityRangeFromNearFar(f.near_depth, f.far_depth, &range_);
-  if (!s.ok()) return s.Prefix("%s: ", path);
-
-  char what[300];
-  snprintf(what, sizeof(what), "%s: GImage", path);
-  ImageReadMemory strip;
-  strip.strip = strip_.data();
-  strip.strip_bytes = strip_.size();
-  strip.max_width = config_.max_width;
-  strip.max_height = config_.max_height;
-  Ycc420Sink ycc(y_.data(), cb_.data(), cr_.data(), rgb_rows_.data());
-  LB_RETURN_IF_ERROR(
-      StreamImageMemory(f.image, f.image_size, what, 0, ycc, strip, ImageFileType::kJpeg));
-  const int32_t width = ycc.frame().width, height = ycc.frame().height;
-  if (width < 16 || height < 16) {
-    return Status(Code::kUnsupported, "%s: a %dx%d original is too small to render", what, width,
-                  height);
-  }
-
-  DepthPngName(path, what, sizeof(what));
-  GrayPngBuffer depth;
-  depth.values = depth_values_.data();
-  depth.capacity = depth_values_.size();
-  depth.strip = strip_.data();
-  depth.strip_bytes = strip_.size();
-  LB_RETURN_IF_ERROR(DecodeGrayPngInto(f.depth_png, f.depth_png_size, what, f.depth_max_side,
-                                       f.depth_width, f.depth_height, &depth));
-  const int32_t dw = depth.width, dh = depth.height;
-  const int32_t scale = width / dw;
-  if (scale < 1 || dw * scale > width || dh * scale > height || height / scale != dh) {
-    return Status(Code::kUnsupported,
-                  "%s: depth map %dx%d is not a whole-number fraction of the %dx%d original", path,
-                  dw, dh, width, height);
-  }
-  LB_RETURN_IF_ERROR(DecodeDepthMap(MakeView<const uint16_t>(depth_values_.data(), dw, dh), range_,
-                                    depth.bits, MakeView(disp_q8_.data(), dw, dh)));
-  depth_w_ = dw;
-  depth_h_ = dh;
   photo_ = EnginePhoto();
-  photo_.width = width;
-  photo_.height = height;
-  photo_.orientation = f.orientation;
-  photo_.working_scale = scale;
-  // What it was rendered with: lens_model.h's blur at infinity is 2 * (2.8 / f) * scale * d_focus
-  // px, d_focus = 1 / FocalDistance, so the f-number comes back from the two.
+  photo_.width = file_.width();
+  photo_.height = file_.height();
+  photo_.orientation = file_.orientation();
+  photo_.working_scale = file_.working_scale();
+  // What it was rendered with (GFocus), else the middle at f/2.8.
   RenderParams& cur = photo_.current;
-  const GFocusInfo& focus = f.focus;
-  const double fx = f.has_focus ? focus.focal_point_x : 0.5;
-  const double fy = f.has_focus ? focus.focal_point_y : 0.5;
-  cur.focus = FocusAtPoint(static_cast<int32_t>(fx * width), static_cast<int32_t>(fy * height));
-  cur.f_number = 2.8f;
-  if (f.has_focus && focus.blur_at_infinity > 0 && focus.focal_distance > 0) {
-    const double fn = 5.6 * scale / (focus.focal_distance * focus.blur_at_infinity * width);
-    if (std::isfinite(fn))
-      cur.f_number = static_cast<float>(
-          std::clamp(fn, double{RenderParams::kMinFNumber}, double{RenderParams::kMaxFNumber}));
-  }
+  cur.focus = file_.has_file_focus() ? file_.file_focus()
+                                     : FocusAtPoint(photo_.width / 2, photo_.height / 2);
+  cur.f_number = file_.has_file_focus() ? file_.file_f_number() : 2.8f;
   return Status::Ok();
 }
 
@@ -275,15 +186,17 @@ Status RefocusEngine::MakePreviewInputs() {
   while ((std::max(w, h) + step - 1) / step > side) ++step;
   preview_step_ = step;
   const int32_t scale = photo_.working_scale;
+  const ConstImageU16 disp = file_.disparity_q8();
+  const int32_t depth_w = disp.width, depth_h = disp.height;
   int32_t pw, ph;
   if (scale % step == 0) {
     // The depth map as it is, upsampled by the render stage as at full size.
     preview_scale_ = scale / step;
-    preview_dw_ = depth_w_;
-    preview_dh_ = depth_h_;
-    pw = depth_w_ * preview_scale_;
-    ph = depth_h_ * preview_scale_;
-    preview_disp_ = disp_q8_.data();
+    preview_dw_ = depth_w;
+    preview_dh_ = depth_h;
+    pw = depth_w * preview_scale_;
+    ph = depth_h * preview_scale_;
+    preview_disp_ = disp.data;
   } else {
     // Nearest depth per preview pixel, in preview pixels per view step.
     preview_scale_ = 1;
@@ -292,10 +205,10 @@ Status RefocusEngine::MakePreviewInputs() {
     preview_dw_ = pw;
     preview_dh_ = ph;
     for (int32_t y = 0; y < ph; ++y) {
-      const int32_t sy = std::min((y * step + step / 2) / scale, depth_h_ - 1);
+      const int32_t sy = std::min((y * step + step / 2) / scale, depth_h - 1);
       for (int32_t x = 0; x < pw; ++x) {
-        const int32_t sx = std::min((x * step + step / 2) / scale, depth_w_ - 1);
-        const int64_t d = disp_q8_[static_cast<size_t>(sy) * depth_w_ + sx];
+        const int32_t sx = std::min((x * step + step / 2) / scale, depth_w - 1);
+        const int64_t d = disp.Row(sy)[sx];
         pdisp_q8_[static_cast<size_t>(y) * pw + x] =
             static_cast<uint16_t>(std::min<int64_t>((d * scale + step / 2) / step, 65535));
       }
@@ -308,10 +221,11 @@ Status RefocusEngine::MakePreviewInputs() {
   photo_.preview_width = pw;
   photo_.preview_height = ph;
   if (step > 1) {
-    BoxDown(y_.data(), w, h, step, py_.data(), pw, ph);
+    const ConstPlanarU8 ref = file_.reference();
+    BoxDown(ref.planes[0].data, w, h, step, py_.data(), pw, ph);
     const int32_t cw = (w + 1) / 2, ch = (h + 1) / 2;
-    BoxDown(cb_.data(), cw, ch, step, pcb_.data(), (pw + 1) / 2, (ph + 1) / 2);
-    BoxDown(cr_.data(), cw, ch, step, pcr_.data(), (pw + 1) / 2, (ph + 1) / 2);
+    BoxDown(ref.planes[1].data, cw, ch, step, pcb_.data(), (pw + 1) / 2, (ph + 1) / 2);
+    BoxDown(ref.planes[2].data, cw, ch, step, pcr_.data(), (pw + 1) / 2, (ph + 1) / 2);
   }
   return Status::Ok();
 }
@@ -325,42 +239,47 @@ Status RefocusEngine::RenderInto(RenderStage* stage, const RenderParams& params,
   if (!loaded_) return Status(Code::kInvalidArgument, "refocus engine: render before Load");
   LB_RETURN_IF_ERROR(RenderStage::ValidateParams(params));
   const int32_t step = preview ? preview_step_ : 1;
-  RenderConfig rc;
-  rc.width = preview ? photo_.preview_width : photo_.width;
-  rc.height = preview ? photo_.preview_height : photo_.height;
-  rc.working_scale = preview ? preview_scale_ : photo_.working_scale;
-  rc.working_width = preview ? preview_dw_ : depth_w_;
-  rc.working_height = preview ? preview_dh_ : depth_h_;
-  rc.max_radius = std::max(1, (config_.max_blur_radius + step / 2) / step);
-  rc.workers = pool_->workers();
-  LB_RETURN_IF_ERROR(RenderStage::Validate(rc));
-  const size_t capacity = preview ? preview_bytes_ : full_bytes_;
-  if (RenderStage::RequiredBytes(rc) > capacity) {
-    return Status(Code::kOutOfMemory, "refocus engine: render needs more than its %zu bytes",
-                  capacity);
+  RenderConfig rc = file_.RenderConfigFor(std::max(1, (config_.max_blur_radius + step / 2) / step),
+                                          pool_->workers());
+  ConstPlanarU8 ref = file_.reference();
+  ConstImageU16 disp = file_.disparity_q8();
+  if (preview) {
+    rc.width = photo_.preview_width;
+    rc.height = photo_.preview_height;
+    rc.working_scale = preview_scale_;
+    rc.working_width = preview_dw_;
+    rc.working_height = preview_dh_;
+    // The original's own planes at step 1 (the preview may crop them), else the downscaled.
+    const int32_t cw = (rc.width + 1) / 2, ch = (rc.height + 1) / 2;
+    if (step > 1) {
+      ref.planes[0] = {py_.data(), rc.width, rc.height, 1, rc.width};
+      ref.planes[1] = {pcb_.data(), cw, ch, 1, cw};
+      ref.planes[2] = {pcr_.data(), cw, ch, 1, cw};
+    } else {
+      ref.planes[0] = {ref.planes[0].data, rc.width, rc.height, 1, ref.planes[0].stride};
+      ref.planes[1] = {ref.planes[1].data, cw, ch, 1, ref.planes[1].stride};
+      ref.planes[2] = {ref.planes[2].data, cw, ch, 1, ref.planes[2].stride};
+    }
+    disp = {preview_disp_, rc.working_width, rc.working_height, 1, rc.working_width};
   }
-  Arena arena = (preview ? preview_block_ : full_block_).arena();
-  LB_RETURN_IF_ERROR(stage->Configure(rc, arena));
-  stage->SetRunner(pool_.get());
-  ConstPlanarU8 ref;
-  ref.count = 3;
-  const int32_t cw = (rc.width + 1) / 2, ch = (rc.height + 1) / 2;
-  const bool own = !preview || step == 1;
-  const int32_t stride = own ? photo_.width : rc.width;
-  const int32_t cstride = own ? (photo_.width + 1) / 2 : cw;
-  ref.planes[0] = {own ? y_.data() : py_.data(), rc.width, rc.height, 1, stride};
-  ref.planes[1] = {own ? cb_.data() : pcb_.data(), cw, ch, 1, cstride};
-  ref.planes[2] = {own ? cr_.data() : pcr_.data(), cw, ch, 1, cstride};
-  const ConstImageU16 disp = {preview ? preview_disp_ : disp_q8_.data(), rc.working_width,
-                              rc.working_height, 1, rc.working_width};
+  LB_RETURN_IF_ERROR(RenderStage::Validate(rc));
+  const ArenaBlock& block = preview ? preview_block_ : full_block_;
+  if (RenderStage::RequiredBytes(rc) > block.size()) {
+    return Status(Code::kOutOfMemory, "refocus engine: render needs more than its %zu bytes",
+                  block.size());
+  }
+  Arena arena = block.arena();
+  WaitForCamera();
+  if (!preview) return file_.BeginRender(rc, arena, pool_.get(), params, stage);
   RenderParams p = params;
-  if (preview && step > 1) {
+  if (step > 1) {
     FocusRegion& f = p.focus;
     if (f.width > 0 && f.height > 0) {
       f = {f.x / step, f.y / step, std::max(1, f.width / step), std::max(1, f.height / step)};
     }
   }
-  WaitForCamera();
+  LB_RETURN_IF_ERROR(stage->Configure(rc, arena));
+  stage->SetRunner(pool_.get());
   return stage->Begin(ref, disp, p);
 }
 
@@ -393,17 +312,10 @@ Status RefocusEngine::RenderFull(const RenderParams& params) {
 Status RefocusEngine::Save(const RenderParams& params, const char* out_path) {
   output_size_ = 0;
   LB_RETURN_IF_ERROR(RenderInto(full_.get(), params, false));
-  RerenderSource source;
-  source.disp_q8 = {disp_q8_.data(), depth_w_, depth_h_, 1, depth_w_};
-  source.range = range_;
-  source.original_jpeg = &original_;
-  source.orientation = photo_.orientation;
-  source.width = photo_.width;
-  source.height = photo_.height;
   CameraYield yield(camera_busy_, &paused_strips_);
   // A new photo beside the others: never over one, however the name was chosen.
-  return WriteRerendered(full_.get(), params, source, config_.quality, "refocusd web", &yield,
-                         nullptr, out_path, AtomicFile::Replace::kNever);
+  return WriteRerendered(full_.get(), params, SourceOf(file_), config_.quality, "refocusd web",
+                         &yield, nullptr, out_path, AtomicFile::Replace::kNever);
 }
 
 }  // namespace lb

@@ -3,11 +3,11 @@
 // every buffer then: the file's bytes (also the output JPEG's, once the file is decoded), the
 // reassembled extended XMP, the all-in-focus original (JPEG bytes and YCbCr 4:2:0 planes), the
 // depth map, a downscaled copy of both for previews, the readers' strip and the render arenas.
-// Load reads through the product's one reader per format (refocusable_reader, the JPEG and PNG
-// readers) into those buffers. Load, RenderPreview, RenderFull allocate nothing after Configure
-// (the codec libraries' own scratch memory aside), so the daemon's memory stays flat however the
-// page is used; Save shares `refocus rerender`'s writing code (WriteRerendered), which builds the
-// file's metadata on the heap and frees it.
+// Load decodes as `refocus rerender` does (RefocusablePhoto: the same files open, phones' Lens
+// Blur files among them) into those buffers. Load, RenderPreview, RenderFull allocate nothing after
+// Configure (the codec libraries' own scratch memory aside), so the daemon's memory stays flat
+// however the page is used; Save shares `refocus rerender`'s writing code (WriteRerendered), which
+// builds the file's metadata on the heap and frees it.
 //
 // The camera comes first: between strips every render waits while `camera_busy` is set, so a
 // capture is slowed by at most one strip of web work.
@@ -21,6 +21,7 @@
 
 #include "algo/core/status.h"
 #include "algo/render/render_stage.h"
+#include "firmware/app/refocusable_photo.h"
 #include "firmware/platform/arena_block.h"
 #include "firmware/refocusable/depth_encoding.h"
 #include "firmware/refocusable/refocusable_reader.h"
@@ -94,7 +95,7 @@ class RefocusEngine {
 
  private:
   Status LoadFile(const char* path);
-  Status ParseAndDecode(const char* path, size_t size);
+  Status Decode(const char* path, size_t size);
   Status MakePreviewInputs();
   Status RenderInto(RenderStage* stage, const RenderParams& params, bool preview);
   void WaitForCamera();
@@ -109,16 +110,7 @@ class RefocusEngine {
   // The file's bytes while it loads, then the output JPEG (capacity kept: never reallocated).
   std::vector<uint8_t> scratch_;
   size_t output_size_ = 0;
-  std::vector<uint8_t> extended_;         // the reassembled extended XMP
-  std::vector<ExtendedXmpChunk> chunks_;  // the reader's extended-XMP chunk descriptors
-  std::vector<uint8_t> png_;              // GDepth:Data (base64-decoded, capacity fixed)
-  std::vector<uint8_t> original_;         // GImage:Data, the all-in-focus JPEG (capacity fixed)
-  std::vector<uint8_t> strip_;            // the image readers' rows (a strip of the widest photo)
-  std::vector<uint8_t> rgb_rows_;         // two RGB rows of the original, for its 4:2:0 chroma
-  std::vector<uint8_t> y_, cb_, cr_;
-  std::vector<uint16_t> depth_values_, disp_q8_;
-  int32_t depth_w_ = 0, depth_h_ = 0;
-  DisparityRange range_;
+  RefocusablePhoto file_;  // the decoded photo, in buffers Configure sized
   // Preview inputs: the original box-filtered by preview_step_, and the disparity at the
   // preview's working size (or the full map when its scale divides by the step).
   int32_t preview_step_ = 1, preview_scale_ = 1, preview_dw_ = 0, preview_dh_ = 0;

@@ -11,6 +11,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <thread>
@@ -343,6 +344,40 @@ TEST_F(RefocusEngineTest, WaitsWhileTheCameraIsBusy) {
   EXPECT_TRUE(done.load());
   EXPECT_GE(engine.paused_strips(), 1);
   EXPECT_GT(engine.output_size(), 0u);
+}
+
+// The page opens what `refocus rerender` opens: phones' Lens Blur files, their depth an 8-bit
+// RGBA PNG at the photo's full size in the phone's own units (../shared/data/phone-depth).
+TEST(RefocusEnginePhoneFiles, OpensAndRendersAPhonesLensBlurFile) {
+  const char* root = std::getenv("LB_SOURCE_DIR");
+  const std::string dir = std::string(root ? root : ".") + "/../shared/data/phone-depth";
+  struct stat st;
+  if (stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
+    GTEST_SKIP() << dir << " is absent: no phone files to open";
+  }
+  RefocusEngine engine;
+  RefocusEngineConfig c;
+  c.max_width = c.max_height = 1024;
+  c.max_depth_pixels = 1024 * 1024;
+  c.threads = 2;
+  c.max_blur_radius = 16;
+  ASSERT_TRUE(engine.Configure(c).ok());
+  struct PhoneFile {
+    const char* name;
+    int32_t width, height;
+  };
+  for (const PhoneFile& f :
+       {PhoneFile{"lensblur_table.jpg", 768, 1024}, PhoneFile{"lensblur_depthy1.jpg", 580, 1024}}) {
+    SCOPED_TRACE(f.name);
+    const Status s = engine.Load((dir + "/" + f.name).c_str());
+    ASSERT_TRUE(s.ok()) << s.message();
+    EXPECT_EQ(engine.photo().width, f.width);
+    EXPECT_EQ(engine.photo().height, f.height);
+    ASSERT_TRUE(engine.RenderPreview(engine.photo().current).ok());
+    EXPECT_GT(engine.output_size(), 0u);
+    ASSERT_TRUE(engine.RenderFull(engine.photo().current).ok());
+    EXPECT_EQ(Decode(Output(engine)).width, f.width);
+  }
 }
 
 }  // namespace
