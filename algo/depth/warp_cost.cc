@@ -158,7 +158,7 @@ void PlaneCostRow(const PlaneHomography& h, const WarpSource& src, int32_t y,
   // chunk of up to kRunSpans spans maps its anchors in one tight loop, then goes to the kernel as
   // one run, or, where a plane has no map at some anchor, as the runs between (the spans
   // touching that anchor cost `invalid`).
-  // Not zeroed (a fill of 400 bytes per call was a sixth of this function's time): every entry
+  // Not zeroed (a fill per call costs a fair part of this short function's time): every entry
   // is written before it is read.
   int32_t ax[kRunSpans + 1], ay[kRunSpans + 1];
   bool ok[kRunSpans + 1];

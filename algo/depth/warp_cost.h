@@ -2,7 +2,7 @@
 // through a label's plane homography. The pixel cost is the rectified one (data_term.h) but the
 // sample position changes per pixel and in both axes: colour is bilinear over 4 taps, and the
 // census Hamming distance is the nearest tap's: on handheld bursts no worse than interpolating
-// it over the 4 taps, and faster (the figures: README, Performance, "Depth").
+// it over the 4 taps, and faster (docs/performance.md).
 //
 // Positions: the exact PlaneHomography::Map at anchors every kAnchorStep pixels and at the row's
 // last pixel, linear in between. Along a row x' = N(x) / D(x) with N, D linear in x, so

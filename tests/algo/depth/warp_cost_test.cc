@@ -396,7 +396,7 @@ std::vector<PlaneHomography> TruePlanes(const motiontest::Burst& b, double rho) 
 // position error delta = 1/512 (Q8 weights) + 2^-16 (Map) + the anchors' chord bound for this
 // focal length and the burst's rotations of at most 1 degree (warp_cost.h; 1/109 px at
 // f ~ 125 px), widened by 1 for the Q15 mean. Against the nominal (exact-position) reference the
-// mean difference must stay below 4 of D's 0..2295 (measured 1.0 .. 3.4): the nearest census tap
+// mean difference must stay below 4 of D's 0..2295: the nearest census tap
 // flips, by up to 24 census weights, where a position lies within delta of a half pixel.
 TEST(WarpCostTest, FixedPointAgreesWithFloatReference) {
   motiontest::Burst b;
