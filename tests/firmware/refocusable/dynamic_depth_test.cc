@@ -317,8 +317,12 @@ TEST(DynamicDepthMalformedTest, RefusedInOneLineNamingTheFile) {
   EXPECT_NE(message.find("16384x16384"), std::string::npos) << message;
   EXPECT_EQ(message.find('\n'), std::string::npos) << message;
   EXPECT_TRUE(image.depth.values.empty());
-  DynamicDepthFields dd;
-  EXPECT_FALSE(ReadDd(bytes, &dd).ok());
+  RefocusableBuffers memory;
+  RefocusableFields fields;
+  const size_t before = testing::AllocationCount();
+  const Status fixed = ReadRefocusableFields(bytes.data(), bytes.size(), "dd.jpg", memory, &fields);
+  EXPECT_EQ(testing::AllocationCount(), before);
+  EXPECT_NE(std::string(fixed.message()).find("16384x16384"), std::string::npos) << fixed.message();
 }
 
 // exiftool, an independent reader, lists the directory and the DepthMap fields; dd_slice.py,
