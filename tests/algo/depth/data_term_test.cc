@@ -123,8 +123,7 @@ void PrepareTerm(Fixed& f, const synth::Burst& b, const DataTermParams& params) 
 // the interpolated Hamming cost by at most 0.5, so a window sum by at most 9 x 2 = 18; the mean of
 // the best half (order statistics move no more than their inputs) adds the final rounding, 0.5.
 // So |fixed - float| <= 18.5 of D's 0..2295 (0.8 %). The mean difference is a bias: at quarter-
-// pixel fractions the Hamming cost often lands on exact halves, which round up (measured about
-// +0.25 per pixel, +2.3 per window); it stays below 5.
+// pixel fractions the Hamming cost often lands on exact halves, which round up; it stays below 5.
 TEST(DataTermTest, FixedPointAgreesWithFloatReference) {
   for (int32_t views : {2, 3, 5, 7}) {
     const int32_t ref = views / 2;

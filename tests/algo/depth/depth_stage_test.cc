@@ -295,7 +295,7 @@ DepthConfig PinnedConfig(const synth::Burst& b) {
 
 // What the pinned bits stand for, with a stated tolerance, so that a deliberate change to the
 // stage reads as better or worse: the share of pixels (off the border the outer views miss)
-// within a quarter pixel of the truth. Measured 100 %.
+// within a quarter pixel of the truth.
 TEST(DepthStageTest, PinnedBurstIsCloseToTheTruth) {
   const synth::Burst b = PinnedBurst();
   Stage s;

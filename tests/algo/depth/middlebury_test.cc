@@ -1,6 +1,6 @@
 // Accuracy on the Middlebury sets with every view and one set of parameters (the defaults):
 // bad pixels (error over 1 px in the units of the evaluated pair, nonocc mask) at most the
-// issue's bounds. The bounds hold for the label output (subpixel off); the sub-label refinement,
+// bounds below. The bounds hold for the label output (subpixel off); the sub-label refinement,
 // made for the rendering, is measured and printed beside it (it moves whole-pixel estimates off
 // tsukuba's whole-pixel truth). Skipped when ../shared/data/middlebury is absent. Run in
 // Release: label `data`.
