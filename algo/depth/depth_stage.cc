@@ -1,8 +1,8 @@
 // Depth by graph cuts: alpha-expansion moves lower E(f) = sum D_p(f_p) + sum w_pq
 // min(|f_p - f_q|, K), each move an exact minimum cut. Coarse to fine (the default): the best
 // of every coarse_step-th label per 2x2 block, full moves over those labels on the blocks
-// (coarse_pass.h), then cycles of moves over every label restricted to pixels
-// near labels within fine_window of alpha, until a cycle changes nothing or the cycle cap.
+// (coarse_pass.h), then cycles of moves over every label restricted to pixels near labels
+// within fine_window of alpha, until a cycle changes nothing or the cycle cap.
 // With coarse_step 1: the winner-take-all labels, then cycles of full moves over every label.
 // The stage composes the pieces: a move's rectangles and record (MoveBook), its graph and cut
 // (ExpansionMove), and the blocks of the coarse pass (CoarsePass), over the grids of move_grid.h.
