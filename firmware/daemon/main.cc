@@ -16,6 +16,7 @@
 #include "firmware/daemon/clock.h"
 #include "firmware/daemon/config.h"
 #include "firmware/daemon/startup_checks.h"
+#include "firmware/daemon/web_page.h"
 #include "firmware/platform/cpu_features.h"
 #include "firmware/platform/log.h"
 #include "firmware/web/web_server.h"
@@ -174,7 +175,7 @@ int main(int argc, char** argv) {
   std::unique_ptr<lb::RefocusBackend> backend;
   std::unique_ptr<lb::WebServer> web;
   if (s.ok() && config.web_on()) {
-    backend = lb::MakeRefocusBackend(config, &log, &daemon);
+    backend = lb::MakeRefocusBackend(config, &log, daemon);
     web = std::make_unique<lb::WebServer>(lb::WebOptionsFrom(config), backend.get(), &log);
     lb::Status ws = web->Start();
     if (!ws.ok()) {

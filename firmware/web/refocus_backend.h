@@ -1,6 +1,6 @@
 // What the web side asks of the camera's renderer: the HTTP handlers (web_server, routes) call
-// this; the daemon implements it with a fixed-memory engine on one low-priority render thread
-// that yields to the camera. Tests give the server a fake.
+// this. refocusd gives the server EngineBackend (engine_backend.h), a fixed-memory engine on one
+// low-priority render thread that yields to the camera; tests give it a fake.
 #pragma once
 
 #include <cstddef>

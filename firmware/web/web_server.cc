@@ -172,16 +172,6 @@ using web::AppendJsonString;
 using web::CommonHeaders;
 using web::SameSecret;
 
-WebServerOptions WebOptionsFrom(const DaemonConfig& config) {
-  WebServerOptions o;
-  o.address = config.web_address;
-  o.port = config.web_port;
-  o.token = config.web_token;
-  o.web_root = config.web_root;
-  o.photo_dir = config.output_dir;
-  return o;
-}
-
 WebServer::WebServer(const WebServerOptions& options, RefocusBackend* backend, Log* log)
     : options_(options), backend_(backend), log_(log) {}
 

@@ -1,4 +1,4 @@
-// refocusd's web page server (issue 16): the page's files and a small JSON API over the photo
+// refocusd's web page server: the page's files and a small JSON API over the photo
 // folder and the renderer (refocus_backend.h), for a phone or laptop on the same network.
 //
 // HTTP comes from GNU libmicrohttpd (Debian libmicrohttpd12, C, made for embedded devices): it
@@ -46,7 +46,6 @@
 #include <string>
 
 #include "algo/core/status.h"
-#include "firmware/daemon/config.h"
 #include "firmware/platform/log.h"
 #include "firmware/web/refocus_backend.h"
 
@@ -56,7 +55,6 @@ struct MHD_Response;
 
 namespace lb {
 
-class CameraDaemon;
 class RequestDeadlines;
 
 struct WebServerOptions {
@@ -81,9 +79,6 @@ struct WebServerOptions {
   int32_t camera_wait_ms = 30000;
   int32_t failed_login_delay_ms = 500;  // slows guessing down
 };
-
-// The options refocusd's configuration implies (web must be on).
-WebServerOptions WebOptionsFrom(const DaemonConfig& config);
 
 class WebServer {
  public:
@@ -149,10 +144,5 @@ class WebServer {
   std::mutex save_mutex_;  // one save at a time chooses its name and writes it (web path only)
   std::atomic<int64_t> requests_{0};
 };
-
-// The renderer the daemon gives the page: EngineBackend (engine_backend.h), sized from the
-// configuration's resolution, yielding to the daemon's captures (backend_factory.cc).
-std::unique_ptr<RefocusBackend> MakeRefocusBackend(const DaemonConfig& config, Log* log,
-                                                   CameraDaemon* daemon);
 
 }  // namespace lb
