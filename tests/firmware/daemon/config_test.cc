@@ -132,7 +132,7 @@ TEST(ConfigTest, NativeResolutionAutoDeviceAndPointFocus) {
   EXPECT_EQ(c.job.sensor.width, 0);
   EXPECT_EQ(c.job.sensor.height, 0);
   EXPECT_EQ(c.device, "");
-  // Issue 13, defect 6: a point means what it means on the command line (firmware/app/focus.h).
+  // A point means what it means on the command line (firmware/app/focus.h).
   const FocusRegion cli = FocusAtPoint(50, 60);
   EXPECT_EQ(c.job.render.focus.x, cli.x);
   EXPECT_EQ(c.job.render.focus.y, cli.y);
@@ -143,7 +143,7 @@ TEST(ConfigTest, NativeResolutionAutoDeviceAndPointFocus) {
 
 TEST(ConfigTest, ErrorsNameTheFileTheLineAndTheProblem) {
   EXPECT_EQ(Error("frames = 5\n\nburst = 3\n"), "test.conf:3: unknown key 'burst'");
-  // Issue 13, defect 6: no integer overflow turns a size into another one.
+  // No integer overflow turns a size into another one.
   EXPECT_EQ(Error("resolution = 4294967616x240\n"),
             "test.conf:1: resolution: '4294967616x240' is neither native nor WxH between 16x16 "
             "and 8192x8192");
@@ -174,8 +174,8 @@ TEST(ConfigTest, ErrorsNameTheFileTheLineAndTheProblem) {
   EXPECT_EQ(Error("size = 320x240\n"), "test.conf:1: unknown key 'size'");
 }
 
-// Issue 13: one parser for the command line and the file. Every shared setting, given the same
-// text under its two spellings, sets the same job.
+// One parser for the command line and the file: every shared setting, given the same text under
+// its two spellings, sets the same job.
 TEST(ConfigTest, EverySharedSettingMeansWhatTheCommandLineMeans) {
   const char* const value_of[][2] = {
       {"focus", "100,80"},

@@ -79,7 +79,7 @@ TEST(RefocusdCommandTest, CheckConfigReportsTheLine) {
   EXPECT_EQ(out, "refocusd: " + bad + ":3: f_number: '0.5' is not a number from 1 to 22\n");
 }
 
-// Issue 13 defect 5: --check-config said OK for a camera and a folder refocusd could not use.
+// --check-config says OK only for a camera and a folder refocusd can use.
 TEST(RefocusdCommandTest, CheckConfigChecksTheCameraTheButtonAndTheFolder) {
   ScratchDir dir;
   const std::string conf = dir.Path("refocusd.conf");
@@ -113,9 +113,8 @@ TEST(RefocusdCommandTest, MissingButtonIsAClearStartupError) {
       << d.log();
 }
 
-// Issue 13 defect 5: refocusd said "ready" with a folder it could not write, and the first press
-// was lost. Now it says why it is not ready, refuses a press with the reason, keeps checking,
-// and is ready once the folder is there.
+// A folder refocusd cannot write must not lose the first press: it says why it is not ready,
+// refuses a press with the reason, keeps checking, and is ready once the folder is there.
 TEST(RefocusdProcessTest, OutputFolderThatIsAFileIsNotReadyUntilItIsAFolder) {
   ScratchDir dir;
   const std::string photos = dir.Path("photos");
@@ -156,8 +155,7 @@ TEST(RefocusdProcessTest, SigtermWhileWaitingForTheCameraStopsAtOnce) {
 
 TEST(RefocusdProcessTest, SigtermLetsThePhotoInProgressFinish) {
   ScratchDir dir;
-  // Slow enough (about a second in a release build; a 480x360 photo took 0.3 s, and the
-  // signal sometimes came after it) that the signal lands while the photo is being taken.
+  // Large enough that the signal lands while the photo is being taken, not after it.
   RefocusdProcess d(dir.dir(), "resolution = 1280x960\nlabels = 32\n");
   ASSERT_TRUE(d.Start());
   ASSERT_TRUE(d.WaitForLine("ready: sensor", kStartMs)) << d.log();
