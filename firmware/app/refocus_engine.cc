@@ -90,28 +90,25 @@ Status RefocusEngine::Configure(const RefocusEngineConfig& config) {
   pcr_.resize(pcpx);
   pdisp_q8_.resize(ppx);
 
-  // The arenas: the largest any photo up to W x H needs, whatever its depth map's scale.
+  // The arenas: the largest any photo up to W x H needs, either way round (a portrait photo on
+  // a landscape camera), whatever its depth map's scale.
   const int32_t workers = WorkerPool::CountFor(config.threads);
-  for (int32_t s = 1; s <= 16; ++s) {
-    RenderConfig rc;
-    rc.width = W;
-    rc.height = H;
-    rc.working_scale = s;
-    rc.working_width = std::max(1, W / s);
-    rc.working_height = std::max(1, H / s);
-    rc.max_radius = config.max_blur_radius;
-    rc.workers = workers;
-    full_bytes_ = std::max(full_bytes_, Arena::RoundUp(RenderStage::RequiredBytes(rc)));
-  }
-  RenderConfig prc;
-  prc.width = pw;
-  prc.height = ph;
-  prc.working_width = pw;
-  prc.working_height = ph;
-  prc.max_radius = config.max_blur_radius;
-  prc.workers = workers;
-  LB_RETURN_IF_ERROR(RenderStage::Validate(prc));
-  preview_bytes_ = Arena::RoundUp(RenderStage::RequiredBytes(prc));
+  const auto render_bytes = [&](int32_t w, int32_t h, int32_t max_scale) {
+    size_t most = 0;
+    for (int32_t s = 1; s <= max_scale; ++s) {
+      const RenderConfig rc = {.width = w,
+                               .height = h,
+                               .working_scale = s,
+                               .working_width = std::max(1, w / s),
+                               .working_height = std::max(1, h / s),
+                               .max_radius = config.max_blur_radius,
+                               .workers = workers};
+      most = std::max(most, Arena::RoundUp(RenderStage::RequiredBytes(rc)));
+    }
+    return most;
+  };
+  full_bytes_ = std::max(render_bytes(W, H, 16), render_bytes(H, W, 16));
+  preview_bytes_ = std::max(render_bytes(pw, ph, 1), render_bytes(ph, pw, 1));
   LB_RETURN_IF_ERROR(full_block_.Reserve(full_bytes_, "for the refocus engine's render"));
   LB_RETURN_IF_ERROR(preview_block_.Reserve(preview_bytes_, "for the refocus engine's preview"));
   full_ = std::make_unique<RenderStage>();

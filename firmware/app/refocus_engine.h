@@ -32,7 +32,9 @@ class JpegWriter;
 class WorkerPool;
 
 struct RefocusEngineConfig {
-  int32_t max_width = 0;  // the largest photo the camera makes (stored pixels)
+  // The largest photo the camera makes (stored pixels); a photo of these sides the other way
+  // round (a phone's portrait) opens too.
+  int32_t max_width = 0;
   int32_t max_height = 0;
   int32_t threads = 1;  // as JobOptions::threads (0: one per core)
   int32_t max_blur_radius = 32;

@@ -123,8 +123,7 @@ Status RefocusablePhoto::Configure(const RefocusableLimits& limits) {
     return Status(Code::kInvalidArgument, "refocusable photo: size %dx%d outside 16..%d", W, H,
                   kMaxFrameSide);
   }
-  max_width_ = W;
-  max_height_ = H;
+  max_side_ = std::max(W, H);
   const size_t pixels = static_cast<size_t>(W) * H;
   const size_t file = limits.max_file_bytes;
   const size_t cpx = static_cast<size_t>((W + 1) / 2) * ((H + 1) / 2);
@@ -137,9 +136,10 @@ Status RefocusablePhoto::Configure(const RefocusableLimits& limits) {
       std::min(pixels, static_cast<size_t>(std::max(1, limits.max_depth_pixels)));
   depth_image_.resize(std::min(file / 4 * 3, depth_px * 2 + depth_px / 64 + 65536));
   original_.reserve(file / 4 * 3);
-  rgb_rows_.resize(static_cast<size_t>(W) * 6);
+  rgb_rows_.resize(static_cast<size_t>(max_side_) * 6);
   // The readers' strip: the original's RGB rows, then the depth image's.
-  strip_.resize(std::max(ImageStripBytes(W, PixelFormat::kRgb8), DepthStripBytes(W)));
+  strip_.resize(
+      std::max(ImageStripBytes(max_side_, PixelFormat::kRgb8), DepthStripBytes(max_side_)));
   y_.resize(pixels);
   cb_.resize(cpx);
   cr_.resize(cpx);
@@ -267,20 +267,21 @@ Status RefocusablePhoto::DecodeOriginal(const uint8_t* jpeg, size_t size, const 
   }
   const size_t pixels = static_cast<size_t>(w) * h;
   const size_t cpx = static_cast<size_t>((w + 1) / 2) * ((h + 1) / 2);
-  if (!fixed_) {
-    Fit(&y_, pixels);
-    Fit(&cb_, cpx);
-    Fit(&cr_, cpx);
-    Fit(&rgb_rows_, static_cast<size_t>(w) * 6);
-    Fit(&strip_, ImageStripBytes(w, PixelFormat::kRgb8));
+  if (fixed_ && (w > max_side_ || h > max_side_ || pixels > y_.size() || cpx > cb_.size())) {
+    return Status(Code::kOutOfMemory, "%s: %s: a %dx%d original, larger than the %zu pixels taken",
+                  name, what, w, h, y_.size());
   }
-  // Straight into the planes, a strip at a time; a photo larger than Configure took is
-  // kOutOfMemory from the reader before any pixel.
+  Fit(&y_, pixels);
+  Fit(&cb_, cpx);
+  Fit(&cr_, cpx);
+  Fit(&rgb_rows_, static_cast<size_t>(w) * 6);
+  Fit(&strip_, ImageStripBytes(w, PixelFormat::kRgb8));
+  // Straight into the planes, a strip at a time.
   ImageReadMemory memory;
   memory.strip = strip_.data();
   memory.strip_bytes = strip_.size();
-  memory.max_width = fixed_ ? max_width_ : w;
-  memory.max_height = fixed_ ? max_height_ : h;
+  memory.max_width = w;
+  memory.max_height = h;
   Ycc420Sink ycc(y_.data(), cb_.data(), cr_.data(), rgb_rows_.data());
   s = StreamImageMemory(jpeg, size, what, 0, ycc, memory, ImageFileType::kJpeg);
   if (!s.ok()) return s.Prefix("%s: ", name);

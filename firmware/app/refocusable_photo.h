@@ -25,7 +25,8 @@
 namespace lb {
 
 struct RefocusableLimits {
-  int32_t max_width = 0;  // the original, stored pixels
+  // The original, stored pixels, either way round: a portrait photo on a landscape camera fits.
+  int32_t max_width = 0;
   int32_t max_height = 0;
   size_t max_file_bytes = 0;
   int32_t max_depth_pixels = 1 << 20;  // the depth image as stored
@@ -87,7 +88,7 @@ class RefocusablePhoto {
 
   bool fixed_ = false;  // Configure sized the buffers: they never grow
   size_t reserved_bytes_ = 0;
-  int32_t max_width_ = kMaxFrameSide, max_height_ = kMaxFrameSide;
+  int32_t max_side_ = kMaxFrameSide;
   int32_t width_ = 0, height_ = 0, scale_ = 1, depth_w_ = 0, depth_h_ = 0;
   int32_t orientation_ = 0;
   int depth_bits_ = 16;  // the stored depth image's values
