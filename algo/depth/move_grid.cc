@@ -1,5 +1,5 @@
 // The shared grid of the expansion moves: its buffers, its row labels, its energy, and the
-// kernels the pieces share.
+// winner-take-all's step.
 #include "algo/depth/move_grid.h"
 
 #include "algo/core/clones.h"
@@ -82,36 +82,6 @@ void RowLabels(MoveGrid& g, int32_t labels, int32_t y) {
 int64_t GridEnergy(const MoveGrid& g, int32_t smooth_trunc) {
   return LabelEnergy(g.labels, g.cost, g.weight_right, g.weight_down, g.width, g.height,
                      smooth_trunc);
-}
-
-void NearColumns(const MoveGrid& g, bool full, const MoveRect& r, int32_t y, int32_t* x0,
-                 int32_t* x1) {
-  if (full) {
-    *x0 = r.x0;
-    *x1 = r.x1;
-    return;
-  }
-  int32_t lo = r.x1, hi = r.x0;
-  for (int32_t k = y > 0 ? y - 1 : 0; k <= y + 1 && k < g.height; ++k) {
-    const int32_t a = g.near_span[2 * k], b = g.near_span[2 * k + 1];
-    if (a >= b) continue;
-    lo = a - 1 < lo ? a - 1 : lo;
-    hi = b + 1 > hi ? b + 1 : hi;
-  }
-  lo = lo > r.x0 ? lo : r.x0;
-  hi = hi < r.x1 ? hi : r.x1;
-  *x0 = lo < hi ? lo : r.x0;
-  *x1 = lo < hi ? hi : r.x0;
-}
-
-LB_CLONES_AVX2 void MarkNearLabels(const uint8_t* __restrict up, const uint8_t* __restrict f,
-                                   const uint8_t* __restrict down, uint8_t base, uint8_t width,
-                                   int32_t a, int32_t b, uint8_t* __restrict out) {
-  for (int32_t x = a; x < b; ++x) {
-    out[x] = static_cast<uint8_t>(static_cast<uint8_t>(up[x] - base) <= width) |
-             static_cast<uint8_t>(static_cast<uint8_t>(f[x] - base) <= width) |
-             static_cast<uint8_t>(static_cast<uint8_t>(down[x] - base) <= width);
-  }
 }
 
 // Without branches, so that it vectorizes (a block's winner is a coin toss to a predictor).

@@ -65,13 +65,40 @@ void RowLabels(MoveGrid& g, int32_t labels, int32_t y);
 int64_t GridEnergy(const MoveGrid& g, int32_t smooth_trunc);
 // The columns of row y (within r) that pass 1 may not fix as far from alpha: those within one
 // of a label near alpha (g.near_span, the fine grid's) in the rows y - 1..y + 1; all of r for a
-// full move. Empty at r.x0 when none.
-void NearColumns(const MoveGrid& g, bool full, const MoveRect& r, int32_t y, int32_t* x0,
-                 int32_t* x1);
+// full move. Empty at r.x0 when none. Inline, as the next helper: both run per row inside the
+// callers' loops, which keep their bounds in registers only when the call does not take their
+// address.
+inline void NearColumns(const MoveGrid& g, bool full, const MoveRect& r, int32_t y, int32_t* x0,
+                        int32_t* x1) {
+  if (full) {
+    *x0 = r.x0;
+    *x1 = r.x1;
+    return;
+  }
+  int32_t lo = r.x1, hi = r.x0;
+  for (int32_t k = y > 0 ? y - 1 : 0; k <= y + 1 && k < g.height; ++k) {
+    const int32_t a = g.near_span[2 * k], b = g.near_span[2 * k + 1];
+    if (a >= b) continue;
+    lo = a - 1 < lo ? a - 1 : lo;
+    hi = b + 1 > hi ? b + 1 : hi;
+  }
+  lo = lo > r.x0 ? lo : r.x0;
+  hi = hi < r.x1 ? hi : r.x1;
+  *x0 = lo < hi ? lo : r.x0;
+  *x1 = lo < hi ? hi : r.x0;
+}
 // out[x] = 1 where column x of the rows up, f and down holds a label in base..base + width, for
 // x in a..b-1: one unsigned compare per label (a label below base wraps above the width).
-void MarkNearLabels(const uint8_t* up, const uint8_t* f, const uint8_t* down, uint8_t base,
-                    uint8_t width, int32_t a, int32_t b, uint8_t* out);
+// Without branches: it vectorizes in the callers' LB_CLONES_AVX2 copies.
+inline void MarkNearLabels(const uint8_t* __restrict up, const uint8_t* __restrict f,
+                           const uint8_t* __restrict down, uint8_t base, uint8_t width, int32_t a,
+                           int32_t b, uint8_t* __restrict out) {
+  for (int32_t x = a; x < b; ++x) {
+    out[x] = static_cast<uint8_t>(static_cast<uint8_t>(up[x] - base) <= width) |
+             static_cast<uint8_t>(static_cast<uint8_t>(f[x] - base) <= width) |
+             static_cast<uint8_t>(static_cast<uint8_t>(down[x] - base) <= width);
+  }
+}
 // The winner-take-all's step: where d is below the best so far (cost), d and `label` become
 // the best.
 void TakeBetter(const uint16_t* d, int32_t n, uint8_t label, uint16_t* cost, uint8_t* labels);
