@@ -10,6 +10,7 @@
 #include <memory>
 
 #include "algo/pipeline/pipeline.h"
+#include "firmware/platform/arena_block.h"
 #include "firmware/platform/worker_pool.h"
 #include "sim/synthetic/synthetic_sensor.h"
 #include "tests/support/alloc_counter.h"
@@ -20,11 +21,9 @@ struct Burst {
   std::unique_ptr<SyntheticSensor> sensor;
   SensorMode mode;
   PipelineConfig config;
-  void* arena = nullptr;
+  ArenaBlock arena;
   Pipeline pipeline;
   WorkerPool pool;  // started by ConfigurePipeline when config.workers > 1
-
-  ~Burst() { free(arena); }
 
   // A small rectified burst with labels over the scene's true disparity range.
   void Setup(int32_t width, int32_t height, int32_t frames) {
@@ -70,8 +69,8 @@ struct Burst {
   void ConfigurePipeline() {
     size_t bytes = 0;
     ASSERT_TRUE(Pipeline::RequiredBytes(config, &bytes).ok());
-    arena = aligned_alloc(Arena::kAlign, Arena::RoundUp(bytes));
-    Status s = pipeline.Configure(config, arena, bytes);
+    ASSERT_TRUE(arena.Reserve(bytes, "for the pipeline").ok());
+    Status s = pipeline.Configure(config, arena.data(), bytes);
     ASSERT_TRUE(s.ok()) << s.message();
     ASSERT_TRUE(pool.Start(config.workers).ok());
     pipeline.SetRunner(&pool);

@@ -402,5 +402,39 @@ TEST(Pipeline, TakesRectifiedOrAutoGeometryOnly) {
   }
 }
 
+// `refocus depth`'s road: a depth-only pipeline carves nothing for the render, refuses one, takes
+// frames as small as the depth stage does, and computes the map a rendering pipeline does.
+TEST(Pipeline, ADepthOnlyRunGivesTheSameMapAndNoRender) {
+  Burst full;
+  full.Setup(160, 120, 5);
+  ASSERT_TRUE(full.sensor->CaptureBurst(full.pipeline).ok());
+  ASSERT_TRUE(full.pipeline.ComputeDepth().ok());
+
+  Burst depth;
+  SceneParams scene;
+  scene.seed = 7;
+  ASSERT_NO_FATAL_FAILURE(depth.Open(scene, 160, 120, 5));
+  depth.config = full.config;
+  depth.config.render = false;
+  ASSERT_NO_FATAL_FAILURE(depth.ConfigurePipeline());
+  ASSERT_TRUE(depth.sensor->CaptureBurst(depth.pipeline).ok());
+  ASSERT_TRUE(depth.pipeline.ComputeDepth().ok());
+  EXPECT_EQ(ImageChecksum(depth.pipeline.disparity_q8()),
+            ImageChecksum(full.pipeline.disparity_q8()));
+  EXPECT_EQ(depth.pipeline.disp_max_q8(), full.pipeline.disp_max_q8());
+  EXPECT_EQ(depth.pipeline.BeginRender(RenderParams()).code(), Code::kInvalidArgument);
+  size_t with = 0, without = 0;
+  ASSERT_TRUE(Pipeline::RequiredBytes(full.config, &with).ok());
+  ASSERT_TRUE(Pipeline::RequiredBytes(depth.config, &without).ok());
+  EXPECT_LE(without, with);
+
+  PipelineConfig tiny;
+  tiny.width = tiny.height = DepthConfig::kMinSize;
+  tiny.render = false;
+  EXPECT_TRUE(Pipeline::RequiredBytes(tiny, &without).ok());
+  tiny.render = true;
+  EXPECT_EQ(Pipeline::RequiredBytes(tiny, &with).code(), Code::kInvalidArgument);
+}
+
 }  // namespace
 }  // namespace lb
