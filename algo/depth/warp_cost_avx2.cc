@@ -9,9 +9,9 @@
 // spans go one by one (AnySpan): their steps take their taps from byte shuffles of 32-byte
 // windows of the two rows when they share them, else from scalar loads (AVX2 gathers are slower
 // than those on some cores). Views narrower than a step or too large for 32-bit offsets, and
-// census weights over 31, take the reference. The band tests, the reference lanes and the
-// anchors' divisions are in warp_cost_prep_avx2.cc, the pieces both files use in
-// warp_cost_avx2.h.
+// census weights over 31, take the reference. The band tests are in warp_cost_avx2.h with the
+// pieces both files use, the reference lanes and the anchors' divisions in
+// warp_cost_prep_avx2.cc.
 #include "algo/depth/warp_cost_avx2.h"
 
 #if defined(__x86_64__)

@@ -1,6 +1,7 @@
 // What the plane sweep's AVX2 kernels share (warp_cost_avx2.cc: the span steps;
-// warp_cost_prep_avx2.cc: the band tests, the reference lanes and the anchors): their constant
-// tables, lane helpers and the band tests' record. Internal to those two files; x86-64 only.
+// warp_cost_prep_avx2.cc: the reference lanes and the anchors): their constant tables and lane
+// helpers; and the band tests of a run's spans, 8 at a time, which the span kernel inlines.
+// Internal to those two files; x86-64 only.
 #pragma once
 
 #if defined(__x86_64__)
@@ -91,10 +92,74 @@ struct RunBands {
   alignas(32) int32_t row[kRunSpans], crow[kRunSpans];  // y * stride, cy * 3 * width
 };
 
-// Spans first .. end - 1 (end - first <= kRunSpans) into b, indexed from `first`
-// (warp_cost_prep_avx2.cc).
-LB_AVX2 void BandsOfRun(const WarpRow& r, const WarpRun& run, int32_t first, int32_t end,
-                        RunBands* b);
+// Spans first .. end - 1 (end - first <= kRunSpans) into b, indexed from `first`. Lanes past
+// `end` load nothing (masked loads: the anchors may end there). Inline: the span kernel's loop
+// over a run's chunks keeps its constants.
+LB_AVX2 inline void BandsOfRun(const WarpRow& r, const WarpRun& run, int32_t first, int32_t end,
+                               RunBands* b) {
+  const __m256i iota = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256i xmax = _mm256_set1_epi32((r.width - 1) * 256);
+  const __m256i ymax = _mm256_set1_epi32((r.height - 1) * 256);
+  const __m256i hm2 = _mm256_set1_epi32(r.height - 2);
+  const __m256i q8_half = _mm256_set1_epi32(128), one = _mm256_set1_epi32(1);
+  const __m256i reach = _mm256_set1_epi32(kAnchorStep * 73728);
+  // The row's last span, when its end anchor's column is wanted too (a 17th), is not stepped
+  // as one of the band, nor is a span the wanted columns lo..hi-1 cut.
+  const __m256i last = _mm256_set1_epi32(run.hi > run.last ? run.last - 1 : run.last);
+  const __m256i lo = _mm256_set1_epi32(run.lo), hi = _mm256_set1_epi32(run.hi);
+  const __m256i stride = _mm256_set1_epi32(static_cast<int32_t>(r.stride));
+  const __m256i census_row = _mm256_set1_epi32(3 * r.width);
+  for (int32_t g = first; g < end; g += kLanes) {
+    const __m256i lanes = _mm256_cmpgt_epi32(_mm256_set1_epi32(end - g), iota);
+    const __m256i ax = _mm256_maskload_epi32(run.x_q16 + g, lanes);
+    const __m256i bx = _mm256_maskload_epi32(run.x_q16 + g + 1, lanes);
+    const __m256i ay = _mm256_maskload_epi32(run.y_q16 + g, lanes);
+    const __m256i by = _mm256_maskload_epi32(run.y_q16 + g + 1, lanes);
+    // The span's end column x0 + kAnchorStep (k + 1) must be an anchor: not past `last`.
+    const __m256i span_end = _mm256_add_epi32(_mm256_set1_epi32(run.x0 + kAnchorStep * (g + 1)),
+                                              _mm256_slli_epi32(iota, 4));  // kAnchorStep = 16
+    __m256i bad =
+        _mm256_or_si256(_mm256_cmpgt_epi32(span_end, last), _mm256_cmpgt_epi32(span_end, hi));
+    bad = _mm256_or_si256(
+        bad, _mm256_cmpgt_epi32(lo, _mm256_sub_epi32(span_end, _mm256_set1_epi32(kAnchorStep))));
+    const __m256i dx = _mm256_sub_epi32(bx, ax), dy = _mm256_sub_epi32(by, ay);
+    bad = _mm256_or_si256(bad, _mm256_cmpgt_epi32(_mm256_abs_epi32(dx), reach));
+    const __m256i xa = _mm256_srai_epi32(_mm256_add_epi32(ax, q8_half), 8);
+    const __m256i xb = _mm256_srai_epi32(_mm256_add_epi32(bx, q8_half), 8);
+    const __m256i ya = _mm256_srai_epi32(_mm256_add_epi32(ay, q8_half), 8);
+    const __m256i yb = _mm256_srai_epi32(_mm256_add_epi32(by, q8_half), 8);
+    const __m256i inside = _mm256_and_si256(_mm256_and_si256(AtMost(xa, xmax), AtMost(xb, xmax)),
+                                            _mm256_and_si256(AtMost(ya, ymax), AtMost(yb, ymax)));
+    const __m256i row_a = _mm256_min_epi32(_mm256_srai_epi32(ya, 8), hm2);
+    const __m256i row_b = _mm256_min_epi32(_mm256_srai_epi32(yb, 8), hm2);
+    const __m256i near_a = _mm256_srai_epi32(_mm256_add_epi32(ya, q8_half), 8);
+    const __m256i near_b = _mm256_srai_epi32(_mm256_add_epi32(yb, q8_half), 8);
+    const __m256i row_d = _mm256_sub_epi32(row_a, row_b), near_d = _mm256_sub_epi32(near_a, near_b);
+    bad = _mm256_or_si256(bad, _mm256_cmpgt_epi32(_mm256_abs_epi32(row_d), one));
+    bad = _mm256_or_si256(bad, _mm256_cmpgt_epi32(_mm256_abs_epi32(near_d), one));
+    const __m256i in_band = _mm256_andnot_si256(bad, _mm256_and_si256(inside, lanes));
+    const __m256i zero = _mm256_setzero_si256();
+    __m256i kind = _mm256_and_si256(in_band, _mm256_set1_epi32(kInBand));
+    kind = _mm256_or_si256(
+        kind, _mm256_andnot_si256(_mm256_cmpeq_epi32(row_d, zero), _mm256_set1_epi32(kTwoRows)));
+    kind = _mm256_or_si256(
+        kind, _mm256_andnot_si256(_mm256_cmpeq_epi32(near_d, zero), _mm256_set1_epi32(kTwoCensus)));
+    kind = _mm256_or_si256(
+        kind, _mm256_andnot_si256(_mm256_cmpgt_epi32(zero, dx), _mm256_set1_epi32(kRising)));
+    const int32_t i = g - first;
+    const __m256i y = _mm256_min_epi32(row_a, row_b), cy = _mm256_min_epi32(near_a, near_b);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->y + i), y);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->cy + i), cy);
+    // Offsets of lanes in the band only (the view's bytes are below 2^31).
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->row + i),
+                        _mm256_and_si256(in_band, _mm256_mullo_epi32(y, stride)));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->crow + i),
+                        _mm256_and_si256(in_band, _mm256_mullo_epi32(cy, census_row)));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->dx + i), dx);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->dy + i), dy);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b->kind + i), kind);
+  }
+}
 
 }  // namespace lb::dtk::plane_avx2
 #endif
