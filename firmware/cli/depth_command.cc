@@ -1,7 +1,8 @@
 // refocus depth: the views of a burst -> the reference view's disparity in px per view step as a
 // PFM, and optionally a colour-mapped PNG preview. With --geometry auto (the default) the camera
 // motion is estimated from the views; with rectified they are taken as equally spaced, left to
-// right.
+// right. The views go through the pipeline as run's burst does, depth only and at their full size
+// (PipelineConfig::render false, the working size the views' own).
 #include <sys/stat.h>
 
 #include <cstdio>
