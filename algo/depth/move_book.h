@@ -16,8 +16,8 @@ namespace lb {
 
 class MoveBook {
  public:
-  // Carves the rows for the configuration; the fit's D go in `fit` (2 * width * height uint16,
-  // borrowed), whose memory the coarse pass uses before the fine moves.
+  // Carves the rows for the configuration. SetFitMemory lends the memory of the fit's D
+  // (2 * width * height uint16), which the coarse pass uses before the fine moves.
   void Carve(Arena& arena, const DepthConfig& config);
   void SetFitMemory(uint16_t* fit);
   // Before the moves of a Compute, and before the fine grid's moves (after the coarse pass):
