@@ -16,7 +16,7 @@ cd "$root"
 ref=$root/build/abb-ref
 rm -rf "$ref/src"
 mkdir -p "$ref/src"
-git archive "$rev" | tar -x -C "$ref/src"
+git archive "$rev" | tar -x -m -C "$ref/src"
 for side in "$ref/src:$ref/build" ".:build/abb"; do
   src=${side%%:*} bin=${side#*:}
   cmake -S "$src" -B "$bin" -G Ninja -DCMAKE_BUILD_TYPE=Release -DLB_TESTS=OFF -DLB_BENCHMARKS=ON \

@@ -15,7 +15,7 @@ cd "$root"
 ref=$root/build/ab-ref
 rm -rf "$ref"
 mkdir -p "$ref/src"
-git archive "$rev" | tar -x -C "$ref/src"
+git archive "$rev" | tar -x -m -C "$ref/src"
 cmake -S "$ref/src" -B "$ref/build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_FLAGS=-Dlb=lbref \
   -DLB_TESTS=OFF -DLB_BENCHMARKS=OFF >/dev/null
 cmake --build "$ref/build" --target lb_algo lb_core >/dev/null
