@@ -132,8 +132,9 @@ void CostRowCAvx2(const uint8_t* ref, const uint8_t* img, const uint8_t* cref, c
 #endif
 // The plane sweep's span kernels, one run of spans a call: the C reference (warp_cost.cc), AVX2
 // (warp_cost_avx2.cc, the caller checks the CPU) and NEON (warp_cost_neon.cc). Its anchor
-// kernels, a row's anchors a call: the C reference and AVX2 (ARM takes the reference: aarch64
-// divides in one instruction, and NEON has no integer division to do it four at a time).
+// kernels, a row's anchors a call: the C reference and AVX2 (warp_cost_prep_avx2.cc; ARM takes the
+// reference: aarch64 divides in one instruction, and NEON has no integer division to do it four at
+// a time).
 void PlaneSpansC(const WarpRow& row, const WarpRun& run, uint8_t* out);
 bool PlaneAnchorsC(const int64_t* sums, const int64_t* changes, int32_t count, int32_t* x_q16,
                    int32_t* y_q16, bool* ok);
