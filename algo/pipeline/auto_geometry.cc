@@ -1,7 +1,7 @@
 #include "algo/pipeline/auto_geometry.h"
 
 #include "algo/depth/depth_order.h"
-#include "algo/depth/planes.h"
+#include "algo/pipeline/planes.h"
 
 namespace lb {
 

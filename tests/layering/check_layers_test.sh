@@ -94,7 +94,7 @@ inject_all() {
   inject firmware/app/CMakeLists.txt 'target_link_libraries(lb_app PRIVATE lb_test_images)'
   # Inside algo: a stage using a later one, a stage composing another, the vocabulary linking the
   # stages.
-  inject algo/motion/motion_stage.cc '#include "algo/depth/planes.h"'
+  inject algo/motion/motion_stage.cc '#include "algo/depth/warp_cost.h"'
   inject algo/render/render_stage.cc '#include "algo/depth/depth_stage.h"'
   inject algo/CMakeLists.txt 'target_link_libraries(lb_core PUBLIC lb_algo)'
   # Inside firmware: against the order, web into daemon, between the programs, between storage

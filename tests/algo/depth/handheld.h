@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "algo/depth/depth_stage.h"
-#include "algo/depth/planes.h"
 #include "algo/motion/motion_stage.h"
+#include "algo/pipeline/planes.h"
 #include "tests/algo/motion/burst.h"
 
 namespace lb::handheld {

@@ -11,7 +11,7 @@
 
 #include "algo/core/progress.h"
 #include "algo/depth/depth_stage.h"
-#include "algo/depth/planes.h"
+#include "algo/pipeline/planes.h"
 #include "tests/algo/depth/handheld.h"
 #include "tests/algo/depth/synthetic_views.h"
 #include "tests/support/alloc_counter.h"

@@ -19,9 +19,9 @@
 
 #include "algo/depth/depth_order.h"
 #include "algo/depth/depth_stage.h"
-#include "algo/depth/planes.h"
 #include "algo/motion/motion_stage.h"
 #include "algo/pipeline/auto_geometry.h"
+#include "algo/pipeline/planes.h"
 #include "tests/algo/depth/fit_score.h"
 #include "tests/algo/depth/middlebury.h"
 #include "tests/algo/motion/burst.h"

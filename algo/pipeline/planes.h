@@ -2,7 +2,8 @@
 // inverse depth LabelDispQ8(l) / 256 / px_per_inv_depth (in the motion result's units), so the
 // depth map's disparity is px_per_inv_depth times inverse depth. Choose px_per_inv_depth as the
 // pixels a unit of inverse depth moves a point in a typical view (focal length times the mean
-// baseline) to keep the label step a fixed fraction of a pixel of motion.
+// baseline) to keep the label step a fixed fraction of a pixel of motion. It joins the motion
+// stage's result to the depth stage's labels, so it lives with the pipeline that composes them.
 #pragma once
 
 #include "algo/depth/depth_stage.h"

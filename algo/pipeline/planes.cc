@@ -1,4 +1,4 @@
-#include "algo/depth/planes.h"
+#include "algo/pipeline/planes.h"
 
 namespace lb {
 
