@@ -19,7 +19,7 @@ mkdir -p "$ref/src"
 git archive "$rev" | tar -x -m -C "$ref/src"
 for side in "$ref/src:$ref/build" ".:build/abb"; do
   src=${side%%:*} bin=${side#*:}
-  cmake -S "$src" -B "$bin" -G Ninja -DCMAKE_BUILD_TYPE=Release -DLB_TESTS=OFF -DLB_BENCHMARKS=ON \
+  cmake -S "$src" -B "$bin" -G Ninja -DCMAKE_BUILD_TYPE=Release -DLB_TESTS=ON -DLB_BENCHMARKS=ON \
     >/dev/null
   cmake --build "$bin" --target "${benches[@]}" >/dev/null
 done
