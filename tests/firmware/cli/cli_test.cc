@@ -233,7 +233,7 @@ TEST_F(Cli, UnwritableOutputDirectory) {
   EXPECT_EQ(Slurp(not_dir).size(), 3u);
 }
 
-// Issue 13, defect 1: a device, a FIFO, a link or an input frame is never written over.
+// A device, a FIFO, a link or an input frame is never written over.
 TEST_F(Cli, OutputOntoSomethingNotARegularFileIsRefusedBeforeWork) {
   const std::vector<std::string> frames = PpmBurst(3, 64, 48);
   ASSERT_EQ(mkfifo((out_dir_ + "/fifo.jpg").c_str(), 0644), 0);
@@ -265,7 +265,7 @@ TEST_F(Cli, OutputOntoSomethingNotARegularFileIsRefusedBeforeWork) {
   EXPECT_EQ(Slurp(frames[0]), frame0) << "the input frame is untouched";
 }
 
-// Issue 13, defect 4: `refocus depth` writes the way every output is written.
+// `refocus depth` writes the way every output is written.
 TEST_F(Cli, DepthOutputsFollowTheFileRule) {
   const std::vector<std::string> frames = PpmBurst(3, 64, 48);
   std::vector<std::string> args = {
@@ -343,7 +343,7 @@ Bytes ZeroPng(uint32_t width, uint32_t height) {
   return out;
 }
 
-// Issue 13, defect 3: a small file that claims a huge image is refused from its header, the
+// A small file that claims a huge image is refused from its header, the
 // file named, in little memory.
 TEST_F(Cli, HugeViewsAreRefusedFromTheirHeaders) {
   const std::string big = dir_ + "/zero.png";
@@ -367,7 +367,7 @@ TEST_F(Cli, HugeViewsAreRefusedFromTheirHeaders) {
   EXPECT_TRUE(OutDirEmpty());
 }
 
-// Issue 13, defects 6 and 7: no value is changed or ignored without a word, and a usage error
+// No value is changed or ignored without a word, and a usage error
 // is one line that says what was wrong.
 TEST_F(Cli, NothingIsSilentlyChangedOrIgnored) {
   const std::vector<std::string> frames = PpmBurst(5, 64, 48);
@@ -415,7 +415,7 @@ TEST_F(Cli, NothingIsSilentlyChangedOrIgnored) {
   EXPECT_EQ(help.err, "");
 }
 
-// Issue 13, defects 7 and 8: the help and the code agree on the ranges, and libpng's own
+// The help and the code agree on the ranges, and libpng's own
 // "PNG ..." messages are not prefixed twice.
 TEST_F(Cli, HelpAndBehaviourAgree) {
   const Result help = Run({"run", "--help"});
@@ -445,7 +445,7 @@ TEST_F(Cli, HelpAndBehaviourAgree) {
   EXPECT_EQ(r.err.find("PNG PNG"), std::string::npos) << r.err;
 }
 
-// Issue 13, defect 6: the frames' EXIF Orientation goes into the photo, so it shows upright.
+// The frames' EXIF Orientation goes into the photo, so it shows upright.
 TEST_F(Cli, TheFramesOrientationGoesIntoThePhoto) {
   JpegMetadata meta;
   meta.orientation = 6;  // stored turned: the viewer rotates 90 degrees clockwise
@@ -478,7 +478,7 @@ TEST_F(Cli, TheFramesOrientationGoesIntoThePhoto) {
   EXPECT_EQ(ExifOrientation(again.c_str()), 6);
 }
 
-// Issue 13, defect 7: a size the camera cannot take is refused naming the file that has it.
+// A size the camera cannot take is refused naming the file that has it.
 TEST_F(Cli, SizeRefusalsNameTheFile) {
   const std::vector<std::string> tiny = PpmBurst(2, 8, 8);
   Result r = Run({"run", "--out", Out(), tiny[0], tiny[1]});

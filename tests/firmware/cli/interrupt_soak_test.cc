@@ -1,4 +1,4 @@
-// Issue 13, defect 2: `refocus run` and `rerender` interrupted by SIGINT or SIGTERM at random
+// `refocus run` and `rerender` interrupted by SIGINT or SIGTERM at random
 // moments (50 runs) leave no hidden temporary in the output folder, and the photo already
 // under the output name is intact: the old bytes, or the new photo whole when the run got
 // there first. Release only (label soak).
