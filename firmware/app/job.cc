@@ -81,16 +81,20 @@ class CountingSink final : public FrameSink {
 };
 
 // The refocusable XMP of a photo, built on the job's side thread (or inline without one) from
-// the reference and the disparity, which the render only reads meanwhile.
+// the reference and the disparity, which the render only reads meanwhile, and the Dynamic Depth
+// items it lists, written after the image.
 class XmpBuild final : public PendingSegments {
  public:
-  XmpBuild(SideTask* side, const Pipeline& p, const FocusUsed& focus, int quality)
+  XmpBuild(SideTask* side, const Pipeline& p, const FocusUsed& focus, int quality,
+           const DdImagingModel& model)
       : side_(side),
         reference_(p.reference()),
         disparity_(p.disparity_q8()),
         range_{p.disp_min_q8(), p.disp_max_q8()},
         focus_(focus),
-        quality_(quality) {}
+        quality_(quality) {
+    trailer_.extras.imaging_model = model;
+  }
   void Start() { side_->Post(&XmpBuild::Run, this); }
   bool Ready() override { return side_->Done(); }
   Status Take(const std::vector<JpegSegment>** segments) override {
@@ -103,6 +107,7 @@ class XmpBuild final : public PendingSegments {
   // After the build: its Status, and its segments handed over.
   const Status& status() const { return status_; }
   std::vector<JpegSegment> Release() { return std::move(segments_); }
+  const DynamicDepthTrailer& trailer() const { return trailer_; }
   double build_s() const { return build_s_; }
   double wait_s() const { return wait_s_; }
 
@@ -114,7 +119,7 @@ class XmpBuild final : public PendingSegments {
     status_ = EncodeYCbCr420(reference_, quality_, &original);
     if (status_.ok()) {
       status_ = BuildRefocusableSegments(disparity_, range_, std::move(original), focus_,
-                                         reference_.planes[0].width, &segments_);
+                                         reference_.planes[0].width, &segments_, &trailer_);
     }
     build_s_ = Now() - t0;
   }
@@ -127,6 +132,7 @@ class XmpBuild final : public PendingSegments {
   int quality_;
   Status status_;
   std::vector<JpegSegment> segments_;
+  DynamicDepthTrailer trailer_;
   double build_s_ = 0, wait_s_ = 0;
 };
 
@@ -247,7 +253,7 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
   // strips render and encode, and the writer holds their bytes until it comes (the file's bytes
   // are the same); otherwise it is built here first.
   XmpBuild xmp(&side_, p, FocusOf(p.render(), options_.render, mode_.width, mode_.height),
-               options_.quality);
+               options_.quality, ImagingModelOf(mode_.focal_px, mode_.width, mode_.height));
   SideTaskGuard joined(&side_);  // declared after `xmp`: its build never outlives it
   PendingSegments* pending = nullptr;
   if (options_.refocusable) {
@@ -266,6 +272,7 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
   JpegWriter writer;
   LB_RETURN_IF_ERROR(writer.Begin(&file, mode_.width, mode_.height, options_.quality, meta));
   LB_RETURN_IF_ERROR(WriteStrips(&p.render(), observer, &writer, progress_, pending));
+  if (options_.refocusable) LB_RETURN_IF_ERROR(WriteDynamicDepthTrailer(xmp.trailer(), &file));
   r.metadata_s = xmp.build_s();
   r.metadata_wait_s = pending != nullptr ? xmp.wait_s() : 0;
   if (progress_ != nullptr) progress_->Update("write", 100);

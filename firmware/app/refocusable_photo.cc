@@ -47,43 +47,6 @@ Status Ycc420Sink::Rows(const FrameRows& rows) {
   return Status::Ok();
 }
 
-// RangeInverse values as disparity = scale / depth, Q8.8, with the range Near and Far give at
-// that scale. Scale 1 is the product's own encoding, decoded exactly (depth_encoding.h).
-Status ValuesToDisparity(ConstImageU16 values, int bits, double near_depth, double far_depth,
-                         double scale, ImageU16 disp_q8, DisparityRange* range) {
-  if (scale == 1.0) {
-    LB_RETURN_IF_ERROR(DisparityRangeFromNearFar(near_depth, far_depth, range));
-    return DecodeDepthMap(values, *range, bits, disp_q8);
-  }
-  if (!(scale > 0.0 && std::isfinite(scale) && near_depth > 0.0 && far_depth > near_depth &&
-        std::isfinite(far_depth))) {
-    return Status(Code::kUnsupported, "depth map: Near %g, Far %g at scale %g give no disparity",
-                  near_depth, far_depth, scale);
-  }
-  if (!(256.0 * scale / near_depth <= 65535.0)) {
-    return Status(Code::kUnsupported, "depth map: Near %g at scale %g is too close", near_depth,
-                  scale);
-  }
-  range->max_q8 = static_cast<int32_t>(std::lround(256.0 * scale / near_depth));
-  range->min_q8 = static_cast<int32_t>(std::lround(256.0 * scale / far_depth));
-  if (range->min_q8 >= range->max_q8) {
-    return Status(Code::kUnsupported, "depth map: Near %g and Far %g are one disparity at scale %g",
-                  near_depth, far_depth, scale);
-  }
-  const int32_t top = bits == 16 ? 65535 : 255;
-  for (int32_t y = 0; y < values.height; ++y) {
-    const uint16_t* in = values.Row(y);
-    uint16_t* out = disp_q8.Row(y);
-    for (int32_t x = 0; x < values.width; ++x) {
-      // The stored value's depth, linear in inverse depth from Near (0) to Far (top).
-      const double dn = static_cast<double>(std::min<int32_t>(in[x], top)) / top;
-      const double depth = far_depth * near_depth / (far_depth - dn * (far_depth - near_depth));
-      out[x] = static_cast<uint16_t>(std::clamp(std::lround(256.0 * scale / depth), 0L, 65535L));
-    }
-  }
-  return Status::Ok();
-}
-
 }  // namespace
 
 // Where the reader puts the extended XMP, the depth image and GImage: the photo's buffers, at
@@ -159,11 +122,9 @@ Status RefocusablePhoto::Decode(const uint8_t* bytes, size_t size, const char* n
   Memory memory(this);
   RefocusableFields f;
   LB_RETURN_IF_ERROR(ReadRefocusableFields(bytes, size, name, memory, &f));
-  if (f.depth_format != "RangeInverse") {
-    return Status(Code::kUnsupported, "%s: GDepth:Format '%.*s' (only RangeInverse)", name,
-                  static_cast<int>(std::min<size_t>(f.depth_format.size(), 32)),
-                  f.depth_format.data());
-  }
+  DepthFormat format;
+  Status s = DepthFormatOf(f.depth_format, &format);
+  if (!s.ok()) return s.Prefix("%s: ", name);
   // Without GImage the photo itself is all there is to refocus. A GImage may lie in the file's
   // bytes (Dynamic Depth): it is kept, as the caller may reuse them.
   from_primary_ = f.image == nullptr;
@@ -206,8 +167,8 @@ Status RefocusablePhoto::Decode(const uint8_t* bytes, size_t size, const char* n
   }
   const FileDepthUnits units = DepthUnitsOf(f, width, scale_);
   const ImageU16 decoded = MakeView(resample ? depth_disp_.data() : disp_q8_.data(), dw, dh);
-  Status s = ValuesToDisparity(MakeView<const uint16_t>(depth_values_.data(), dw, dh), depth_bits_,
-                               f.near_depth, f.far_depth, units.scale, decoded, &range_);
+  s = DepthValuesToDisparity(MakeView<const uint16_t>(depth_values_.data(), dw, dh), depth_bits_,
+                             format, f.near_depth, f.far_depth, units.scale, decoded, &range_);
   if (!s.ok()) return s.Prefix("%s: ", name);
   depth_w_ = gw;
   depth_h_ = gh;

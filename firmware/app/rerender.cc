@@ -72,12 +72,14 @@ Status WriteRerendered(RenderStage* render, const RenderParams& params,
   meta.software = software;
   meta.f_number = params.f_number;
   meta.orientation = source.orientation;
+  DynamicDepthTrailer dd;
   LB_RETURN_IF_ERROR(BuildRefocusableSegments(source.disp_q8, source.range, *source.original_jpeg,
                                               FocusOf(*render, params, source.width, source.height),
-                                              source.width, &meta.extra_segments));
+                                              source.width, &meta.extra_segments, &dd));
   JpegWriter writer;
   LB_RETURN_IF_ERROR(writer.Begin(&file, source.width, source.height, quality, meta));
   LB_RETURN_IF_ERROR(WriteStrips(render, observer, &writer, progress));
+  LB_RETURN_IF_ERROR(WriteDynamicDepthTrailer(dd, &file));
   return file.Commit(replace);
 }
 

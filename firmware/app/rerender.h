@@ -39,7 +39,8 @@ struct RerenderSource {
 
 // The writing half of every re-render (`refocus rerender` and the web page's engine): `render`
 // has begun with `params`; its strips go through `observer` (may be nullptr) into a refocusable
-// JPEG written atomically at `out_path`. Allocates the metadata (XMP, EXIF) while it writes.
+// JPEG (GDepth and Dynamic Depth) written atomically at `out_path`. Allocates the metadata (XMP,
+// EXIF, Dynamic Depth's items) while it writes.
 // `replace`: whether out_path may be a regular file already (AtomicFile::Commit).
 Status WriteRerendered(RenderStage* render, const RenderParams& params,
                        const RerenderSource& source, int quality, const char* software,
@@ -51,9 +52,10 @@ RerenderSource SourceOf(const RefocusablePhoto& photo);
 
 class Rerenderer {
  public:
-  // Reads `path` (RefocusablePhoto): its GDepth (RangeInverse, PNG or JPEG, any size up to the
-  // photo's: resampled onto the render's working grid) and the original it refocuses, GImage or,
-  // when the file has none, the photo itself (from_primary()).
+  // Reads `path` (RefocusablePhoto): its depth (GDepth or Dynamic Depth, RangeInverse or
+  // RangeLinear, PNG or JPEG, any size up to the photo's: resampled onto the render's working grid)
+  // and the original it refocuses, GImage or, when the file has none, the photo itself
+  // (from_primary()).
   Status Load(const char* path);
   // The file's own focus (GFocus: its point, moved to the nearest pixel at its FocalDistance,
   // and the f-number that gives its BlurAtInfinity) into `params`, except what the user chose.

@@ -1,5 +1,6 @@
 #include "firmware/refocusable/depth_encoding.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace lb {
@@ -100,6 +101,62 @@ Status DecodeDepthMap(ConstImageU16 values, const DisparityRange& range, int bit
     uint16_t* out = disp_q8.Row(y);
     for (int32_t x = 0; x < values.width; ++x) {
       out[x] = static_cast<uint16_t>(DecodeRangeInverse(in[x], range, bits));
+    }
+  }
+  return Status::Ok();
+}
+
+Status DepthFormatOf(std::string_view text, DepthFormat* format) {
+  if (text == "RangeInverse") {
+    *format = DepthFormat::kRangeInverse;
+  } else if (text == "RangeLinear") {
+    *format = DepthFormat::kRangeLinear;
+  } else {
+    return Status(Code::kUnsupported, "depth map: Format '%.*s' (RangeInverse or RangeLinear)",
+                  static_cast<int>(std::min<size_t>(text.size(), 32)), text.data());
+  }
+  return Status::Ok();
+}
+
+Status DepthValuesToDisparity(ConstImageU16 values, int bits, DepthFormat format, double near_depth,
+                              double far_depth, double scale, ImageU16 disp_q8,
+                              DisparityRange* range) {
+  const bool linear = format == DepthFormat::kRangeLinear;
+  if (!linear && scale == 1.0) {
+    LB_RETURN_IF_ERROR(DisparityRangeFromNearFar(near_depth, far_depth, range));
+    return DecodeDepthMap(values, *range, bits, disp_q8);
+  }
+  if (!(scale > 0.0 && std::isfinite(scale) && near_depth > 0.0 && far_depth > near_depth &&
+        std::isfinite(far_depth))) {
+    return Status(Code::kUnsupported, "depth map: Near %g, Far %g at scale %g give no disparity",
+                  near_depth, far_depth, scale);
+  }
+  if (!(256.0 * scale / near_depth <= 65535.0)) {
+    return Status(Code::kUnsupported, "depth map: Near %g at scale %g is too close", near_depth,
+                  scale);
+  }
+  if (bits != 8 && bits != 16) {
+    return Status(Code::kInvalidArgument, "depth encoding: %d bits (8 or 16)", bits);
+  }
+  if (!SameSize(values, disp_q8)) {
+    return Status(Code::kInvalidArgument, "depth encoding: map sizes differ");
+  }
+  range->max_q8 = static_cast<int32_t>(std::lround(256.0 * scale / near_depth));
+  range->min_q8 = static_cast<int32_t>(std::lround(256.0 * scale / far_depth));
+  if (range->min_q8 >= range->max_q8) {
+    return Status(Code::kUnsupported, "depth map: Near %g and Far %g are one disparity at scale %g",
+                  near_depth, far_depth, scale);
+  }
+  const int32_t top = bits == 16 ? 65535 : 255;
+  const double span = far_depth - near_depth;
+  for (int32_t y = 0; y < values.height; ++y) {
+    const uint16_t* in = values.Row(y);
+    uint16_t* out = disp_q8.Row(y);
+    for (int32_t x = 0; x < values.width; ++x) {
+      const double dn = static_cast<double>(std::min<int32_t>(in[x], top)) / top;
+      const double depth =
+          linear ? near_depth + dn * span : far_depth * near_depth / (far_depth - dn * span);
+      out[x] = static_cast<uint16_t>(std::clamp(std::lround(256.0 * scale / depth), 0L, 65535L));
     }
   }
   return Status::Ok();

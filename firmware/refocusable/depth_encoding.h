@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string_view>
 
 #include "algo/core/image.h"
 #include "algo/core/status.h"
@@ -42,5 +43,18 @@ Status EncodeDepthMap(ConstImageU16 disp_q8, const DisparityRange& range, int bi
                       ImageU16 values);
 Status DecodeDepthMap(ConstImageU16 values, const DisparityRange& range, int bits,
                       ImageU16 disp_q8);
+
+// How a file's stored values map to depth between Near (value 0) and Far (the top value):
+// RangeInverse is linear in 1 / depth, RangeLinear in depth.
+enum class DepthFormat { kRangeInverse, kRangeLinear };
+Status DepthFormatOf(std::string_view text, DepthFormat* format);
+
+// A file's stored depth values (`bits` 8 or 16, in `format`, Near and Far in the file's units) as
+// Q8.8 disparity = `scale` / depth, clamped to 16 bits, and the disparities of Near and Far in
+// `range`. RangeInverse at scale 1 is the product's own encoding: DecodeDepthMap, exact. The
+// others compute each value in double (one division a pixel, nothing allocated).
+Status DepthValuesToDisparity(ConstImageU16 values, int bits, DepthFormat format, double near_depth,
+                              double far_depth, double scale, ImageU16 disp_q8,
+                              DisparityRange* range);
 
 }  // namespace lb

@@ -78,7 +78,9 @@ Status ReadDynamicDepthFields(const uint8_t* data, size_t size, const char* name
 // item as the depth image, the original as the image; the confidence map is not among them.
 void DynamicDepthAsRefocusable(const DynamicDepthFields& dd, RefocusableFields* out);
 
-// The photo's intrinsics (Camera:ImagingModel), in pixels of an image_width x image_height photo.
+// The photo's intrinsics (Camera:ImagingModel) as the specification normalises them: the focal
+// lengths by the larger side of the image_width x image_height photo, the principal point by the
+// width and the height.
 struct DdImagingModel {
   double focal_length_x = 0.0, focal_length_y = 0.0;  // 0: not known, not written
   double principal_point_x = 0.0, principal_point_y = 0.0;

@@ -439,54 +439,19 @@ Status ReadRefocusableFile(const char* path, RefocusableImage* out) {
 
 Status DisparityFromDepth(const RefocusableImage& image, std::vector<uint16_t>* disp_q8,
                           DisparityRange* range) {
-  const GDepthInfo& d = image.xmp.depth;
-  if (d.format != "RangeInverse") {
-    return Status(Code::kUnsupported, "depth map: %s (only RangeInverse maps back to disparity)",
-                  d.format.c_str());
-  }
-  LB_RETURN_IF_ERROR(DisparityRangeFromNearFar(d.near_depth, d.far_depth, range));
-  const GrayPng& png = image.depth;
-  disp_q8->assign(png.values.size(), 0);
-  ConstImageU16 values = MakeView(png.values.data(), png.width, png.height);
-  return DecodeDepthMap(values, *range, png.bits, MakeView(disp_q8->data(), png.width, png.height));
+  return ScaledDisparityFromDepth(image, 1.0, disp_q8, range);
 }
 
 Status ScaledDisparityFromDepth(const RefocusableImage& image, double scale,
                                 std::vector<uint16_t>* disp_q8, DisparityRange* range) {
   const GDepthInfo& d = image.xmp.depth;
-  if (scale == 1.0 || d.format != "RangeInverse") return DisparityFromDepth(image, disp_q8, range);
-  const double near_depth = d.near_depth, far_depth = d.far_depth;
-  if (!(scale > 0.0 && std::isfinite(scale) && near_depth > 0.0 && far_depth > near_depth &&
-        std::isfinite(far_depth))) {
-    return Status(Code::kUnsupported, "depth map: Near %g, Far %g at scale %g give no disparity",
-                  near_depth, far_depth, scale);
-  }
-  const double max_q8 = 256.0 * scale / near_depth;
-  if (!(max_q8 <= 65535.0)) {
-    return Status(Code::kUnsupported, "depth map: Near %g at scale %g is too close", near_depth,
-                  scale);
-  }
-  range->max_q8 = static_cast<int32_t>(std::lround(max_q8));
-  range->min_q8 = static_cast<int32_t>(std::lround(256.0 * scale / far_depth));
-  if (range->min_q8 >= range->max_q8) {
-    return Status(Code::kUnsupported, "depth map: Near %g and Far %g are one disparity at scale %g",
-                  near_depth, far_depth, scale);
-  }
-  // Every stored value once, whatever the map's size.
+  DepthFormat format;
+  LB_RETURN_IF_ERROR(DepthFormatOf(d.format, &format));
   const GrayPng& png = image.depth;
-  const int32_t top = png.bits == 16 ? 65535 : 255;
-  std::vector<uint16_t> table(static_cast<size_t>(top) + 1);
-  for (int32_t v = 0; v <= top; ++v) {
-    const double dn = static_cast<double>(v) / top;
-    const double depth = far_depth * near_depth / (far_depth - dn * (far_depth - near_depth));
-    table[static_cast<size_t>(v)] =
-        static_cast<uint16_t>(std::clamp(std::lround(256.0 * scale / depth), 0L, 65535L));
-  }
-  disp_q8->resize(png.values.size());
-  for (size_t i = 0; i < png.values.size(); ++i) {
-    (*disp_q8)[i] = table[std::min<size_t>(png.values[i], static_cast<size_t>(top))];
-  }
-  return Status::Ok();
+  disp_q8->assign(png.values.size(), 0);
+  return DepthValuesToDisparity(MakeView(png.values.data(), png.width, png.height), png.bits,
+                                format, d.near_depth, d.far_depth, scale,
+                                MakeView(disp_q8->data(), png.width, png.height), range);
 }
 
 }  // namespace lb

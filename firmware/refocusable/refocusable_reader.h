@@ -97,13 +97,13 @@ Status ReadRefocusableFile(const char* path, RefocusableImage* out);
 // The name the depth image goes by in messages ("<file>: GDepth:Data").
 void DepthPngName(const char* name, char* out, size_t out_size);
 
-// The depth image as Q8.8 disparity (RangeInverse files), with the range its Near and Far give.
+// The depth image as Q8.8 disparity, with the range its Near and Far give (ScaledDisparityFromDepth
+// at scale 1).
 Status DisparityFromDepth(const RefocusableImage& image, std::vector<uint16_t>* disp_q8,
                           DisparityRange* range);
 
-// The depth image as Q8.8 disparity (RangeInverse files) with disparity = `scale` / depth: a
-// phone's depth is in its own units, not the product's 1 / px. Scale 1 is DisparityFromDepth,
-// exact for the product's own files.
+// The depth image (RangeInverse or RangeLinear) as Q8.8 disparity = `scale` / depth
+// (DepthValuesToDisparity): a phone's depth is in its own units, not the product's 1 / px.
 Status ScaledDisparityFromDepth(const RefocusableImage& image, double scale,
                                 std::vector<uint16_t>* disp_q8, DisparityRange* range);
 

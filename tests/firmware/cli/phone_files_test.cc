@@ -16,7 +16,9 @@
 #include "firmware/codecs/jpeg_writer.h"
 #include "firmware/refocusable/refocusable_reader.h"
 #include "tests/firmware/cli/cli_fixture.h"
+#include "tests/firmware/codecs/jpeg_test_util.h"
 #include "tests/firmware/codecs/test_images.h"
+#include "tests/firmware/refocusable/refocusable_test_util.h"
 
 namespace lb {
 namespace {
@@ -95,7 +97,7 @@ TEST_F(PhoneFiles, InfoSaysWhatEachCarries) {
          {std::string("formats: GDepth GImage GFocus"), "primary: " + size, "depth: " + size,
           std::string("depth format: RangeInverse"), std::string("depth near: ") + f.near_depth,
           std::string("depth mime: image/png"), std::string("depth colour: 8-bit RGBA"),
-          "original: " + size + " image/jpeg"}) {
+          "original: " + size + " image/jpeg (GImage)"}) {
       EXPECT_TRUE(Has(r.out, line)) << "no line '" << line << "' in\n" << r.out;
     }
     EXPECT_NE(r.out.find("\nfocus point: 0."), std::string::npos) << r.out;
@@ -155,15 +157,71 @@ TEST_F(Info, OnTheProductsOwnFile) {
   r = Run({"info", photo});
   EXPECT_EQ(r.exit_code, 0) << r.err;
   for (const char* line :
-       {"formats: GDepth GImage GFocus", "primary: 320x240", "depth format: RangeInverse",
-        "depth mime: image/png", "depth colour: 16-bit grey", "original: 320x240 image/jpeg"}) {
+       {"formats: GDepth GImage GFocus DynamicDepth", "primary: 320x240", "depth from: GDepth",
+        "depth format: RangeInverse", "depth mime: image/png", "depth colour: 16-bit grey",
+        "original: 320x240 image/jpeg (GImage)", "dynamic depth confidence: none"}) {
     EXPECT_TRUE(Has(r.out, line)) << "no line '" << line << "' in\n" << r.out;
   }
+  EXPECT_NE(r.out.find("\ndynamic depth original: 320x240 image/jpeg, "), std::string::npos)
+      << r.out;
   // Re-rendered with no lens settings, it starts where `run` left it.
   const std::string again = dir_ + "/again.jpg";
   r = Run({"rerender", photo, "--out", again});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("at f/1.4"), std::string::npos) << r.out;
+}
+
+// `refocus run` writes Dynamic Depth beside GDepth: exiftool lists its directory and DepthMap
+// fields, dd_slice.py (an independent parser) slices its items from the end of the file and finds
+// the depth and the original valid images of their Mime, and with the GDepth part removed the
+// photo still tells what it carries and rerenders, carrying both formats again.
+TEST_F(Info, TheProductsDynamicDepthOpensWithoutGDepth) {
+  const std::string photo = dir_ + "/photo.jpg";
+  Result r =
+      Run({"run", "--synthetic", "--size", "160x120", "--geometry", "rectified", "--out", photo});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  int code = 0;
+  if (test::HaveTool("exiftool")) {
+    const std::string out = test::RunTool("exiftool -a -G1 -s '" + photo + "' 2>&1", &code);
+    EXPECT_EQ(code, 0) << out;
+    for (const char* want :
+         {"[XMP-Device]", "ContainerDirectoryItemMime", "image/jpeg, image/png, image/jpeg",
+          "ContainerDirectoryItemLength", "DepthMapFormat", "RangeInverse", "DepthMapNear",
+          "DepthMapFar", "DepthMapUnits", "Diopters", "DepthMapDepthURI", "android/depthmap",
+          "ImageItemURI", "android/originalimage"}) {
+      EXPECT_NE(out.find(want), std::string::npos) << want << "\n" << out;
+    }
+  }
+  if (test::HaveTool("python3")) {
+    const char* source = std::getenv("LB_SOURCE_DIR");
+    const std::string out =
+        test::RunTool("python3 '" + std::string(source ? source : ".") +
+                          "/tests/firmware/refocusable/dd_slice.py' '" + photo + "' 2>&1",
+                      &code);
+    ASSERT_EQ(code, 0) << out;
+    EXPECT_NE(out.find(" image/png "), std::string::npos) << out;
+    EXPECT_NE(out.find(" android/originalimage 160x120\n"), std::string::npos) << out;
+    EXPECT_NE(out.find("depth 1\n"), std::string::npos) << out;
+    EXPECT_NE(out.find("original 2\n"), std::string::npos) << out;
+  }
+
+  const std::string text = clitest::Slurp(photo);
+  const Bytes dd_only = test::WithoutGDepth(Bytes(text.begin(), text.end()));
+  ASSERT_FALSE(dd_only.empty());
+  const std::string stripped = dir_ + "/dd_only.jpg";
+  ASSERT_TRUE(test::WriteFile(stripped, dd_only));
+  r = Run({"info", stripped});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  for (const char* line :
+       {"formats: DynamicDepth", "depth from: Dynamic Depth",
+        "original: 160x120 image/jpeg (Dynamic Depth Original)", "depth units: Diopters"}) {
+    EXPECT_TRUE(Has(r.out, line)) << "no line '" << line << "' in\n" << r.out;
+  }
+  r = Run({"rerender", stripped, "--focus", "80,60", "--out", Out()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  r = Run({"info", Out()});
+  EXPECT_TRUE(Has(r.out, "formats: GDepth GImage GFocus DynamicDepth")) << r.out;
 }
 
 TEST_F(Info, APlainJpegCarriesNone) {

@@ -71,7 +71,7 @@ TEST_F(Rerender, AFileItCouldHaveWrittenRenders) {
   EXPECT_EQ(r.exit_code, 0) << r.err;
 }
 
-// Issue 13: a few bytes of GImage that claim a 16384x16384 original.
+// A few bytes of GImage that claim a 16384x16384 original.
 TEST_F(Rerender, AnOriginalClaimingHugeSizeIsRefusedFromItsHeader) {
   Bytes original = OriginalJpeg();
   size_t sof = 2;
@@ -89,7 +89,7 @@ TEST_F(Rerender, AnOriginalClaimingHugeSizeIsRefusedFromItsHeader) {
   printf("a GImage claiming 16384x16384: refused at %ld KiB peak RSS\n", rss_kib);
 }
 
-// Issue 13: an 8192x8192 depth map (a small PNG of zeros) inside a 64x48 photo.
+// An 8192x8192 depth map (a small PNG of zeros) inside a 64x48 photo.
 TEST_F(Rerender, ADepthMapLargerThanThePhotoIsRefusedFromItsHeader) {
   // Made in a process of its own: the measured child would count the pages of ours (a
   // sanitizer's allocator keeps freed memory).
@@ -110,16 +110,23 @@ TEST_F(Rerender, ADepthMapLargerThanThePhotoIsRefusedFromItsHeader) {
   printf("an 8192x8192 GDepth in a 64x48 photo: refused at %ld KiB peak RSS\n", rss_kib);
 }
 
-// Issue 13, defect 7: a depth map rerender cannot use says which file holds it.
-TEST_F(Rerender, ALinearDepthMapIsRefusedNamingTheFile) {
+// A depth map stored RangeLinear rerenders (its values read as depth = near + v * (far - near));
+// one in a format of no name is refused naming the file and the formats it could be.
+TEST_F(Rerender, ALinearDepthMapRerendersAndAnUnknownFormatIsRefused) {
   ASSERT_TRUE(WriteRefocusable(In(), depth(), OriginalJpeg()));
-  std::string bytes = clitest::Slurp(In());
-  const size_t at = bytes.find("\"RangeInverse\"");
+  const std::string good = clitest::Slurp(In());
+  const size_t at = good.find("\"RangeInverse\"");
   ASSERT_NE(at, std::string::npos);
+  std::string bytes = good;
   bytes.replace(at, 14, "\"RangeLinear\" ");  // the same length: no segment length changes
   ASSERT_TRUE(test::WriteFile(In(), Bytes(bytes.begin(), bytes.end())));
-  const Result r = Run({"rerender", In(), "--out", Out()});
-  ExpectCleanFailure(r, In(), "RangeInverse");
+  Result r = Run({"rerender", In(), "--out", dir_ + "/linear.jpg"});
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  bytes = good;
+  bytes.replace(at, 14, "\"RangeSquare\" ");
+  ASSERT_TRUE(test::WriteFile(In(), Bytes(bytes.begin(), bytes.end())));
+  r = Run({"rerender", In(), "--out", Out()});
+  ExpectCleanFailure(r, In(), "RangeInverse or RangeLinear");
 }
 
 TEST_F(Rerender, ADepthMapOfNoWholeFractionNamesBothSizes) {

@@ -31,4 +31,9 @@ std::vector<uint8_t> WriteRefocusJpeg(const RefocusSample& s,
 std::string PayloadText(const JpegSegment& seg);
 void SetPayloadText(JpegSegment* seg, const std::string& text);
 
+// A refocusable JPEG with its GDepth part removed, as a Dynamic Depth writer that knows nothing of
+// GDepth would have written it: the extended XMP dropped, the main packet cut to the Dynamic
+// Depth Device element, the items after the EOI kept. Empty when the file has no Device element.
+std::vector<uint8_t> WithoutGDepth(const std::vector<uint8_t>& jpeg);
+
 }  // namespace lb::test
