@@ -1,8 +1,9 @@
 // Writing a 12 MP photo: the rendered strips encoded as they come, the all-in-focus
 // original encoded whole (GImage), the refocusable XMP built (the depth map as a 16-bit PNG,
-// base64, extended-XMP segments) and the finished file written, fsynced and renamed. The
-// pictures are the synthetic burst's own reference frame and depth (computed once, before
-// timing), so the encoders see camera-like content.
+// base64, extended-XMP segments), with or without Dynamic Depth beside GDepth (its Device
+// element and its items, the same depth PNG and original again, raw), and the finished file
+// written, fsynced and renamed. The pictures are the synthetic burst's own reference frame and
+// depth (computed once, before timing), so the encoders see camera-like content.
 //   build/host/tests/bench/app/writing_bench --benchmark_repetitions=5
 #include <benchmark/benchmark.h>
 
@@ -100,18 +101,33 @@ void BM_RefocusableXmp(benchmark::State& state) {
   if (!EncodeYCbCr420(p.reference(), 92, &original).ok()) state.SkipWithError("original");
   FocusUsed focus;
   focus.focus_disp_q8 = (p.disp_min_q8() + p.disp_max_q8()) / 2;
-  size_t bytes = 0;
+  const bool dynamic_depth = state.range(0) != 0;
+  size_t bytes = 0, items = 0;
+  std::vector<uint8_t> after_eoi;
   for (auto _ : state) {
     std::vector<JpegSegment> segments;
-    const Status s = BuildRefocusableSegments(p.disparity_q8(), {p.disp_min_q8(), p.disp_max_q8()},
-                                              original, focus, kWidth, &segments);
+    DynamicDepthTrailer dd;
+    Status s =
+        BuildRefocusableSegments(p.disparity_q8(), {p.disp_min_q8(), p.disp_max_q8()}, original,
+                                 focus, kWidth, &segments, dynamic_depth ? &dd : nullptr);
+    // The items as the job writes them after the image, here into memory.
+    after_eoi.clear();
+    if (s.ok() && dynamic_depth) {
+      s = WriteDynamicDepthItems(dd.xmp, dd.extras, [&after_eoi](const uint8_t* d, size_t n) {
+        after_eoi.insert(after_eoi.end(), d, d + n);
+        return Status::Ok();
+      });
+    }
     if (!s.ok()) state.SkipWithError(s.message());
-    bytes = 0;
+    bytes = after_eoi.size();
+    items = after_eoi.size();
     for (const JpegSegment& seg : segments) bytes += seg.payload.size();
   }
   state.counters["MB"] = static_cast<double>(bytes) / 1e6;
+  state.counters["items_MB"] = static_cast<double>(items) / 1e6;
 }
-BENCHMARK(BM_RefocusableXmp)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+// Arg 0: GDepth only; 1: Dynamic Depth beside it, as the product writes.
+BENCHMARK(BM_RefocusableXmp)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 // The finished photo's bytes through the storage rule: a hidden temporary, fsync, rename and
 // the folder's fsync, on TMPDIR (a card on the board).
@@ -129,7 +145,14 @@ void BM_Commit(benchmark::State& state) {
   }
   unlink(path.c_str());
 }
-BENCHMARK(BM_Commit)->Arg(12)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+// Arg: MiB. 4 and 6: the synthetic 12 MP photo without and with Dynamic Depth's items.
+BENCHMARK(BM_Commit)
+    ->Arg(4)
+    ->Arg(6)
+    ->Arg(12)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2.0);
 
 }  // namespace
 }  // namespace lb
