@@ -16,10 +16,11 @@ const char kUsage[] =
     "usage: refocus rerender IN.jpg --out OUT.jpg [--focus X,Y[,W,H]] [--f-number N] [options]\n"
     "\n"
     "Renders a new focus from a refocusable JPEG alone (one written by `refocus run`, or a\n"
-    "phone's Lens Blur photo: any file with a GDepth depth map), no burst needed. Without\n"
-    "--focus and --f-number it starts from the file's own focus and blur (GFocus) when it has\n"
-    "them. A file without the all-in-focus original (GImage) is refocused from the photo itself,\n"
-    "which is already blurred: a warning says so.\n"
+    "phone's depth photo: any file with a GDepth depth map or Dynamic Depth), no burst needed.\n"
+    "Without --focus and --f-number it starts from the file's own focus and blur (GFocus) when\n"
+    "it has them. A file without the all-in-focus original (GImage or Dynamic Depth's Original)\n"
+    "is refocused from the photo itself, which is already blurred: a warning says so. The new\n"
+    "photo carries its depth and original again, as GDepth and as Dynamic Depth.\n"
     "  --out OUT.jpg          written atomically: the name holds a whole JPEG or nothing\n"
     "Lens (refocusd.conf takes the same settings, with _ for -):\n";
 
