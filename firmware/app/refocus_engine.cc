@@ -73,7 +73,11 @@ Status RefocusEngine::Configure(const RefocusEngineConfig& config) {
   }
   config_ = config;
   const size_t pixels = static_cast<size_t>(W) * H;
-  if (config_.max_file_bytes == 0) config_.max_file_bytes = pixels + (size_t{1} << 20);
+  // The XMP a photo reassembles holds its original and depth once (GImage, GDepth); the file
+  // holds them again after the image as Dynamic Depth's items, read whole but never copied.
+  const size_t xmp_bytes = pixels + (size_t{1} << 20);
+  const bool default_size = config_.max_file_bytes == 0;
+  if (default_size) config_.max_file_bytes = xmp_bytes + pixels / 2;
   const size_t file = config_.max_file_bytes;
   const int32_t pw = std::min(W, config.preview_side), ph = std::min(H, config.preview_side);
   const size_t ppx = static_cast<size_t>(pw) * ph;
@@ -82,7 +86,7 @@ Status RefocusEngine::Configure(const RefocusEngineConfig& config) {
   RefocusableLimits limits;
   limits.max_width = W;
   limits.max_height = H;
-  limits.max_file_bytes = file;
+  limits.max_file_bytes = default_size ? xmp_bytes : file;
   limits.max_depth_pixels = config.max_depth_pixels;
   LB_RETURN_IF_ERROR(file_.Configure(limits));
   py_.resize(ppx);

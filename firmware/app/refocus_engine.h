@@ -41,8 +41,10 @@ struct RefocusEngineConfig {
   int32_t preview_side = 1024;  // a preview's longer side, at most
   int quality = 92;
   int preview_quality = 85;
-  // The largest file Load accepts; 0: one byte per pixel of the largest photo and 1 MiB (a photo
-  // and its original at the camera's quality take about half that).
+  // The largest file Load accepts; 0: one and a half bytes per pixel of the largest photo and
+  // 1 MiB, its XMP (the original and the depth, base64) at most one byte per pixel and 1 MiB. The
+  // camera's photo holds the original three times (the photo itself, GImage, Dynamic Depth's
+  // Original item) and the depth twice.
   size_t max_file_bytes = 0;
   // The largest depth map (the pipeline's working size is at most 640x480 by default).
   int32_t max_depth_pixels = 1 << 20;
