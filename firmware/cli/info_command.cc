@@ -21,9 +21,10 @@ const char kUsage[] =
     "Prints what a photo carries for refocusing, one `key: value` line each: the formats found\n"
     "(GDepth, GImage, GFocus: the refocusable JPEG of `refocus run` and of phones' Lens Blur;\n"
     "DynamicDepth: Dynamic Depth 1.0, as Pixel phones and `refocus run` write it), the primary\n"
-    "image's size, the depth map refocusing uses (its format, size, format, near, far, units,\n"
-    "mime and colour type), the focus (GFocus) and the all-in-focus original (GImage or Dynamic\n"
-    "Depth's Original item); then Dynamic Depth's own items, depth, original and confidence.\n"
+    "image's size, the depth map refocusing uses (the format it comes from, its size, format,\n"
+    "near, far, units, mime and colour type), the focus (GFocus) and the all-in-focus original\n"
+    "(GImage or Dynamic Depth's Original item); then Dynamic Depth's own items, depth, range,\n"
+    "units, original and confidence map.\n"
     "Exit status: 0 when the file carries a depth map; 1 when it carries none (the lines then end\n"
     "with `formats: none`) or cannot be read (one line on stderr); 2 for a usage error.\n";
 
