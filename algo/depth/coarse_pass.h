@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "algo/core/arena.h"
+#include "algo/depth/confidence.h"
 #include "algo/depth/data_term.h"
 #include "algo/depth/depth_config.h"
 #include "algo/depth/grid_maxflow.h"
@@ -43,6 +44,8 @@ class CoarsePass {
   // took (0 without carried rings).
   void StripedWinners(bool on) { striped_winners_ = on; }
   int32_t winner_stripes() const { return winner_stripes_; }
+  // Where the winner-take-all leaves each pixel's two lowest D (borrowed; nullptr: nowhere).
+  void SetMargins(LabelMargins* margins) { margins_ = margins; }
 
  private:
   // Where the pass keeps, in the max-flow's spare, each coarse label's block D, `stripes`
@@ -74,7 +77,12 @@ class CoarsePass {
   }
   void FineFromBlocks(MoveGrid& fine, const LabelTerm& term, RowRuns* runs, uint8_t* marks);
 
+  // The pixels' D of `label` over the block rows of `rows`, as BlockCosts left them in the fine
+  // grid's cost_alpha, into the margins.
+  void TakeMargins(const MoveGrid& fine, const MoveRect& rows, int32_t label);
+
   MoveGrid grid_;  // the blocks
+  LabelMargins* margins_ = nullptr;
   // The grid's own cost_alpha, while the moves point it at block_costs_.
   uint16_t* scratch_ = nullptr;
   // The block D of every coarse label, kept from the winner-take-all for the moves in storage

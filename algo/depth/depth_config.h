@@ -49,6 +49,9 @@ struct DepthConfig {
   // within fine_window, which moves the block edges onto the image's.
   bool coarse_blocks = true;
   bool subpixel = true;  // parabola fit between labels for the output
+  // The confidence map (confidence.h): kept from the winner-take-all's costs, a few bytes a
+  // pixel of arena; the disparity map is the same either way.
+  bool confidence = true;
   // Workers the data term carves rings for (task_runner.h), 1..kMaxWorkers.
   int32_t workers = 1;
 };

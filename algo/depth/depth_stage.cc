@@ -100,6 +100,9 @@ Status DepthStage::Carve(Arena& arena) {
   book_.SetFitMemory(reinterpret_cast<uint16_t*>(refine));
   Arena blocks(refine, refine == nullptr ? 0 : refine_bytes);
   coarse_.CarveGrid(blocks, config_);
+  margins_ = LabelMargins{};
+  if (config_.confidence) margins_.Carve(arena, w, h);
+  coarse_.SetMargins(config_.confidence ? &margins_ : nullptr);
   planes_ = nullptr;
   if (config_.geometry == ViewGeometry::kKnownPoses) {
     planes_ = arena.Allocate<PlaneHomography>(static_cast<size_t>(config_.labels) * config_.views);
@@ -201,6 +204,7 @@ void DepthStage::WinnerTakeAll() {
   const int32_t step = config_.max_cycles > 0 ? config_.coarse_step : 1;
   for (int32_t label = 0; label < config_.labels; label += step) {
     LabelCosts(label, fine_.cost_alpha);
+    if (margins_.carved()) margins_.Take(fine_.cost_alpha, 0, n, static_cast<uint8_t>(label));
     TakeBetter(fine_.cost_alpha, n, static_cast<uint8_t>(label), cost, labels);
   }
 }
@@ -333,6 +337,7 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
   stats_.coarse_energy = stats_.handover_energy = 0;
   window_ = DepthConfig::kMaxLabels;
   const bool coarse = c.coarse_step > 1 && c.max_cycles > 0;
+  if (margins_.carved()) margins_.Reset();
   if (coarse && c.coarse_blocks) {
     CoarseMoves();  // ends with the pixels' labels, their row masks, costs and energy
   } else {
@@ -363,6 +368,12 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
   }
   stats_.energy = energy_;
   Refine(disp_q8);
+  stats_.low_confidence = 0;
+  if (margins_.carved()) {
+    // The winner-take-all's label step (WinnerTakeAll, CoarsePass::Start).
+    const int32_t step = c.max_cycles > 0 ? c.coarse_step : 1;
+    stats_.low_confidence = margins_.Finish(fine_.labels, fine_.cost, step, views[c.reference]);
+  }
   if (progress_ != nullptr) progress_->Report(total, total);
   return Status::Ok();
 }

@@ -21,6 +21,7 @@
 #include "algo/core/progress.h"
 #include "algo/core/status.h"
 #include "algo/depth/coarse_pass.h"
+#include "algo/depth/confidence.h"
 #include "algo/depth/data_term.h"
 #include "algo/depth/depth_config.h"
 #include "algo/depth/expansion_move.h"
@@ -44,6 +45,8 @@ struct DepthStats {
   int64_t handover_energy = 0;
   int64_t energy = 0;      // final energy
   size_t arena_bytes = 0;  // bytes this stage carved from the arena
+  // Pixels whose confidence is below kLowConfidence (0 without the map).
+  int64_t low_confidence = 0;
 };
 
 class DepthStage {
@@ -85,6 +88,10 @@ class DepthStage {
   // After Compute: the label map of the reference view (row stride = width), which the depth
   // order votes on (auto_geometry.h).
   const uint8_t* labels() const { return fine_.labels; }
+  // After Compute, with config().confidence: how sure each pixel's depth is, 0..255 (255: sure;
+  // confidence.h), row stride = width; nullptr without it.
+  const uint8_t* confidence() const { return margins_.confidence; }
+  static constexpr uint8_t kLowConfidence = LabelMargins::kLow;
   int32_t LabelDispQ8(int32_t label) const { return LabelDispQ8(config_, label); }
   // The disparity of a label, Q8.8, for any valid configuration.
   static int32_t LabelDispQ8(const DepthConfig& config, int32_t label);
@@ -112,10 +119,11 @@ class DepthStage {
   ProgressSink* progress_ = nullptr;
   DepthStats stats_;
   DataTerm data_;
-  MoveGrid fine_;       // the pixels
-  ExpansionMove move_;  // the graph and the cut, and the solver
-  MoveBook book_;       // where the moves look and what they leave behind
-  CoarsePass coarse_;   // the blocks, in the memory of the book's fit costs
+  MoveGrid fine_;         // the pixels
+  ExpansionMove move_;    // the graph and the cut, and the solver
+  MoveBook book_;         // where the moves look and what they leave behind
+  CoarsePass coarse_;     // the blocks, in the memory of the book's fit costs
+  LabelMargins margins_;  // the confidence map and what it is made from
   bool on_coarse_ = false;
   int64_t energy_ = 0;
   int32_t window_ = DepthConfig::kMaxLabels;  // the move in progress frees labels this near alpha
