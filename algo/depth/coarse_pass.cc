@@ -153,7 +153,7 @@ void CoarsePass::WinnerTakeAll(const MoveGrid& fine, const LabelTerm& term, Grid
         uint16_t* d =
             block_costs_ != nullptr ? CoarseCosts(label, config.coarse_step) : g.cost_alpha;
         BlockCosts(fine, term, label, rows, d);
-        TakeMargins(fine, rows, label);
+        TakeMargins(fine, rows, label, config.coarse_step);
         const int32_t p0 = rows.y0 * g.width;
         TakeBetter(d + p0, (rows.y1 - rows.y0) * g.width, static_cast<uint8_t>(label), g.cost + p0,
                    g.labels + p0);
@@ -174,7 +174,7 @@ void CoarsePass::WinnersOfStripe(const MoveGrid& fine, const LabelTerm& term,
       uint16_t* d = CoarseCosts(label, config.coarse_step);
       uint16_t* ring = rings + term.data.CarriedRingSize() * (label / config.coarse_step);
       BlockCosts(fine, term, label, rows, d, ring, by0 > stripe.y0, worker);
-      TakeMargins(fine, rows, label);
+      TakeMargins(fine, rows, label, config.coarse_step);
       if (winner_costs_ != nullptr) KeepWinnerCosts(fine, rows, d);
       const int32_t p0 = rows.y0 * g.width;
       TakeBetter(d + p0, (rows.y1 - rows.y0) * g.width, static_cast<uint8_t>(label), g.cost + p0,
@@ -183,11 +183,12 @@ void CoarsePass::WinnersOfStripe(const MoveGrid& fine, const LabelTerm& term,
   }
 }
 
-void CoarsePass::TakeMargins(const MoveGrid& fine, const MoveRect& rows, int32_t label) {
+void CoarsePass::TakeMargins(const MoveGrid& fine, const MoveRect& rows, int32_t label,
+                             int32_t step) {
   if (margins_ == nullptr) return;
   const int32_t w = fine.width;
   const int32_t y0 = 2 * rows.y0, y1 = Min(2 * rows.y1, fine.height);
-  margins_->Take(fine.cost_alpha + y0 * w, y0 * w, (y1 - y0) * w, static_cast<uint8_t>(label));
+  margins_->Take(fine.cost_alpha + y0 * w, y0 * w, (y1 - y0) * w, label, step);
 }
 
 // Before the winner-take-all takes a label's block costs d over the band b: the pixels' D

@@ -79,7 +79,7 @@ class CoarsePass {
 
   // The pixels' D of `label` over the block rows of `rows`, as BlockCosts left them in the fine
   // grid's cost_alpha, into the margins.
-  void TakeMargins(const MoveGrid& fine, const MoveRect& rows, int32_t label);
+  void TakeMargins(const MoveGrid& fine, const MoveRect& rows, int32_t label, int32_t step);
 
   MoveGrid grid_;  // the blocks
   LabelMargins* margins_ = nullptr;

@@ -15,6 +15,8 @@ namespace {
 constexpr int32_t kMarginFloor = 64;
 constexpr int32_t kDoubtShare = 32;
 constexpr int32_t kSureShare = 128;
+// The table of shares: every away cost (at most DataTerm::kMaxCost; none seen: the last entry).
+constexpr int32_t kShareEntries = 4096;
 // Texture: the reference's luma (R + 2G + B, 0..1020) steps to the right and down, summed over
 // 3x3 (18 steps). Under kFlatTexture (a mean step of 8, two levels a channel: sensor noise on a
 // wall) it is flat, confidence 0; at kSureTexture (a mean step of 48) and above it says nothing.
@@ -25,19 +27,22 @@ inline int32_t Luma(const uint8_t* rgb) { return rgb[0] + 2 * rgb[1] + rgb[2]; }
 
 inline int32_t Abs(int32_t v) { return v < 0 ? -v : v; }
 
-// The luma steps right and down of pixel x of `row` (0 past the last column or row).
-inline int32_t Steps(const uint8_t* row, const uint8_t* below, int32_t x, int32_t w) {
-  const int32_t l = Luma(row + 3 * x);
-  const int32_t right = x + 1 < w ? Abs(Luma(row + 3 * x + 3) - l) : 0;
-  const int32_t down = below != nullptr ? Abs(Luma(below + 3 * x) - l) : 0;
-  return right + down;
-}
-
 // Q0.8 from v on a ramp lo..hi, clamped.
 inline int32_t Ramp(int32_t v, int32_t lo, int32_t hi) {
   if (v <= lo) return 0;
   if (v >= hi) return 255;
   return ((v - lo) * 255 + (hi - lo) / 2) / (hi - lo);
+}
+
+// Each pixel's luma steps to the right and down (0 past the last column; below: nullptr past the
+// last row), at most 2040.
+void StepsRow(const uint8_t* row, const uint8_t* below, int32_t w, uint16_t* out) {
+  for (int32_t x = 0; x < w; ++x) {
+    const int32_t l = Luma(row + 3 * x);
+    const int32_t right = x + 1 < w ? Abs(Luma(row + 3 * x + 3) - l) : 0;
+    const int32_t down = below != nullptr ? Abs(Luma(below + 3 * x) - l) : 0;
+    out[x] = static_cast<uint16_t>(right + down);
+  }
 }
 }  // namespace
 
@@ -47,8 +52,16 @@ void LabelMargins::Carve(Arena& arena, int32_t w, int32_t h) {
   height = h;
   best = arena.Allocate<uint16_t>(n);
   second = arena.Allocate<uint16_t>(n);
-  best_label = arena.Allocate<uint8_t>(n);
+  best_label = arena.Allocate<uint16_t>(n);
   confidence = arena.Allocate<uint8_t>(n);
+  steps = arena.Allocate<uint16_t>(4 * static_cast<size_t>(w));
+  column = steps == nullptr ? nullptr : steps + 3 * static_cast<size_t>(w);
+  share = arena.Allocate<uint32_t>(kShareEntries);
+  // The margin's share without a division a pixel (Finish): 256 << 16 over at least
+  // kMarginFloor fits 18 bits, and times a margin of 12 bits, 30.
+  for (int32_t a = 0; share != nullptr && a < kShareEntries; ++a) {
+    share[a] = static_cast<uint32_t>((int64_t{256} << 16) / (a + kMarginFloor));
+  }
 }
 
 void LabelMargins::Reset() {
@@ -59,14 +72,28 @@ void LabelMargins::Reset() {
   }
 }
 
-// Without branches, so that it vectorizes. Labels come ascending, so label - best_label >= 0.
-LB_CLONES_AVX2 static void TakeTwoBest(const uint16_t* __restrict d, int32_t n, uint8_t label,
-                                       uint16_t* __restrict best, uint16_t* __restrict second,
-                                       uint8_t* __restrict best_label) {
+// Labels more than one apart (a step over 1): the two lowest, a min and a max a pixel.
+LB_CLONES_AVX2 static void TakeTwo(const uint16_t* __restrict d, int32_t n, uint16_t label,
+                                   uint16_t* __restrict best, uint16_t* __restrict second,
+                                   uint16_t* __restrict best_label) {
+  for (int32_t p = 0; p < n; ++p) {
+    const uint16_t b = best[p], v = d[p];
+    const uint16_t high = v > b ? v : b;
+    second[p] = high < second[p] ? high : second[p];
+    best[p] = v < b ? v : b;
+    best_label[p] = v < b ? label : best_label[p];
+  }
+}
+
+// Every label (a step of 1): the second only from labels apart from the best as it stands.
+// Labels come ascending, so label - best_label >= 0.
+LB_CLONES_AVX2 static void TakeTwoApart(const uint16_t* __restrict d, int32_t n, uint16_t label,
+                                        uint16_t* __restrict best, uint16_t* __restrict second,
+                                        uint16_t* __restrict best_label) {
   for (int32_t p = 0; p < n; ++p) {
     const uint16_t b = best[p], s = second[p], v = d[p];
     const bool wins = v < b;
-    const bool apart = static_cast<uint8_t>(label - best_label[p]) > 1;
+    const bool apart = static_cast<uint16_t>(label - best_label[p]) > 1;
     const uint16_t low = v < s ? v : s;
     second[p] = apart ? (wins ? b : low) : s;
     best[p] = wins ? v : b;
@@ -74,8 +101,13 @@ LB_CLONES_AVX2 static void TakeTwoBest(const uint16_t* __restrict d, int32_t n, 
   }
 }
 
-void LabelMargins::Take(const uint16_t* d, int32_t p0, int32_t n, uint8_t label) {
-  TakeTwoBest(d, n, label, best + p0, second + p0, best_label + p0);
+void LabelMargins::Take(const uint16_t* d, int32_t p0, int32_t n, int32_t label, int32_t step) {
+  const uint16_t l = static_cast<uint16_t>(label);
+  if (step > 1) {
+    TakeTwo(d, n, l, best + p0, second + p0, best_label + p0);
+  } else {
+    TakeTwoApart(d, n, l, best + p0, second + p0, best_label + p0);
+  }
 }
 
 int64_t LabelMargins::Finish(const uint8_t* labels, const uint16_t* cost, int32_t step,
@@ -85,25 +117,32 @@ int64_t LabelMargins::Finish(const uint8_t* labels, const uint16_t* cost, int32_
   // the coarse labels): the margin is to the second; else the winner itself is away from it.
   const int32_t near = step / 2 > 1 ? step / 2 : 1;
   int64_t low = 0;
+  // The texture's steps of rows y - 1, y and y + 1 in a ring of three.
+  StepsRow(reference.Row(0), h > 1 ? reference.Row(1) : nullptr, w, steps);
   for (int32_t y = 0; y < h; ++y) {
-    const uint8_t* rows[3] = {reference.Row(y > 0 ? y - 1 : y), reference.Row(y),
-                              reference.Row(y + 1 < h ? y + 1 : y)};
-    const uint8_t* below[3] = {y > 0 ? rows[1] : nullptr, y + 1 < h ? rows[2] : nullptr,
-                               y + 2 < h ? reference.Row(y + 2) : nullptr};
+    if (y + 1 < h) {
+      StepsRow(reference.Row(y + 1), y + 2 < h ? reference.Row(y + 2) : nullptr, w,
+               steps + ((y + 1) % 3) * w);
+    }
+    const uint16_t* up = y > 0 ? steps + ((y + 2) % 3) * w : nullptr;
+    const uint16_t* mid = steps + (y % 3) * w;
+    const uint16_t* down = y + 1 < h ? steps + ((y + 1) % 3) * w : nullptr;
+    for (int32_t x = 0; x < w; ++x) {
+      column[x] = static_cast<uint16_t>(mid[x] + (up != nullptr ? up[x] : 0) +
+                                        (down != nullptr ? down[x] : 0));
+    }
     for (int32_t x = 0; x < w; ++x) {
       const int32_t p = y * w + x;
       const int32_t f = labels[p];
       const int32_t apart = Abs(f - best_label[p]) > near;
-      const int32_t away = apart ? best[p] : second[p];
+      const int32_t seen = apart != 0 ? best[p] : second[p];
+      const int32_t away = seen < kShareEntries ? seen : kShareEntries - 1;
       const int32_t margin = away > cost[p] ? away - cost[p] : 0;
-      const int32_t by_data = Ramp((margin << 8) / (away + kMarginFloor), kDoubtShare, kSureShare);
-      int32_t texture = 0;
-      for (int32_t k = 0; k < 3; ++k) {
-        if ((k == 0 && y == 0) || (k == 2 && y + 1 >= h)) continue;
-        for (int32_t dx = x > 0 ? -1 : 0; dx <= 1 && x + dx < w; ++dx) {
-          texture += Steps(rows[k], below[k], x + dx, w);
-        }
-      }
+      const int32_t by_data =
+          Ramp(static_cast<int32_t>((static_cast<uint32_t>(margin) * share[away]) >> 16),
+               kDoubtShare, kSureShare);
+      const int32_t texture =
+          column[x] + (x > 0 ? column[x - 1] : 0) + (x + 1 < w ? column[x + 1] : 0);
       const int32_t by_texture = Ramp(texture, kFlatTexture, kSureTexture);
       const int32_t c = (by_data * by_texture + 127) / 255;
       confidence[p] = static_cast<uint8_t>(c);

@@ -31,10 +31,13 @@ namespace lb {
 struct LabelMargins {
   static constexpr uint8_t kLow = 64;  // below this a pixel counts as low confidence
 
-  uint16_t* best = nullptr;    // the lowest D the winner-take-all saw
-  uint16_t* second = nullptr;  // the lowest at a label apart from best's (above)
-  uint8_t* best_label = nullptr;
-  uint8_t* confidence = nullptr;  // the map, row stride = width
+  uint16_t* best = nullptr;        // the lowest D the winner-take-all saw
+  uint16_t* second = nullptr;      // the lowest at a label apart from best's (above)
+  uint16_t* best_label = nullptr;  // 16 bits, as the costs: the loop that keeps them vectorizes
+  uint8_t* confidence = nullptr;   // the map, row stride = width
+  uint16_t* steps = nullptr;       // Finish: 3 rows of the texture's steps, and their column sums
+  uint16_t* column = nullptr;
+  uint32_t* share = nullptr;  // Finish: (256 << 16) / (away + floor), for each away
   int32_t width = 0, height = 0;
 
   void Carve(Arena& arena, int32_t w, int32_t h);
@@ -42,8 +45,8 @@ struct LabelMargins {
   // Before the winner-take-all: no label seen.
   void Reset();
   // The winner-take-all's D of `label` for pixels p0..p0+n-1 (d indexed from p0), labels
-  // ascending.
-  void Take(const uint16_t* d, int32_t p0, int32_t n, uint8_t label);
+  // ascending by `step`.
+  void Take(const uint16_t* d, int32_t p0, int32_t n, int32_t label, int32_t step);
   // After the moves: the map from the final labels and their D (row stride = width), the
   // winner-take-all's label step and the reference view (RGB8); returns the pixels below kLow.
   int64_t Finish(const uint8_t* labels, const uint16_t* cost, int32_t step,

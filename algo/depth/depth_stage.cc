@@ -204,7 +204,7 @@ void DepthStage::WinnerTakeAll() {
   const int32_t step = config_.max_cycles > 0 ? config_.coarse_step : 1;
   for (int32_t label = 0; label < config_.labels; label += step) {
     LabelCosts(label, fine_.cost_alpha);
-    if (margins_.carved()) margins_.Take(fine_.cost_alpha, 0, n, static_cast<uint8_t>(label));
+    if (margins_.carved()) margins_.Take(fine_.cost_alpha, 0, n, label, step);
     TakeBetter(fine_.cost_alpha, n, static_cast<uint8_t>(label), cost, labels);
   }
 }

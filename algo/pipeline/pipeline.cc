@@ -43,6 +43,7 @@ static DepthConfig MakeDepthConfig(const PipelineConfig& c, int32_t w, int32_t h
   d.smooth_weight = c.smooth_weight;
   d.max_cycles = c.max_cycles;
   d.subpixel = c.subpixel;
+  d.confidence = c.confidence;
   if (c.geometry == ViewGeometry::kAuto) d.geometry = ViewGeometry::kKnownPoses;
   if (c.geometry == ViewGeometry::kAuto && c.plan_range) {
     // Placeholder range for sizing; every burst sets its own (auto_geometry.h).
@@ -143,6 +144,7 @@ Status Pipeline::Carve(Arena& arena) {
   for (int32_t i = 0; i < c.frames; ++i)
     working_[i] = arena.AllocateImage<uint8_t>(work_w_, work_h_, 3);
   disp_q8_ = arena.AllocateImage<uint16_t>(work_w_, work_h_);
+  confidence_ = c.confidence ? arena.AllocateImage<uint8_t>(work_w_, work_h_) : ImageU8{};
   rgb_rows_[0] = arena.Allocate<uint8_t>(static_cast<size_t>(c.width) * 3);
   rgb_rows_[1] = arena.Allocate<uint8_t>(static_cast<size_t>(c.width) * 3);
   cols_ = arena.Allocate<uint32_t>(static_cast<size_t>(work_w_) * scale_ * 3);
@@ -354,11 +356,23 @@ Status Pipeline::ComputeDepth() {
       uint16_t* row = disp_q8_.Row(y);
       for (int32_t x = 0; x < work_w_; ++x) row[x] = static_cast<uint16_t>(disp_min_q8_);
     }
+    for (int32_t y = 0; y < confidence_.height; ++y)
+      memset(confidence_.Row(y), 0, static_cast<size_t>(work_w_));
+    low_confidence_permille_ = config_.confidence ? 1000 : 0;
     depth_ready_ = true;
     return Status::Ok();
   }
   LB_RETURN_IF_ERROR(geometry);
   LB_RETURN_IF_ERROR(depth_.Compute(views, disp_q8_));
+  low_confidence_permille_ = 0;
+  if (depth_.confidence() != nullptr && confidence_.data != nullptr) {
+    // Out of the stage's memory, which the render takes over.
+    for (int32_t y = 0; y < work_h_; ++y)
+      memcpy(confidence_.Row(y), depth_.confidence() + static_cast<size_t>(y) * work_w_,
+             static_cast<size_t>(work_w_));
+    low_confidence_permille_ =
+        static_cast<int32_t>(depth_.stats().low_confidence * 1000 / (int64_t{work_w_} * work_h_));
+  }
   if (config_.geometry == ViewGeometry::kAuto) {
     // SetDepthGeometry rebuilds the planes for every burst, so they are still this one's.
     LB_RETURN_IF_ERROR(OrderDepth(views, planes_, order_scratch_, &depth_, &motion_,

@@ -57,6 +57,8 @@ struct PipelineConfig {
   int32_t smooth_weight = DepthConfig{}.smooth_weight;
   int32_t max_cycles = DepthConfig{}.max_cycles;
   bool subpixel = DepthConfig{}.subpixel;
+  // The depth map's confidence (confidence() below; DepthConfig::confidence).
+  bool confidence = DepthConfig{}.confidence;
   // kAuto: the label range planned from the tracked points; false: disp_min_q8..disp_max_q8
   // as given, only the planes follow the motion.
   bool plan_range = true;
@@ -113,6 +115,15 @@ class Pipeline : public FrameSink {
   ConstPlanarU8 reference() const { return ref_.AsConst(); }
   ConstImageU8 working_view(int32_t i) const { return working_[i].AsConst(); }
   ConstImageU16 disparity_q8() const { return disp_q8_.AsConst(); }
+  // After ComputeDepth, with config().confidence: how sure each pixel of disparity_q8() is,
+  // 0..255 (255: sure; algo/depth/confidence.h), all 0 when the burst gave no depth; an empty
+  // image without it. Kept until the next burst's ComputeDepth, the render does not touch it.
+  ConstImageU8 confidence() const { return confidence_.AsConst(); }
+  // The whole burst's: the share of its pixels below DepthStage::kLowConfidence, per mille (1000
+  // when it gave no depth, 0 without the map). Above kRetakePermille most of the picture's depth
+  // is a guess (a white wall, the sky, a burst without texture): worth a retake hint.
+  int32_t low_confidence_permille() const { return low_confidence_permille_; }
+  static constexpr int32_t kRetakePermille = 500;
   const DepthStage& depth() const { return depth_; }
   RenderStage& render() { return render_; }
 
@@ -137,7 +148,9 @@ class Pipeline : public FrameSink {
   PlanarU8 ref_;                                 // full-resolution reference, YCbCr 4:2:0
   ImageU8 working_[PipelineConfig::kMaxFrames];  // working-resolution views, RGB8
   ImageU16 disp_q8_;                             // working-resolution disparity, Q8.8
-  uint8_t* rgb_rows_[2] = {nullptr, nullptr};    // full-width RGB8 rows (even, odd)
+  ImageU8 confidence_;                           // its confidence (config_.confidence)
+  int32_t low_confidence_permille_ = 0;
+  uint8_t* rgb_rows_[2] = {nullptr, nullptr};  // full-width RGB8 rows (even, odd)
   uint32_t* cols_ = nullptr;  // box downscale: column sums, working row x scale x 3 (ingest.h)
   DepthStage depth_;
   RenderStage render_;
