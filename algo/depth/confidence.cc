@@ -27,22 +27,27 @@ inline int32_t Luma(const uint8_t* rgb) { return rgb[0] + 2 * rgb[1] + rgb[2]; }
 
 inline int32_t Abs(int32_t v) { return v < 0 ? -v : v; }
 
-// Q0.8 from v on a ramp lo..hi, clamped.
+// Q0.8 from v on a ramp lo..hi, clamped; without branches.
 inline int32_t Ramp(int32_t v, int32_t lo, int32_t hi) {
-  if (v <= lo) return 0;
-  if (v >= hi) return 255;
-  return ((v - lo) * 255 + (hi - lo) / 2) / (hi - lo);
+  int32_t t = v - lo;
+  t = t < 0 ? 0 : t;
+  t = t > hi - lo ? hi - lo : t;
+  return (t * 255 + (hi - lo) / 2) / (hi - lo);
+}
+
+// R + 2G + B of a row, 0..1020.
+LB_CLONES_AVX2 void LumaRow(const uint8_t* __restrict rgb, int32_t w, uint16_t* __restrict out) {
+  for (int32_t x = 0; x < w; ++x) {
+    out[x] = static_cast<uint16_t>(rgb[3 * x] + 2 * rgb[3 * x + 1] + rgb[3 * x + 2]);
+  }
 }
 
 // Each pixel's luma steps to the right and down (0 past the last column; below: nullptr past the
 // last row), at most 2040.
-void StepsRow(const uint8_t* row, const uint8_t* below, int32_t w, uint16_t* out) {
-  for (int32_t x = 0; x < w; ++x) {
-    const int32_t l = Luma(row + 3 * x);
-    const int32_t right = x + 1 < w ? Abs(Luma(row + 3 * x + 3) - l) : 0;
-    const int32_t down = below != nullptr ? Abs(Luma(below + 3 * x) - l) : 0;
-    out[x] = static_cast<uint16_t>(right + down);
-  }
+LB_CLONES_AVX2 void StepsRow(const uint16_t* __restrict l, const uint16_t* __restrict below,
+                             int32_t w, uint16_t* __restrict out) {
+  for (int32_t x = 0; x < w; ++x) out[x] = below != nullptr ? Abs(below[x] - l[x]) : 0;
+  for (int32_t x = 0; x + 1 < w; ++x) out[x] = static_cast<uint16_t>(out[x] + Abs(l[x + 1] - l[x]));
 }
 }  // namespace
 
@@ -54,8 +59,9 @@ void LabelMargins::Carve(Arena& arena, int32_t w, int32_t h) {
   second = arena.Allocate<uint16_t>(n);
   best_label = arena.Allocate<uint16_t>(n);
   confidence = arena.Allocate<uint8_t>(n);
-  steps = arena.Allocate<uint16_t>(4 * static_cast<size_t>(w));
+  steps = arena.Allocate<uint16_t>(6 * static_cast<size_t>(w) + 2);
   column = steps == nullptr ? nullptr : steps + 3 * static_cast<size_t>(w);
+  luma = column == nullptr ? nullptr : column + w + 2;
   share = arena.Allocate<uint32_t>(kShareEntries);
   // The margin's share without a division a pixel (Finish): 256 << 16 over at least
   // kMarginFloor fits 18 bits, and times a margin of 12 bits, 30.
@@ -113,23 +119,32 @@ void LabelMargins::Take(const uint16_t* d, int32_t p0, int32_t n, int32_t label,
 int64_t LabelMargins::Finish(const uint8_t* labels, const uint16_t* cost, int32_t step,
                              const ConstImageU8& reference) {
   const int32_t w = width, h = height;
+  if (!carved() || luma == nullptr) return 0;
   // A final label this near the winner's is its own minimum (the fine moves place it between
   // the coarse labels): the margin is to the second; else the winner itself is away from it.
   const int32_t near = step / 2 > 1 ? step / 2 : 1;
   int64_t low = 0;
-  // The texture's steps of rows y - 1, y and y + 1 in a ring of three.
-  StepsRow(reference.Row(0), h > 1 ? reference.Row(1) : nullptr, w, steps);
+  // The texture's steps of rows y - 1, y and y + 1 in a ring of three, from the luma of rows
+  // y + 1 and y + 2 in a ring of two.
+  LumaRow(reference.Row(0), w, luma);
+  if (h > 1) LumaRow(reference.Row(1), w, luma + w);
+  StepsRow(luma, h > 1 ? luma + w : nullptr, w, steps);
+  column[0] = column[w + 1] = 0;
   for (int32_t y = 0; y < h; ++y) {
     if (y + 1 < h) {
-      StepsRow(reference.Row(y + 1), y + 2 < h ? reference.Row(y + 2) : nullptr, w,
+      if (y + 2 < h) LumaRow(reference.Row(y + 2), w, luma + (y % 2) * w);
+      StepsRow(luma + ((y + 1) % 2) * w, y + 2 < h ? luma + (y % 2) * w : nullptr, w,
                steps + ((y + 1) % 3) * w);
     }
-    const uint16_t* up = y > 0 ? steps + ((y + 2) % 3) * w : nullptr;
     const uint16_t* mid = steps + (y % 3) * w;
-    const uint16_t* down = y + 1 < h ? steps + ((y + 1) % 3) * w : nullptr;
+    const uint16_t* up = y > 0 ? steps + ((y + 2) % 3) * w : mid;
+    const uint16_t* down = y + 1 < h ? steps + ((y + 1) % 3) * w : mid;
+    const int32_t rows = 1 + (y > 0 ? 1 : 0) + (y + 1 < h ? 1 : 0);
+    // Both neighbours or only the row itself: the sum over the rows there are, without a branch.
     for (int32_t x = 0; x < w; ++x) {
-      column[x] = static_cast<uint16_t>(mid[x] + (up != nullptr ? up[x] : 0) +
-                                        (down != nullptr ? down[x] : 0));
+      column[x + 1] = static_cast<uint16_t>(rows == 3   ? up[x] + mid[x] + down[x]
+                                            : rows == 2 ? up[x] + down[x]
+                                                        : mid[x]);
     }
     for (int32_t x = 0; x < w; ++x) {
       const int32_t p = y * w + x;
@@ -141,8 +156,7 @@ int64_t LabelMargins::Finish(const uint8_t* labels, const uint16_t* cost, int32_
       const int32_t by_data =
           Ramp(static_cast<int32_t>((static_cast<uint32_t>(margin) * share[away]) >> 16),
                kDoubtShare, kSureShare);
-      const int32_t texture =
-          column[x] + (x > 0 ? column[x - 1] : 0) + (x + 1 < w ? column[x + 1] : 0);
+      const int32_t texture = column[x] + column[x + 1] + column[x + 2];
       const int32_t by_texture = Ramp(texture, kFlatTexture, kSureTexture);
       const int32_t c = (by_data * by_texture + 127) / 255;
       confidence[p] = static_cast<uint8_t>(c);

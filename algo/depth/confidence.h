@@ -35,8 +35,11 @@ struct LabelMargins {
   uint16_t* second = nullptr;      // the lowest at a label apart from best's (above)
   uint16_t* best_label = nullptr;  // 16 bits, as the costs: the loop that keeps them vectorizes
   uint8_t* confidence = nullptr;   // the map, row stride = width
-  uint16_t* steps = nullptr;       // Finish: 3 rows of the texture's steps, and their column sums
+  // Finish's rows: 3 of the texture's steps, their column sums (with a 0 either side) and 2 of
+  // the reference's luma.
+  uint16_t* steps = nullptr;
   uint16_t* column = nullptr;
+  uint16_t* luma = nullptr;
   uint32_t* share = nullptr;  // Finish: (256 << 16) / (away + floor), for each away
   int32_t width = 0, height = 0;
 
