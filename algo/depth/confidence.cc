@@ -11,7 +11,8 @@ namespace {
 // as when the truth lies between the labels the winner-take-all tried and the moves never
 // reached it) is barely better than the rest however large the costs, and the floor keeps the
 // small costs of a flat patch, where both are noise, from reading as a large share. Under
-// kDoubtShare it says nothing for the depth, at kSureShare (D half of away, or less) sure.
+// kDoubtShare it says nothing for the depth, at kSureShare (D about half of away, or less)
+// sure.
 constexpr int32_t kMarginFloor = 64;
 constexpr int32_t kDoubtShare = 32;
 constexpr int32_t kSureShare = 128;
@@ -22,8 +23,6 @@ constexpr int32_t kShareEntries = 4096;
 // wall) it is flat, confidence 0; at kSureTexture (a mean step of 48) and above it says nothing.
 constexpr int32_t kFlatTexture = 18 * 8;
 constexpr int32_t kSureTexture = 18 * 48;
-
-inline int32_t Luma(const uint8_t* rgb) { return rgb[0] + 2 * rgb[1] + rgb[2]; }
 
 inline int32_t Abs(int32_t v) { return v < 0 ? -v : v; }
 

@@ -1,23 +1,26 @@
 // The depth map's confidence (DepthConfig::confidence): per pixel of the reference view, 8 bits,
 // 255 = sure, 0 = a guess. Two pieces of evidence, multiplied (Q0.8 x Q0.8 -> Q0.8, rounded):
-// - The data term's margin: how much worse the best D at labels away from the chosen one is
-//   than the chosen label's own D. A small or negative margin means another depth explains the
-//   pixel as well (a repeated pattern, a flat patch, a label the smoothness forced against the
-//   data). Labels within one of the chosen one are not "away": a minimum spread over
-//   neighbouring labels is a sub-label position, not a doubt.
-// - The reference's texture (the gradient summed over 3x3): on a flat patch every label matches
-//   and the margin that remains is noise, so it must not read as sure.
+// - The data term's margin: how much lower the chosen label's D is than the best D at labels
+//   away from it, as a share of the latter (confidence.cc says why a share). A small or negative
+//   margin means another depth explains the pixel as well (a repeated pattern, a flat patch, a
+//   label the smoothness forced against the data). Labels near the chosen one are not "away"
+//   (within one label, or half the winner-take-all's label step when it tries every
+//   coarse_step-th): a minimum spread over neighbouring labels is a sub-label position, not a
+//   doubt.
+// - The reference's texture (its luma steps summed over 3x3): on a flat patch every label
+//   matches and the margin that remains is noise, so it must not read as sure.
 // Occlusion is not a separate term: the data term already takes the mean of each pixel's best
 // views, and does not keep which it dropped; an occluded pixel that matches no view shows as a
 // small margin.
 //
 // The margin needs D at the labels away from the chosen one. The winner-take-all that starts the
-// stage computes D at every label it tries, pixel by pixel: it keeps the two lowest
-// (TakeTwoBest) rather than the data term running again. With coarse_step > 1 it tries every
-// coarse_step-th label, all of them apart, so the two are exact; with every label (coarse_step
-// 1), the second is the lowest D more than one label from the best as it stood when each label
-// came: when the best moves to its neighbour, the label two below the new best is not taken,
-// which can only make the margin larger on a minimum's slope.
+// stage computes D at every label it tries, pixel by pixel: it keeps the two lowest (Take)
+// rather than the data term running again. With coarse_step > 1 it tries every coarse_step-th
+// label, all of them apart, so the two are exact; with every label (coarse_step 1), the second
+// is the lowest D more than one label from the best as it stood when each label came: when the
+// best moves to its neighbour, the label two below the new best is not taken, which can only
+// make the margin larger on a minimum's slope. A truth between the labels the winner-take-all
+// tried is not seen at all; the moves' label then matches poorly, and the share is small.
 #pragma once
 
 #include <cstddef>
