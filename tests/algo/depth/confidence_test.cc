@@ -15,22 +15,7 @@
 namespace lb {
 namespace {
 
-struct Stage {
-  std::vector<uint8_t> memory;
-  DepthStage depth;
-  std::vector<uint16_t> disp;
-
-  Status Configure(const DepthConfig& c) {
-    const size_t bytes = DepthStage::RequiredBytes(c);
-    memory.assign(bytes + Arena::kAlign, 0);
-    Arena arena(Arena::AlignUp(memory.data()), bytes);
-    disp.assign(static_cast<size_t>(c.width) * c.height, 0);
-    return depth.Configure(c, arena);
-  }
-  Status Compute(const synth::Burst& b) {
-    return depth.Compute(b.views.data(), MakeView(disp.data(), b.width, b.height));
-  }
-};
+using handheld::Stage;
 
 // One label per px per view step, labels 0..labels-1.
 DepthConfig Config(const synth::Burst& b, int32_t labels) {
@@ -109,7 +94,7 @@ TEST(ConfidenceTest, LowConfidenceHoldsTheWrongDepth) {
   const synth::Burst b = PatchedBurst(w, h, 16, 64, 20, 76, false);
   Stage s;
   ASSERT_TRUE(s.Configure(Config(b, 12)).ok());
-  ASSERT_TRUE(s.Compute(b).ok());
+  ASSERT_TRUE(s.Compute(b.views.data()).ok());
   const uint8_t* confidence = s.depth.confidence();
   ASSERT_NE(confidence, nullptr);
   // The split is the product's own: kLowConfidence is what the retake hint counts, so this
@@ -143,7 +128,7 @@ TEST(ConfidenceTest, PlaneSweepLowConfidenceHoldsTheWrongDepth) {
   motiontest::Burst b;
   ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(6), 160, 120, 5, &b));
   const handheld::Labels l = handheld::HandheldLabels(b, 0.1);
-  handheld::Stage s;
+  Stage s;
   ASSERT_TRUE(s.Configure(l.config).ok());
   ASSERT_TRUE(s.depth.SetPlanes(handheld::Planes(b, l).data()).ok());
   ASSERT_TRUE(s.Compute(b.views.data()).ok());
@@ -171,7 +156,7 @@ TEST(ConfidenceTest, TexturelessBurstIsLowConfidence) {
   const synth::Burst b = PatchedBurst(w, h, 0, 0, 0, 0, true);
   Stage s;
   ASSERT_TRUE(s.Configure(Config(b, 12)).ok());
-  ASSERT_TRUE(s.Compute(b).ok());
+  ASSERT_TRUE(s.Compute(b.views.data()).ok());
   EXPECT_GT(s.depth.stats().low_confidence, int64_t{w} * h * 9 / 10);
 }
 
@@ -186,8 +171,8 @@ TEST(ConfidenceTest, DepthMapIsTheSameWithoutTheMap) {
       ASSERT_TRUE(with.Configure(c).ok());
       c.confidence = false;
       ASSERT_TRUE(without.Configure(c).ok());
-      ASSERT_TRUE(with.Compute(b).ok());
-      ASSERT_TRUE(without.Compute(b).ok());
+      ASSERT_TRUE(with.Compute(b.views.data()).ok());
+      ASSERT_TRUE(without.Compute(b.views.data()).ok());
       EXPECT_EQ(with.disp, without.disp) << "blocks " << blocks << " step " << step;
       EXPECT_EQ(without.depth.confidence(), nullptr);
       EXPECT_LT(DepthStage::RequiredBytes(c), with.depth.stats().arena_bytes + 1);
