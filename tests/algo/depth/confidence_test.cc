@@ -27,6 +27,7 @@ DepthConfig Config(const synth::Burst& b, int32_t labels) {
   c.labels = labels;
   c.disp_min_q8 = 0;
   c.disp_max_q8 = (labels - 1) * 256;
+  c.confidence = true;
   return c;
 }
 
@@ -127,7 +128,8 @@ TEST(ConfidenceTest, LowConfidenceHoldsTheWrongDepth) {
 TEST(ConfidenceTest, PlaneSweepLowConfidenceHoldsTheWrongDepth) {
   motiontest::Burst b;
   ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(6), 160, 120, 5, &b));
-  const handheld::Labels l = handheld::HandheldLabels(b, 0.1);
+  handheld::Labels l = handheld::HandheldLabels(b, 0.1);
+  l.config.confidence = true;
   Stage s;
   ASSERT_TRUE(s.Configure(l.config).ok());
   ASSERT_TRUE(s.depth.SetPlanes(handheld::Planes(b, l).data()).ok());

@@ -20,6 +20,7 @@ using pipelinetest::RenderChecksum;
 
 TEST(PipelineConfidence, TheMapSitsNextToTheDisparityAndOutlivesTheRender) {
   Burst b;
+  b.config.confidence = true;
   b.Setup(192, 144, 5);
   ASSERT_TRUE(b.sensor->CaptureBurst(b.pipeline).ok());
   ASSERT_TRUE(b.pipeline.ComputeDepth().ok());
@@ -64,6 +65,7 @@ TEST(PipelineConfidence, TheMapSitsNextToTheDisparityAndOutlivesTheRender) {
 
 TEST(PipelineConfidence, OffItLeavesTheDisparityAndCarvesLess) {
   Burst on;
+  on.config.confidence = true;
   on.Setup(160, 120, 5);
   ASSERT_TRUE(on.sensor->CaptureBurst(on.pipeline).ok());
   ASSERT_TRUE(on.pipeline.ComputeDepth().ok());
