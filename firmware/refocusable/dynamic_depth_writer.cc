@@ -4,6 +4,7 @@
 // second time as raw bytes (three quarters of the base64), neither encoded again.
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <string>
 
 #include "firmware/refocusable/dynamic_depth.h"
@@ -125,8 +126,13 @@ Status AppendDynamicDepthItems(const RefocusableXmp& xmp, const DynamicDepthExtr
   }
   jpeg->reserve(n + xmp.depth.data.size() + extras.confidence.size() +
                 (extras.original ? xmp.image.size() : 0));
+  // resize and memcpy rather than insert: GCC 14 takes an empty range's insert for an overflow
+  // (-Wstringop-overflow) in Debian 13's Release builds.
   return WriteDynamicDepthItems(xmp, extras, [jpeg](const uint8_t* data, size_t size) {
-    jpeg->insert(jpeg->end(), data, data + size);
+    if (size == 0) return Status::Ok();
+    const size_t at = jpeg->size();
+    jpeg->resize(at + size);
+    memcpy(jpeg->data() + at, data, size);
     return Status::Ok();
   });
 }
