@@ -89,10 +89,12 @@ done
 wait "$prefetch_pid" || { cat "$prefetch"; die "making the Debian roots failed"; }
 for suite in bookworm trixie; do
   step "$suite arm64: the board's package built in the release's root, and checked"
-  if deb=$(bash scripts/package.sh "$suite" arm64 | tail -n1) &&
+  if deb=$(bash scripts/package.sh "$suite" arm64 | tee "$log/package-$suite.log" | tail -n1) &&
      bash tests/firmware/daemon/check_deb.sh "$deb" "build/roots/$suite-cross-arm64"; then
     passed=$((passed + 1))
   else
+    # The build's own output (a compiler's error) went to the log, not the screen.
+    grep -E -A8 'FAILED|error' "$log/package-$suite.log" | head -n 40
     failed=$((failed + 1)); echo "test: the $suite arm64 package failed"
   fi
 done
