@@ -19,14 +19,7 @@ using handheld::Stage;
 
 // One label per px per view step, labels 0..labels-1.
 DepthConfig Config(const synth::Burst& b, int32_t labels) {
-  DepthConfig c;
-  c.width = b.width;
-  c.height = b.height;
-  c.views = static_cast<int32_t>(b.views.size());
-  c.reference = b.reference;
-  c.labels = labels;
-  c.disp_min_q8 = 0;
-  c.disp_max_q8 = (labels - 1) * 256;
+  DepthConfig c = synth::SmallConfig(b, labels, 256);
   c.confidence = true;
   return c;
 }

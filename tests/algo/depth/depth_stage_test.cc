@@ -37,23 +37,11 @@ struct Stage {
   }
 };
 
-DepthConfig SmallConfig(const synth::Burst& b, int32_t labels, int32_t step_q8) {
-  DepthConfig c;
-  c.width = b.width;
-  c.height = b.height;
-  c.views = static_cast<int32_t>(b.views.size());
-  c.reference = b.reference;
-  c.labels = labels;
-  c.disp_min_q8 = 0;
-  c.disp_max_q8 = (labels - 1) * step_q8;
-  return c;
-}
-
 TEST(DepthStageTest, EnergyNeverRisesAcrossExpansionMoves) {
   for (uint32_t seed : {1u, 2u, 3u}) {
     const synth::Burst b = synth::MakeBurst(24, 16, 4, 1, 1, 3, 6, 17, 3, 12, seed);
     for (int32_t trunc : {1, 2, 8}) {
-      DepthConfig c = SmallConfig(b, 8, 128);
+      DepthConfig c = synth::SmallConfig(b, 8, 128);
       c.max_cycles = 0;  // winner-take-all only; the test runs the moves
       c.smooth_weight = 40;
       c.smooth_trunc = trunc;
@@ -83,7 +71,7 @@ TEST(DepthStageTest, EnergyNeverRisesAcrossExpansionMoves) {
 // keep theirs. Its bookkeeping (the energy, the labels) must match a recomputation.
 TEST(DepthStageTest, RestrictedMovesLookOnlyNearTheirLabels) {
   const synth::Burst b = synth::MakeBurst(64, 40, 5, 2, 1, 6, 20, 44, 10, 30, 5u);
-  DepthConfig c = SmallConfig(b, 33, 64);
+  DepthConfig c = synth::SmallConfig(b, 33, 64);
   c.max_cycles = 0;
   c.smooth_weight = 40;
   Stage s;
@@ -133,7 +121,7 @@ TEST(DepthStageTest, RestrictedMovesLookOnlyNearTheirLabels) {
 TEST(DepthStageTest, CoarseBlocksHaveThePixelsEnergy) {
   for (const auto& [w, h] : {std::pair{64, 40}, {63, 41}, {9, 8}}) {
     const synth::Burst b = synth::MakeBurst(w, h, 5, 2, 1, 6, w / 3, 2 * w / 3, h / 4, h / 2, 9u);
-    DepthConfig c = SmallConfig(b, 33, 64);
+    DepthConfig c = synth::SmallConfig(b, 33, 64);
     ASSERT_TRUE(c.coarse_blocks);
     ASSERT_GT(c.coarse_step, 1);
     Stage s;
@@ -155,7 +143,7 @@ TEST(DepthStageTest, HandoverFromTheWinnersIsExact) {
   for (const auto& [w, h, labels] :
        {std::tuple{64, 40, 33}, {63, 41, 64}, {9, 8, 33}, {31, 17, 20}}) {
     const synth::Burst b = synth::MakeBurst(w, h, 5, 2, 1, 6, w / 3, 2 * w / 3, h / 4, h / 2, 5u);
-    const DepthConfig c = SmallConfig(b, labels, 64);
+    const DepthConfig c = synth::SmallConfig(b, labels, 64);
     Stage taken, again;
     ASSERT_TRUE(taken.Configure(c).ok());
     ASSERT_TRUE(again.Configure(c).ok());
@@ -184,7 +172,7 @@ TEST(DepthStageTest, HandoverFromTheWinnersIsExact) {
 TEST(DepthStageTest, CoarsePassHasRoomForItsCostsAtAnyLabelCount) {
   const synth::Burst b = synth::MakeBurst(48, 32, 5, 2, 1, 6, 16, 32, 8, 16, 5u);
   for (const int32_t labels : {16, 64, 128, 256}) {
-    const DepthConfig c = SmallConfig(b, labels, 16);
+    const DepthConfig c = synth::SmallConfig(b, labels, 16);
     Stage s;
     ASSERT_TRUE(s.Configure(c).ok());
     ASSERT_TRUE(s.Compute(b).ok());
@@ -195,7 +183,7 @@ TEST(DepthStageTest, CoarsePassHasRoomForItsCostsAtAnyLabelCount) {
 
 TEST(DepthStageTest, MoveResultBeatsEverySinglePixelSwitch) {
   const synth::Burst b = synth::MakeBurst(16, 12, 3, 1, 1, 2, 4, 11, 2, 9, 9u);
-  DepthConfig c = SmallConfig(b, 5, 128);
+  DepthConfig c = synth::SmallConfig(b, 5, 128);
   c.max_cycles = 0;
   c.smooth_weight = 60;
   Stage s;
@@ -228,7 +216,7 @@ TEST(DepthStageTest, MoveResultBeatsEverySinglePixelSwitch) {
 TEST(DepthStageTest, SubLabelFitUsesTheTrueCosts) {
   for (uint32_t seed : {5u, 21u}) {
     const synth::Burst b = synth::MakeBurst(64, 40, 5, 2, 2, 6, 20, 44, 10, 30, seed);
-    const DepthConfig c = SmallConfig(b, 33, 64);  // coarse to fine, subpixel: the defaults
+    const DepthConfig c = synth::SmallConfig(b, 33, 64);  // coarse to fine, subpixel: the defaults
     Stage s;
     ASSERT_TRUE(s.Configure(c).ok());
     ASSERT_TRUE(s.Compute(b).ok());
@@ -258,7 +246,7 @@ TEST(DepthStageTest, SubLabelFitUsesTheTrueCosts) {
 
 TEST(DepthStageTest, RecoversTwoLayers) {
   const synth::Burst b = synth::MakeBurst(64, 40, 5, 2, 2, 6, 20, 44, 10, 30, 21u);
-  DepthConfig c = SmallConfig(b, 33, 64);  // 0 .. 8 px per step in quarter pixels
+  DepthConfig c = synth::SmallConfig(b, 33, 64);  // 0 .. 8 px per step in quarter pixels
   Stage s;
   ASSERT_TRUE(s.Configure(c).ok());
   ASSERT_TRUE(s.Compute(b).ok());
@@ -278,7 +266,7 @@ TEST(DepthStageTest, RecoversTwoLayers) {
 // The burst and the parameters of the pinned bits below.
 synth::Burst PinnedBurst() { return synth::MakeBurst(48, 32, 5, 2, 1, 4, 14, 34, 6, 24, 77u); }
 DepthConfig PinnedConfig(const synth::Burst& b) {
-  DepthConfig c = SmallConfig(b, 24, 64);
+  DepthConfig c = synth::SmallConfig(b, 24, 64);
   // Pinned parameters, so tuning the defaults does not move the value.
   c.color_trunc = 45;
   c.census_weight = 6;

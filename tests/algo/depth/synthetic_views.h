@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "algo/core/image.h"
+#include "algo/depth/depth_config.h"
 
 namespace lb::synth {
 
@@ -69,6 +70,19 @@ inline uint32_t DisparityHash(const std::vector<uint16_t>& disp) {
     hash = (hash ^ (v >> 8)) * 16777619u;
   }
   return hash;
+}
+
+// A depth configuration over the whole burst: labels 0..labels-1, step_q8 apart from 0.
+inline DepthConfig SmallConfig(const Burst& b, int32_t labels, int32_t step_q8) {
+  DepthConfig c;
+  c.width = b.width;
+  c.height = b.height;
+  c.views = static_cast<int32_t>(b.views.size());
+  c.reference = b.reference;
+  c.labels = labels;
+  c.disp_min_q8 = 0;
+  c.disp_max_q8 = (labels - 1) * step_q8;
+  return c;
 }
 
 }  // namespace lb::synth
