@@ -124,6 +124,15 @@ class Pipeline : public FrameSink {
   // is a guess (a white wall, the sky, a burst without texture): worth a retake hint.
   int32_t low_confidence_permille() const { return low_confidence_permille_; }
   static constexpr int32_t kRetakePermille = 500;
+  // The depth map a photo carries and the render uses (the file's GDepth and Dynamic Depth),
+  // after ComputeDepth: map_scale() full-resolution px per map px, its disparity in map px per
+  // view step (Q8.8) within map_min_q8()..map_max_q8(), and its confidence (0..255, empty
+  // without config().confidence), the same size as the map.
+  int32_t map_scale() const { return scale_; }
+  ConstImageU16 map_q8() const { return disp_q8_.AsConst(); }
+  ConstImageU8 map_confidence() const { return confidence_.AsConst(); }
+  int32_t map_min_q8() const { return disp_min_q8_; }
+  int32_t map_max_q8() const { return disp_max_q8_; }
   const DepthStage& depth() const { return depth_; }
   RenderStage& render() { return render_; }
 
