@@ -23,20 +23,21 @@ FocusUsed FocusOf(const RenderStage& render, const RenderParams& params, int32_t
 Status BuildRefocusableSegments(ConstImageU16 disp_q8, const DisparityRange& range,
                                 const std::vector<uint8_t>& original_jpeg, const FocusUsed& focus,
                                 int32_t width, std::vector<JpegSegment>* segments,
-                                DynamicDepthTrailer* dd) {
+                                DynamicDepthTrailer* dd, ConstImageU8 confidence) {
   return BuildRefocusableSegments(disp_q8, range, std::vector<uint8_t>(original_jpeg), focus, width,
-                                  segments, dd);
+                                  segments, dd, confidence);
 }
 
 Status BuildRefocusableSegments(ConstImageU16 disp_q8, const DisparityRange& range,
                                 std::vector<uint8_t>&& original_jpeg, const FocusUsed& focus,
                                 int32_t width, std::vector<JpegSegment>* segments,
-                                DynamicDepthTrailer* dd) {
+                                DynamicDepthTrailer* dd, ConstImageU8 confidence) {
   RefocusableXmp local;
   RefocusableXmp& xmp = dd != nullptr ? dd->xmp : local;
   xmp = RefocusableXmp();
   // 16 bits: the stored depth decodes back to exactly the disparity the picture was rendered from.
   LB_RETURN_IF_ERROR(SetDepthFromDisparity(disp_q8, range, 16, &xmp));
+  if (!confidence.empty()) LB_RETURN_IF_ERROR(SetConfidence(confidence, &xmp));
   xmp.image = std::move(original_jpeg);
   xmp.has_focus = true;
   xmp.focus.focal_distance = DepthForDisparity(focus.focus_disp_q8);

@@ -1,9 +1,9 @@
-// The refocusable JPEG of a render: the XMP (GDepth: the working-resolution disparity as a
-// lossless 16-bit RangeInverse PNG; GImage: the all-in-focus reference as JPEG; GFocus: the focus
-// the picture was rendered with) as APP1 segments for the JpegWriter, and beside GDepth the same
-// depth and original as Dynamic Depth (its Device element in the main XMP, its items after the
-// primary's EOI), so that readers of either format open the photo. Shared by `refocus run`,
-// `refocus rerender` and the daemon.
+// The refocusable JPEG of a render: the XMP (GDepth: the photo's depth map as a lossless 16-bit
+// RangeInverse PNG, and its confidence as an 8-bit grey PNG; GImage: the all-in-focus reference as
+// JPEG; GFocus: the focus the picture was rendered with) as APP1 segments for the JpegWriter, and
+// beside GDepth the same depth and original as Dynamic Depth (its Device element in the main XMP,
+// its items after the primary's EOI), so that readers of either format open the photo. Shared by
+// `refocus run`, `refocus rerender` and the daemon.
 //
 // What the second format costs: neither can point at the other's bytes (GDepth holds its images
 // as base64 in the XMP, Dynamic Depth only as items after the EOI), so the depth PNG and the
@@ -43,17 +43,21 @@ struct DynamicDepthTrailer {
 
 // Builds the segments. `original_jpeg` is the all-in-focus reference, already encoded. With
 // `dd`, the XMP lists Dynamic Depth's items too and `dd` keeps what WriteDynamicDepthTrailer
-// writes; without, the file is GDepth only (tests' inputs). Allocates (host and device alike:
-// outside the pipeline's no-allocation window).
+// writes; without, the file is GDepth only (tests' inputs). `confidence` (0..255, 255: sure),
+// when not empty, is the map's size and goes in as GDepth:Confidence and Dynamic Depth's
+// confidence item. Allocates (host and device alike: outside the pipeline's no-allocation
+// window).
 Status BuildRefocusableSegments(ConstImageU16 disp_q8, const DisparityRange& range,
                                 const std::vector<uint8_t>& original_jpeg, const FocusUsed& focus,
                                 int32_t width, std::vector<JpegSegment>* segments,
-                                DynamicDepthTrailer* dd = nullptr);
+                                DynamicDepthTrailer* dd = nullptr,
+                                ConstImageU8 confidence = ConstImageU8());
 // The same, taking the original over rather than copying it (a megabyte less at the peak).
 Status BuildRefocusableSegments(ConstImageU16 disp_q8, const DisparityRange& range,
                                 std::vector<uint8_t>&& original_jpeg, const FocusUsed& focus,
                                 int32_t width, std::vector<JpegSegment>* segments,
-                                DynamicDepthTrailer* dd = nullptr);
+                                DynamicDepthTrailer* dd = nullptr,
+                                ConstImageU8 confidence = ConstImageU8());
 
 // Appends `dd`'s items to `file`, after JpegWriter::Finish and before Commit.
 Status WriteDynamicDepthTrailer(const DynamicDepthTrailer& dd, AtomicFile* file);

@@ -60,8 +60,9 @@ class RefocusablePhoto::Memory final : public RefocusableMemory {
   uint8_t* Bytes(Part part, size_t count) override {
     std::vector<uint8_t>* v = part == Part::kExtendedXmp ? &photo_->extended_
                               : part == Part::kDepthPng  ? &photo_->depth_image_
-                                                         : &photo_->original_;
-    return photo_->Fit(v, count) ? v->data() : nullptr;
+                              : part == Part::kImage     ? &photo_->original_
+                                                         : nullptr;  // the confidence: not read
+    return v != nullptr && photo_->Fit(v, count) ? v->data() : nullptr;
   }
 
  private:

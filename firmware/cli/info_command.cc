@@ -22,7 +22,8 @@ const char kUsage[] =
     "(GDepth, GImage, GFocus: the refocusable JPEG of `refocus run` and of phones' Lens Blur;\n"
     "DynamicDepth: Dynamic Depth 1.0, as Pixel phones and `refocus run` write it), the primary\n"
     "image's size, the depth map refocusing uses (the format it comes from, its size, format,\n"
-    "near, far, units, mime and colour type), the focus (GFocus) and the all-in-focus original\n"
+    "near, far, units, mime and colour type) and its confidence map (GDepth:Confidence or\n"
+    "Dynamic Depth's confidence item), the focus (GFocus) and the all-in-focus original\n"
     "(GImage or Dynamic Depth's Original item); then Dynamic Depth's own items, depth, range,\n"
     "units, original and confidence map.\n"
     "Exit status: 0 when the file carries a depth map; 1 when it carries none (the lines then end\n"
@@ -46,7 +47,7 @@ class Memory final : public RefocusableMemory {
 
  private:
   std::vector<ExtendedXmpChunk> chunks_;
-  std::vector<uint8_t> bytes_[3];
+  std::vector<uint8_t> bytes_[4];
 };
 
 std::string Text(std::string_view v) { return std::string(v.data(), v.size()); }
@@ -152,6 +153,15 @@ int InfoCommand(int argc, char** argv) {
   printf("depth units: %s\n", f.depth_units.empty() ? "not given" : Text(f.depth_units).c_str());
   printf("depth mime: %s\n", Text(f.depth_mime).c_str());
   printf("depth colour: %d-bit %s\n", depth.bits, depth.colour);
+  if (f.confidence != nullptr) {
+    printf("confidence: %dx%d %s, %zu bytes (%s)\n", f.confidence_width, f.confidence_height,
+           Text(f.confidence_mime).c_str(), f.confidence_size,
+           f.dynamic_depth ? "Dynamic Depth" : "GDepth");
+  } else if (!f.confidence_ignored.ok()) {
+    printf("confidence: ignored: %s\n", f.confidence_ignored.message());
+  } else {
+    printf("confidence: none\n");
+  }
   if (f.has_focus) {
     printf("focus point: %.4f,%.4f\n", f.focus.focal_point_x, f.focus.focal_point_y);
     printf("focus distance: %g\n", f.focus.focal_distance);

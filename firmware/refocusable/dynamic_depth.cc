@@ -295,6 +295,14 @@ void DynamicDepthAsRefocusable(const DynamicDepthFields& dd, RefocusableFields* 
   out->dynamic_depth = true;
   out->image = nullptr;
   out->image_size = 0;
+  out->confidence = nullptr;
+  out->confidence_size = 0;
+  if (dd.confidence >= 0) {
+    const DynamicDepthItem& confidence = dd.items[dd.confidence];
+    out->confidence_mime = confidence.mime;
+    out->confidence = confidence.data;
+    out->confidence_size = confidence.length;
+  }
   if (dd.original >= 0) {
     const DynamicDepthItem& original = dd.items[dd.original];
     out->image_mime = original.mime;

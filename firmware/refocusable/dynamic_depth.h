@@ -75,7 +75,7 @@ Status ReadDynamicDepthFields(const uint8_t* data, size_t size, const char* name
                               int32_t photo_height, DynamicDepthFields* out);
 
 // The fields the GDepth reader gives (RefocusableFields), from a file's Dynamic Depth: the depth
-// item as the depth image, the original as the image; the confidence map is not among them.
+// item as the depth image, the confidence item as its confidence, the original as the image.
 void DynamicDepthAsRefocusable(const DynamicDepthFields& dd, RefocusableFields* out);
 
 // The photo's intrinsics (Camera:ImagingModel) as the specification normalises them: the focal
@@ -87,12 +87,11 @@ struct DdImagingModel {
   int32_t image_width = 0, image_height = 0;
 };
 
-// What a written file carries as Dynamic Depth besides the RefocusableXmp's depth and original.
+// What a written file carries as Dynamic Depth besides the RefocusableXmp's depth, its confidence
+// (GDepth:Confidence's bytes, the ConfidenceURI item when there are any) and original.
 struct DynamicDepthExtras {
   // The specification's name for depth that is not metric (the product's: 1 / disparity in px).
   std::string units = "Diopters";
-  std::vector<uint8_t> confidence;  // an 8-bit grey PNG or JPEG the depth's size; empty = none
-  std::string confidence_mime = "image/png";
   // GImage's original as an item too: Dynamic Depth readers refocus from it, at the cost of its
   // bytes a second time.
   bool original = true;
@@ -112,9 +111,8 @@ template <typename Write>
 Status WriteDynamicDepthItems(const RefocusableXmp& xmp, const DynamicDepthExtras& extras,
                               Write&& write) {
   LB_RETURN_IF_ERROR(write(xmp.depth.data.data(), xmp.depth.data.size()));
-  if (!extras.confidence.empty()) {
-    LB_RETURN_IF_ERROR(write(extras.confidence.data(), extras.confidence.size()));
-  }
+  const std::vector<uint8_t>& confidence = xmp.depth.confidence;
+  if (!confidence.empty()) LB_RETURN_IF_ERROR(write(confidence.data(), confidence.size()));
   if (extras.original && !xmp.image.empty()) {
     LB_RETURN_IF_ERROR(write(xmp.image.data(), xmp.image.size()));
   }

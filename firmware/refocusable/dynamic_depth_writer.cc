@@ -1,7 +1,8 @@
 // The Dynamic Depth a product's photo carries beside GDepth (dynamic_depth.h). GDepth can hold its
 // images only inline (base64 in the XMP) and Dynamic Depth only as items after the primary JPEG,
-// neither by reference to the other, so the depth image and the original are stored twice, the
-// second time as raw bytes (three quarters of the base64), neither encoded again.
+// neither by reference to the other, so the depth image, its confidence and the original are
+// stored twice, the second time as raw bytes (three quarters of the base64), neither encoded
+// again.
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -54,7 +55,7 @@ bool IsPlain(const std::string& s) {
 Status SetDynamicDepth(const DynamicDepthExtras& extras, RefocusableXmp* xmp) {
   const GDepthInfo& d = xmp->depth;
   if (d.data.empty()) return Status(Code::kInvalidArgument, "dynamic depth: no depth image");
-  if (!IsPlain(d.mime) || !IsPlain(xmp->image_mime) || !IsPlain(extras.confidence_mime) ||
+  if (!IsPlain(d.mime) || !IsPlain(xmp->image_mime) || !IsPlain(d.confidence_mime) ||
       (extras.units != "Meters" && extras.units != "Diopters" && extras.units != "None") ||
       (d.format != "RangeInverse" && d.format != "RangeLinear")) {
     return Status(Code::kInvalidArgument, "dynamic depth: a mime, units or format out of range");
@@ -65,8 +66,7 @@ Status SetDynamicDepth(const DynamicDepthExtras& extras, RefocusableXmp* xmp) {
       !std::isfinite(m.principal_point_x) || !std::isfinite(m.principal_point_y)) {
     return Status(Code::kInvalidArgument, "dynamic depth: fields must be finite");
   }
-  const bool original = extras.original && !xmp->image.empty(),
-             confidence = !extras.confidence.empty();
+  const bool original = extras.original && !xmp->image.empty(), confidence = !d.confidence.empty();
   std::string& p = xmp->extra_description;
   p = "  <rdf:Description rdf:about=\"\"";
   const std::pair<const char*, const char*> spaces[] = {
@@ -81,7 +81,7 @@ Status SetDynamicDepth(const DynamicDepthExtras& extras, RefocusableXmp* xmp) {
        "     <rdf:Seq>\n";
   Item("image/jpeg", 0, kPrimaryUri, &p);
   Item(d.mime, d.data.size(), kDepthUri, &p);
-  if (confidence) Item(extras.confidence_mime, extras.confidence.size(), kConfidenceUri, &p);
+  if (confidence) Item(d.confidence_mime, d.confidence.size(), kConfidenceUri, &p);
   if (original) Item(xmp->image_mime, xmp->image.size(), kOriginalUri, &p);
   p += "     </rdf:Seq>\n    </Container:Directory>\n   </Device:Container>\n";
   p += "   <Device:Profiles>\n    <rdf:Seq>\n     <rdf:li rdf:parseType=\"Resource\">\n"
@@ -124,7 +124,7 @@ Status AppendDynamicDepthItems(const RefocusableXmp& xmp, const DynamicDepthExtr
   if (n < 4 || (*jpeg)[n - 2] != 0xFF || (*jpeg)[n - 1] != 0xD9) {
     return Status(Code::kInvalidArgument, "dynamic depth: the primary does not end with its EOI");
   }
-  jpeg->reserve(n + xmp.depth.data.size() + extras.confidence.size() +
+  jpeg->reserve(n + xmp.depth.data.size() + xmp.depth.confidence.size() +
                 (extras.original ? xmp.image.size() : 0));
   // resize and memcpy rather than insert: GCC 14 takes an empty range's insert for an overflow
   // (-Wstringop-overflow) in Debian 13's Release builds.

@@ -160,6 +160,50 @@ Status ReadImage(const char* name, const Fields& f, RefocusableMemory& memory,
   return Status::Ok();
 }
 
+// GDepth:Confidence, base64-decoded into memory; a defect only leaves it out (with why).
+void ReadGDepthConfidence(const Fields& f, RefocusableMemory& memory, RefocusableFields* out) {
+  if (!f.Has(kGDepthNs, "GDepth", "Confidence")) return;
+  out->confidence_mime = "image/png";  // the format's usual one when ConfidenceMime is absent
+  if (f.Has(kGDepthNs, "GDepth", "ConfidenceMime")) {
+    (void)f.Text(kGDepthNs, "GDepth", "ConfidenceMime", &out->confidence_mime);
+  }
+  const uint8_t* data = nullptr;
+  size_t size = 0;
+  Status s = f.Base64(kGDepthNs, "GDepth", "Confidence", memory,
+                      RefocusableMemory::Part::kConfidence, &data, &size);
+  if (!s.ok()) {
+    out->confidence_ignored = s;
+    return;
+  }
+  out->confidence = data;
+  out->confidence_size = size;
+}
+
+// The confidence map kept only when its header reads and gives the depth image's size.
+void CheckConfidence(const char* name, RefocusableFields* out) {
+  if (out->confidence == nullptr) return;
+  const char* what = out->dynamic_depth ? "Dynamic Depth confidence item" : "GDepth:Confidence";
+  char label[320];
+  snprintf(label, sizeof(label), "%s: %s", name, what);
+  DepthImageHeader depth, confidence;
+  Status s = ProbeDepthImage(out->confidence, out->confidence_size, out->confidence_mime, label,
+                             &confidence);
+  if (s.ok() &&
+      ProbeDepthImage(out->depth_png, out->depth_png_size, out->depth_mime, label, &depth).ok() &&
+      (confidence.width != depth.width || confidence.height != depth.height)) {
+    s = Status(Code::kCorruptData, "%s: a %dx%d image for a %dx%d depth map", label,
+               confidence.width, confidence.height, depth.width, depth.height);
+  }
+  if (!s.ok()) {
+    out->confidence_ignored = s;
+    out->confidence = nullptr;
+    out->confidence_size = 0;
+    return;
+  }
+  out->confidence_width = confidence.width;
+  out->confidence_height = confidence.height;
+}
+
 Status ReadFocus(const Fields& f, RefocusableFields* out) {
   const char* names[4] = {"BlurAtInfinity", "FocalDistance", "FocalPointX", "FocalPointY"};
   double* values[4] = {&out->focus.blur_at_infinity, &out->focus.focal_distance,
@@ -294,9 +338,10 @@ class VectorMemory final : public RefocusableMemory {
     return chunks_.data();
   }
   uint8_t* Bytes(Part part, size_t count) override {
-    std::vector<uint8_t>& v = part == Part::kDepthPng ? xmp_->depth.data
-                              : part == Part::kImage  ? xmp_->image
-                                                      : extended_;
+    std::vector<uint8_t>& v = part == Part::kDepthPng     ? xmp_->depth.data
+                              : part == Part::kImage      ? xmp_->image
+                              : part == Part::kConfidence ? xmp_->depth.confidence
+                                                          : extended_;
     v.resize(std::max<size_t>(count, 1));
     return v.data();
   }
@@ -321,6 +366,8 @@ uint8_t* RefocusableBuffers::Bytes(Part part, size_t count) {
       return count <= depth_png_capacity ? depth_png : nullptr;
     case Part::kImage:
       return count <= image_capacity ? image : nullptr;
+    case Part::kConfidence:
+      return count <= confidence_capacity ? confidence : nullptr;
   }
   return nullptr;
 }
@@ -358,6 +405,7 @@ Status ReadRefocusableFields(const uint8_t* data, size_t size, const char* name,
   if (fields.Has(kGDepthNs, "GDepth", "Format") || fields.Has(kGDepthNs, "GDepth", "Data")) {
     LB_RETURN_IF_ERROR(ReadDepth(name, fields, memory, out));
     LB_RETURN_IF_ERROR(ReadImage(name, fields, memory, out));
+    ReadGDepthConfidence(fields, memory, out);
   } else if (HasDynamicDepth(main, extended)) {
     DynamicDepthFields dd;
     LB_RETURN_IF_ERROR(
@@ -366,6 +414,7 @@ Status ReadRefocusableFields(const uint8_t* data, size_t size, const char* name,
   } else {
     return Status(Code::kNotFound, "%s: XMP has no depth map (GDepth or Dynamic Depth)", name);
   }
+  CheckConfidence(name, out);
   LB_RETURN_IF_ERROR(ReadFocus(fields, out));
   // From the bytes in hand: a re-render must not open the file a second time.
   out->orientation = ExifOrientation(data, size);
@@ -393,6 +442,7 @@ Status ReadRefocusable(const uint8_t* data, size_t size, const char* name, Refoc
   };
   keep(f.depth_png, f.depth_png_size, &d.data);
   keep(f.image, f.image_size, &out->xmp.image);
+  keep(f.confidence, f.confidence_size, &d.confidence);
   if (!s.ok()) return s;
   out->width = f.width;
   out->height = f.height;
@@ -409,8 +459,26 @@ Status ReadRefocusable(const uint8_t* data, size_t size, const char* name, Refoc
   out->xmp.focus = f.focus;
   char what[300];
   DepthPngName(name, what, sizeof(what));
-  return DecodeDepthImage(d.data.data(), d.data.size(), d.mime, what, f.depth_max_side, d.width,
-                          d.height, &out->depth);
+  LB_RETURN_IF_ERROR(DecodeDepthImage(d.data.data(), d.data.size(), d.mime, what, f.depth_max_side,
+                                      d.width, d.height, &out->depth));
+  out->confidence_ignored = f.confidence_ignored;
+  if (f.confidence != nullptr) {
+    d.confidence_mime = std::string(f.confidence_mime);
+    snprintf(what, sizeof(what), "%s: %s", name,
+             f.dynamic_depth ? "Dynamic Depth confidence item" : "GDepth:Confidence");
+    // The header promised the depth's size; the pixels may still be broken.
+    Status c =
+        DecodeDepthImage(d.confidence.data(), d.confidence.size(), d.confidence_mime, what,
+                         f.depth_max_side, out->depth.width, out->depth.height, &out->confidence);
+    if (!c.ok()) {
+      out->confidence_ignored = c;
+      out->confidence = GrayPng();
+      d.confidence.clear();
+    }
+  } else {
+    d.confidence.clear();
+  }
+  return Status::Ok();
 }
 
 Status ReadRefocusableFile(const char* path, RefocusableImage* out) {

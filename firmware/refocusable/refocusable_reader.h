@@ -1,7 +1,9 @@
 // Reads a refocusable JPEG: walks the segments before the image data, reassembles extended XMP
-// by GUID and offset (checking it against its MD5), and extracts GDepth (fields and the decoded
-// depth image), GImage (the original JPEG's bytes) and GFocus. Any defect is a Status naming the
-// file and the problem; the reader never trusts a length it has not checked.
+// by GUID and offset (checking it against its MD5), and extracts GDepth (fields, the decoded
+// depth image and its confidence map), GImage (the original JPEG's bytes) and GFocus. Any defect
+// is a Status naming the file and the problem; the reader never trusts a length it has not
+// checked. The confidence map alone is optional even when broken: a bad one is ignored, with
+// the reason in the fields, and the depth still opens.
 //
 // One reader, two doors: ReadRefocusableFields puts what it decodes where a RefocusableMemory
 // says (the web page's engine: memory sized once, nothing allocated) and leaves the depth PNG
@@ -32,7 +34,8 @@ struct ExtendedXmpChunk {
 // `count` items, or nullptr when there is none (the read is then kOutOfMemory).
 class RefocusableMemory {
  public:
-  enum class Part : uint8_t { kExtendedXmp, kDepthPng, kImage };
+  // kConfidence: a memory without room for it (nullptr) reads the file without its confidence.
+  enum class Part : uint8_t { kExtendedXmp, kDepthPng, kImage, kConfidence };
   virtual ~RefocusableMemory() = default;
   virtual ExtendedXmpChunk* Chunks(size_t count) = 0;
   virtual uint8_t* Bytes(Part part, size_t count) = 0;
@@ -49,6 +52,8 @@ class RefocusableBuffers final : public RefocusableMemory {
   size_t depth_png_capacity = 0;
   uint8_t* image = nullptr;  // GImage:Data, base64-decoded
   size_t image_capacity = 0;
+  uint8_t* confidence = nullptr;  // GDepth:Confidence, base64-decoded (none: not read)
+  size_t confidence_capacity = 0;
 
   ExtendedXmpChunk* Chunks(size_t count) override;
   uint8_t* Bytes(Part part, size_t count) override;
@@ -72,6 +77,16 @@ struct RefocusableFields {
   bool has_focus = false;
   GFocusInfo focus;
   bool dynamic_depth = false;  // the depth and the image from Dynamic Depth's items (no GDepth)
+  // How sure each depth pixel is (GDepth:Confidence, or Dynamic Depth's confidence item when the
+  // depth comes from there), still encoded, an image the depth image's size by both headers;
+  // nullptr when the file has none or it was ignored.
+  std::string_view confidence_mime;
+  const uint8_t* confidence = nullptr;
+  size_t confidence_size = 0;
+  int32_t confidence_width = 0, confidence_height = 0;
+  // Not ok when the file's confidence map was ignored (bad base64, an image that does not read
+  // or is not the depth's size, no room for it): one line saying why. The depth still opens.
+  Status confidence_ignored;
 };
 
 // The file's main XMP packet and its extended one, reassembled into `memory` ("" when the file has
@@ -87,6 +102,10 @@ struct RefocusableImage {
   int32_t height = 0;
   RefocusableXmp xmp;  // depth.data holds the PNG bytes, image the original JPEG (may be empty)
   GrayPng depth;       // the decoded depth image, grey whatever colour type it was stored in
+  // The decoded confidence map (xmp.depth.confidence holds its bytes): empty when the file has
+  // none or it was ignored (confidence_ignored says why).
+  GrayPng confidence;
+  Status confidence_ignored;
   int32_t orientation = 0;  // the photo's EXIF Orientation 1..8, 0 when it records none
 };
 

@@ -53,14 +53,22 @@ void AppendBase64(const char* name, const std::vector<uint8_t>& data, std::strin
   *out += '"';
 }
 
-// One rdf:Description with the fields; `data` puts the two Data blobs in, `fields` the rest.
 size_t Base64Chars(size_t bytes) { return (bytes + 2) / 3 * 4; }
+
+// The base64 of every blob the packet carries.
+size_t DataChars(const RefocusableXmp& xmp) {
+  return Base64Chars(xmp.depth.data.size()) + Base64Chars(xmp.depth.confidence.size()) +
+         Base64Chars(xmp.image.size());
+}
+
+// One rdf:Description with the fields; `data` puts the blobs in (the depth, its confidence, the
+// original), `fields` the rest.
 
 std::string Packet(const RefocusableXmp& xmp, bool fields, bool data, const char* extended_md5,
                    bool wrapper) {
   std::string p;
   // Reserved whole: a megabyte-long packet grown by doubling would peak at twice its size.
-  p.reserve(4096 + (data ? Base64Chars(xmp.depth.data.size()) + Base64Chars(xmp.image.size()) : 0));
+  p.reserve(4096 + (data ? DataChars(xmp) : 0));
   if (wrapper) p += "<?xpacket begin=\"\xEF\xBB\xBF\" id=\"W5M0MpCehiHzreSzNTczkc9d\"?>\n";
   p += "<x:xmpmeta xmlns:x=\"adobe:ns:meta/\">\n";
   p += " <rdf:RDF xmlns:rdf=\"http://www.w3.org/1999/02/22-rdf-syntax-ns#\">\n";
@@ -80,6 +88,9 @@ std::string Packet(const RefocusableXmp& xmp, bool fields, bool data, const char
     AppendNumber("GDepth:Near", xmp.depth.near_depth, &p);
     AppendNumber("GDepth:Far", xmp.depth.far_depth, &p);
     AppendText("GDepth:Mime", xmp.depth.mime, &p);
+    if (!xmp.depth.confidence.empty()) {
+      AppendText("GDepth:ConfidenceMime", xmp.depth.confidence_mime, &p);
+    }
     if (xmp.depth.width > 0 && xmp.depth.height > 0) {
       AppendNumber("GDepth:ImageWidth", xmp.depth.width, &p);
       AppendNumber("GDepth:ImageHeight", xmp.depth.height, &p);
@@ -89,6 +100,7 @@ std::string Packet(const RefocusableXmp& xmp, bool fields, bool data, const char
   }
   if (data) {
     AppendBase64("GDepth:Data", xmp.depth.data, &p);
+    if (!xmp.depth.confidence.empty()) AppendBase64("GDepth:Confidence", xmp.depth.confidence, &p);
     if (!xmp.image.empty()) AppendBase64("GImage:Data", xmp.image, &p);
   }
   p += "/>\n";
@@ -139,6 +151,26 @@ Status SetDepthFromDisparity(ConstImageU16 disp_q8, const DisparityRange& range,
   return Status::Ok();
 }
 
+Status SetConfidence(ConstImageU8 confidence, RefocusableXmp* xmp) {
+  GDepthInfo& depth = xmp->depth;
+  if (confidence.empty() || confidence.width != depth.width || confidence.height != depth.height) {
+    return Status(Code::kInvalidArgument, "depth xmp: a %dx%d confidence map for a %dx%d depth map",
+                  confidence.width, confidence.height, depth.width, depth.height);
+  }
+  // The PNG writer takes 16-bit samples whatever the depth it writes.
+  std::vector<uint16_t> values(static_cast<size_t>(confidence.width) * confidence.height);
+  for (int32_t y = 0; y < confidence.height; ++y) {
+    const uint8_t* row = confidence.Row(y);
+    uint16_t* out = values.data() + static_cast<size_t>(y) * confidence.width;
+    for (int32_t x = 0; x < confidence.width; ++x) out[x] = row[x];
+  }
+  LB_RETURN_IF_ERROR(
+      EncodeGrayPng(MakeView<const uint16_t>(values.data(), confidence.width, confidence.height), 8,
+                    &depth.confidence));
+  depth.confidence_mime = "image/png";
+  return Status::Ok();
+}
+
 Status BuildXmpSegments(const RefocusableXmp& xmp, std::vector<JpegSegment>* segments) {
   segments->clear();
   const GDepthInfo& d = xmp.depth;
@@ -151,7 +183,8 @@ Status BuildXmpSegments(const RefocusableXmp& xmp, std::vector<JpegSegment>* seg
                   d.near_depth, d.far_depth);
   }
   if (d.data.empty()) return Status(Code::kInvalidArgument, "depth xmp: no depth image");
-  if (!IsPlainValue(d.mime) || (!xmp.image.empty() && !IsPlainValue(xmp.image_mime))) {
+  if (!IsPlainValue(d.mime) || (!xmp.image.empty() && !IsPlainValue(xmp.image_mime)) ||
+      (!d.confidence.empty() && !IsPlainValue(d.confidence_mime))) {
     return Status(Code::kInvalidArgument, "depth xmp: bad mime type");
   }
   if (xmp.has_focus) {
@@ -161,10 +194,10 @@ Status BuildXmpSegments(const RefocusableXmp& xmp, std::vector<JpegSegment>* seg
       return Status(Code::kInvalidArgument, "depth xmp: focus fields must be finite");
     }
   }
-  // Everything in one packet when it fits; otherwise the two Data blobs go to extended XMP.
+  // Everything in one packet when it fits; otherwise the blobs go to extended XMP.
   // Blobs whose base64 alone is larger cannot fit: that packet is not built (megabytes, only to
   // be measured).
-  if (Base64Chars(d.data.size()) + Base64Chars(xmp.image.size()) <= kMaxXmpPacket) {
+  if (DataChars(xmp) <= kMaxXmpPacket) {
     const std::string single = Packet(xmp, true, true, nullptr, true);
     if (single.size() <= kMaxXmpPacket) {
       segments->push_back(MainSegment(single));

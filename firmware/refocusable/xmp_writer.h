@@ -1,7 +1,8 @@
 // The refocusable-JPEG XMP (Google depth-map format, shared/notes/formats.md): GDepth (the depth
-// map as a base64 PNG), GImage (the all-in-focus original as a base64 JPEG) and GFocus (the focus
-// the picture was rendered with), laid out as APP1 segments for JpegMetadata::extra_segments:
-// one main XMP packet and, when the data do not fit 64 KB, extended-XMP chunks.
+// map as a base64 PNG, and its confidence map the same way), GImage (the all-in-focus original as a
+// base64 JPEG) and GFocus (the focus the picture was rendered with), laid out as APP1 segments for
+// JpegMetadata::extra_segments: one main XMP packet and, when the data do not fit 64 KB,
+// extended-XMP chunks.
 #pragma once
 
 #include <cstddef>
@@ -35,6 +36,11 @@ struct GDepthInfo {
   std::vector<uint8_t> data;  // the encoded depth image (PNG or JPEG bytes)
   int32_t width = 0;          // GDepth:ImageWidth / ImageHeight, 0 = not written
   int32_t height = 0;
+  // GDepth:Confidence: how sure each depth pixel is, an 8-bit grey image the depth's size (255:
+  // sure; RangeLinear over 0..1), encoded as confidence_mime says; empty = none. Dynamic Depth's
+  // ConfidenceURI item is the same bytes.
+  std::vector<uint8_t> confidence;
+  std::string confidence_mime = "image/png";
 };
 
 struct GFocusInfo {
@@ -58,6 +64,10 @@ struct RefocusableXmp {
 // grey PNG, Near and Far from `range` (see depth_encoding.h). Allocates.
 Status SetDepthFromDisparity(ConstImageU16 disp_q8, const DisparityRange& range, int bits,
                              RefocusableXmp* xmp);
+
+// Fills `xmp->depth.confidence` from the depth map's confidence (0..255, 255: sure): an 8-bit
+// grey PNG, which must be the size of the depth image already set. Allocates.
+Status SetConfidence(ConstImageU8 confidence, RefocusableXmp* xmp);
 
 // The APP1 segments (main packet first, then extended chunks in offset order).
 Status BuildXmpSegments(const RefocusableXmp& xmp, std::vector<JpegSegment>* segments);

@@ -200,7 +200,7 @@ std::string PacketText(const lb::JpegSegment& seg) {
 void DdSeeds(const std::string& dir, const std::string& suffix, const Bytes& picture,
              const lb::JpegSegment& exif, lb::RefocusableXmp* xmp) {
   lb::DynamicDepthExtras extras;
-  if (suffix == "8") extras.confidence = xmp->depth.data;  // an 8-bit grey PNG the depth's size
+  if (suffix == "8") xmp->depth.confidence = xmp->depth.data;  // 8-bit grey, the depth's size
   std::vector<lb::JpegSegment> segments;
   Bytes items;
   const auto append = [&items](const uint8_t* data, size_t size) {

@@ -31,7 +31,7 @@ DdFile MakeDdFile(bool large) {
   std::vector<uint16_t> confidence(s.disp_q8.size(), 200);
   EXPECT_TRUE(
       EncodeGrayPng(MakeView<const uint16_t>(confidence.data(), s.disp_width, s.disp_height), 8,
-                    &f.extras.confidence)
+                    &s.xmp.depth.confidence)
           .ok());
   f.extras.imaging_model = {
       400.0,           400.0,           s.picture.width / 2.0, s.picture.height / 2.0,
@@ -125,7 +125,7 @@ TEST_P(DynamicDepthTest, RoundTripsBesideGDepth) {
   EXPECT_EQ(dd.depth_header.width, s.disp_width);
   EXPECT_EQ(dd.depth_header.height, s.disp_height);
   ASSERT_GE(dd.confidence, 0);
-  EXPECT_EQ(Bytes(dd.items[dd.confidence]), f.extras.confidence);
+  EXPECT_EQ(Bytes(dd.items[dd.confidence]), f.sample.xmp.depth.confidence);
   if (GetParam()) {
     ASSERT_GE(dd.original, 0);
     EXPECT_EQ(Bytes(dd.items[dd.original]), s.xmp.image);
@@ -200,7 +200,7 @@ TEST(DynamicDepthReaderTest, GContainerDirectoryBySemantic) {
       "   <Container:Directory>\n    <rdf:Seq>\n" + item("image/jpeg", "Primary", 0) +
       item("image/jpeg", "GainMap", x.image.size()) +
       item("image/png", "Depth", x.depth.data.size()) +
-      item("image/png", "Confidence", f.extras.confidence.size()) +
+      item("image/png", "Confidence", f.sample.xmp.depth.confidence.size()) +
       item("image/jpeg", "Original", x.image.size()) +
       "    </rdf:Seq>\n   </Container:Directory>\n   <Device:Cameras><rdf:Seq><rdf:li "
       "rdf:parseType=\"Resource\"><Device:Camera rdf:parseType=\"Resource\">\n"
@@ -218,7 +218,8 @@ TEST(DynamicDepthReaderTest, GContainerDirectoryBySemantic) {
                                   "http://www.w3.org/1999/02/22-rdf-syntax-ns#\">\n" +
                                   description + "</rdf:RDF></x:xmpmeta>");
   std::vector<uint8_t> bytes = test::WriteRefocusJpeg(f.sample, {main});
-  for (const std::vector<uint8_t>* part : {&x.image, &x.depth.data, &f.extras.confidence, &x.image})
+  for (const std::vector<uint8_t>* part :
+       {&x.image, &x.depth.data, &f.sample.xmp.depth.confidence, &x.image})
     bytes.insert(bytes.end(), part->begin(), part->end());
   DynamicDepthFields dd;
   const Status status = ReadDd(bytes, &dd);
@@ -356,8 +357,8 @@ TEST(DynamicDepthToolsTest, ExiftoolAndAPythonParserReadTheItems) {
   for (const std::string& want :
        {std::string("0 image/jpeg "),
         "1 image/png " + std::to_string(s.xmp.depth.data.size()) + " android/depthmap " + dims,
-        "2 image/png " + std::to_string(f.extras.confidence.size()) + " android/confidencemap " +
-            dims,
+        "2 image/png " + std::to_string(f.sample.xmp.depth.confidence.size()) +
+            " android/confidencemap " + dims,
         "3 image/jpeg " + std::to_string(s.xmp.image.size()) + " android/originalimage " +
             std::to_string(s.picture.width) + "x" + std::to_string(s.picture.height),
         std::string("depth 1\n"), std::string("original 3\n")}) {
