@@ -51,8 +51,8 @@ struct DepthConfig {
   bool subpixel = true;  // parabola fit between labels for the output
   // The confidence map (confidence.h): kept from the winner-take-all's costs, a few bytes a
   // pixel of arena and a few per cent of the stage's time; the disparity map is the same either
-  // way. Off until the photo carries it (GDepth:Confidence), so nobody pays for a map unused.
-  bool confidence = false;
+  // way. Every photo carries it (GDepth:Confidence, Dynamic Depth's confidence item).
+  bool confidence = true;
   // Workers the data term carves rings for (task_runner.h), 1..kMaxWorkers.
   int32_t workers = 1;
 };

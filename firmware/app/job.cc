@@ -81,16 +81,17 @@ class CountingSink final : public FrameSink {
 };
 
 // The refocusable XMP of a photo, built on the job's side thread (or inline without one) from
-// the reference and the disparity, which the render only reads meanwhile, and the Dynamic Depth
-// items it lists, written after the image.
+// the reference, the map and its confidence, which the render only reads meanwhile, and the
+// Dynamic Depth items it lists, written after the image.
 class XmpBuild final : public PendingSegments {
  public:
   XmpBuild(SideTask* side, const Pipeline& p, const FocusUsed& focus, int quality,
            const DdImagingModel& model)
       : side_(side),
         reference_(p.reference()),
-        disparity_(p.disparity_q8()),
-        range_{p.disp_min_q8(), p.disp_max_q8()},
+        map_(p.map_q8()),
+        confidence_(p.map_confidence()),
+        range_{p.map_min_q8(), p.map_max_q8()},
         focus_(focus),
         quality_(quality) {
     trailer_.extras.imaging_model = model;
@@ -118,15 +119,17 @@ class XmpBuild final : public PendingSegments {
     std::vector<uint8_t> original;
     status_ = EncodeYCbCr420(reference_, quality_, &original);
     if (status_.ok()) {
-      status_ = BuildRefocusableSegments(disparity_, range_, std::move(original), focus_,
-                                         reference_.planes[0].width, &segments_, &trailer_);
+      status_ =
+          BuildRefocusableSegments(map_, range_, std::move(original), focus_,
+                                   reference_.planes[0].width, &segments_, &trailer_, confidence_);
     }
     build_s_ = Now() - t0;
   }
 
   SideTask* side_;
   ConstPlanarU8 reference_;
-  ConstImageU16 disparity_;
+  ConstImageU16 map_;
+  ConstImageU8 confidence_;
   DisparityRange range_;
   FocusUsed focus_;
   int quality_;
@@ -231,6 +234,9 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
   r.motion_s =
       depth_progress.labeling_began() >= 0 ? depth_progress.labeling_began() - t1 : r.depth_s;
   r.warning = p.depth_warning();
+  r.low_confidence_permille = p.low_confidence_permille();
+  // A burst without depth has its own warning, which says what to do.
+  if (r.warning.ok() && r.low_confidence_permille > Pipeline::kRetakePermille) r.hint = kRetakeHint;
 
   LB_RETURN_IF_ERROR(p.BeginRender(options_.render));
   r.focus_disp_q8 = p.render().focus_disp_q8();

@@ -56,7 +56,16 @@ struct JobReport {
   // Not ok when the burst gave no depth (kDegenerate, with what to do): the photo was saved
   // unblurred.
   Status warning;
+  // The share of the picture whose depth is a guess (Pipeline::low_confidence_permille), and
+  // kRetakeHint when that is most of it and the burst gave depth all the same (nullptr
+  // otherwise): what the user is told, one line.
+  int32_t low_confidence_permille = 0;
+  const char* hint = nullptr;
 };
+
+inline constexpr char kRetakeHint[] =
+    "most of this photo's depth is a guess (a flat or textureless scene): retake with more "
+    "texture in view, or move the camera more between frames";
 
 // Receives each rendered strip as the encoder does (tests use it to checksum the output).
 class StripObserver {

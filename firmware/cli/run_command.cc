@@ -193,6 +193,7 @@ int RunCommand(int argc, char** argv) {
     fprintf(stderr, "refocus: warning: no depth from this burst, the photo is not blurred: %s\n",
             report.warning.message());
   }
+  if (report.hint != nullptr) fprintf(stderr, "refocus: hint: %s\n", report.hint);
   printf(
       "wrote %s: %dx%d, %d frames, focus disparity %.2f px; capture %.2f s, depth %.2f s (motion "
       "%.2f s), render+encode %.2f s, arena %.1f MiB, %d thread%s\n",

@@ -349,6 +349,7 @@ void CameraDaemon::TakePhoto(int32_t number) {
     log_->Printf(LogLevel::kWarning, "photo %d: not blurred (no depth from this burst): %s", number,
                  report.warning.message());
   }
+  if (report.hint != nullptr) log_->Printf(LogLevel::kWarning, "photo %d: %s", number, report.hint);
   log_->Printf(LogLevel::kInfo,
                "photo %d: saved %s (%dx%d; capture %.2f s, depth %.2f s of which motion %.2f s, "
                "render and save %.2f s)",

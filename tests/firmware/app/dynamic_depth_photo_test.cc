@@ -115,9 +115,10 @@ TEST_P(JobDynamicDepth, ThePhotoCarriesBothFormatsAndOpensWithoutGDepth) {
   if (test::HaveTool("exiftool")) {
     const std::string out = test::RunTool("exiftool -a -G1 -s '" + path + "' 2>&1", &code);
     EXPECT_EQ(code, 0) << out;
-    for (const char* want : {"ContainerDirectoryItemMime", "image/jpeg, image/png, image/jpeg",
-                             "ContainerDirectoryItemLength", "DepthMapFormat", "DepthMapNear",
-                             "DepthMapFar", "DepthMapUnits", "DepthMapDepthURI", "ImageItemURI"}) {
+    for (const char* want :
+         {"ContainerDirectoryItemMime", "image/jpeg, image/png, image/png, image/jpeg",
+          "DepthMapConfidenceURI", "ContainerDirectoryItemLength", "DepthMapFormat", "DepthMapNear",
+          "DepthMapFar", "DepthMapUnits", "DepthMapDepthURI", "ImageItemURI"}) {
       EXPECT_NE(out.find(want), std::string::npos) << want << "\n" << out;
     }
     EXPECT_EQ(out.find("Warning"), std::string::npos) << out;
@@ -130,10 +131,16 @@ TEST_P(JobDynamicDepth, ThePhotoCarriesBothFormatsAndOpensWithoutGDepth) {
   const std::string depth_line = "1 image/png " + std::to_string(gdepth.xmp.depth.data.size()) +
                                  " android/depthmap " + std::to_string(gdepth.depth.width) + "x" +
                                  std::to_string(gdepth.depth.height);
+  // The confidence map after the depth, the depth's size, the same bytes as GDepth:Confidence.
+  ASSERT_FALSE(gdepth.xmp.depth.confidence.empty());
+  const std::string confidence_line =
+      "2 image/png " + std::to_string(gdepth.xmp.depth.confidence.size()) +
+      " android/confidencemap " + std::to_string(gdepth.depth.width) + "x" +
+      std::to_string(gdepth.depth.height);
   const std::string original_line =
-      "2 image/jpeg " + std::to_string(gdepth.xmp.image.size()) + " android/originalimage 160x120";
-  for (const std::string& want :
-       {depth_line, original_line, std::string("depth 1\n"), std::string("original 2\n")}) {
+      "3 image/jpeg " + std::to_string(gdepth.xmp.image.size()) + " android/originalimage 160x120";
+  for (const std::string& want : {depth_line, confidence_line, original_line,
+                                  std::string("depth 1\n"), std::string("original 3\n")}) {
     EXPECT_NE(out.find(want), std::string::npos) << want << "\n" << out;
   }
 }

@@ -50,6 +50,20 @@ bool Has(const std::string& text, const std::string& line) {
   return text.find(line + "\n") != std::string::npos;
 }
 
+// Whether a line of `text` begins with `start`.
+bool StartsLine(const std::string& text, const std::string& start) {
+  return ("\n" + text).find("\n" + start) != std::string::npos;
+}
+
+// The rest of the line that begins with `key` ("" when there is none).
+std::string LineValue(const std::string& text, const std::string& key) {
+  const std::string lines = "\n" + text;
+  size_t at = lines.find("\n" + key);
+  if (at == std::string::npos) return "";
+  at += 1 + key.size();
+  return lines.substr(at, lines.find('\n', at) - at);
+}
+
 // The decoded luma of a JPEG; empty when it does not decode.
 std::vector<int> Luma(const std::string& path, int32_t* width, int32_t* height) {
   ImageFileInfo info;
@@ -97,7 +111,7 @@ TEST_F(PhoneFiles, InfoSaysWhatEachCarries) {
          {std::string("formats: GDepth GImage GFocus"), "primary: " + size, "depth: " + size,
           std::string("depth format: RangeInverse"), std::string("depth near: ") + f.near_depth,
           std::string("depth mime: image/png"), std::string("depth colour: 8-bit RGBA"),
-          "original: " + size + " image/jpeg (GImage)"}) {
+          "original: " + size + " image/jpeg (GImage)", std::string("confidence: none")}) {
       EXPECT_TRUE(Has(r.out, line)) << "no line '" << line << "' in\n" << r.out;
     }
     EXPECT_NE(r.out.find("\nfocus point: 0."), std::string::npos) << r.out;
@@ -159,9 +173,16 @@ TEST_F(Info, OnTheProductsOwnFile) {
   for (const char* line :
        {"formats: GDepth GImage GFocus DynamicDepth", "primary: 320x240", "depth from: GDepth",
         "depth format: RangeInverse", "depth mime: image/png", "depth colour: 16-bit grey",
-        "original: 320x240 image/jpeg (GImage)", "dynamic depth confidence: none"}) {
+        "original: 320x240 image/jpeg (GImage)"}) {
     EXPECT_TRUE(Has(r.out, line)) << "no line '" << line << "' in\n" << r.out;
   }
+  // The confidence map, the depth's size, in both formats.
+  const std::string size = LineValue(r.out, "depth: ");
+  EXPECT_FALSE(size.empty()) << r.out;
+  EXPECT_TRUE(StartsLine(r.out, "confidence: " + size + " image/png, ")) << r.out;
+  EXPECT_NE(r.out.find("(GDepth)\n"), std::string::npos) << r.out;
+  EXPECT_TRUE(StartsLine(r.out, "dynamic depth confidence: " + size + " 8-bit grey image/png, "))
+      << r.out;
   EXPECT_NE(r.out.find("\ndynamic depth original: 320x240 image/jpeg, "), std::string::npos)
       << r.out;
   // Re-rendered with no lens settings, it starts where `run` left it.
@@ -185,10 +206,11 @@ TEST_F(Info, TheProductsDynamicDepthOpensWithoutGDepth) {
     const std::string out = test::RunTool("exiftool -a -G1 -s '" + photo + "' 2>&1", &code);
     EXPECT_EQ(code, 0) << out;
     for (const char* want :
-         {"[XMP-Device]", "ContainerDirectoryItemMime", "image/jpeg, image/png, image/jpeg",
-          "ContainerDirectoryItemLength", "DepthMapFormat", "RangeInverse", "DepthMapNear",
-          "DepthMapFar", "DepthMapUnits", "Diopters", "DepthMapDepthURI", "android/depthmap",
-          "ImageItemURI", "android/originalimage"}) {
+         {"[XMP-Device]", "ContainerDirectoryItemMime",
+          "image/jpeg, image/png, image/png, image/jpeg", "DepthMapConfidenceURI",
+          "android/confidencemap", "ContainerDirectoryItemLength", "DepthMapFormat", "RangeInverse",
+          "DepthMapNear", "DepthMapFar", "DepthMapUnits", "Diopters", "DepthMapDepthURI",
+          "android/depthmap", "ImageItemURI", "android/originalimage"}) {
       EXPECT_NE(out.find(want), std::string::npos) << want << "\n" << out;
     }
   }
@@ -202,7 +224,7 @@ TEST_F(Info, TheProductsDynamicDepthOpensWithoutGDepth) {
     EXPECT_NE(out.find(" image/png "), std::string::npos) << out;
     EXPECT_NE(out.find(" android/originalimage 160x120\n"), std::string::npos) << out;
     EXPECT_NE(out.find("depth 1\n"), std::string::npos) << out;
-    EXPECT_NE(out.find("original 2\n"), std::string::npos) << out;
+    EXPECT_NE(out.find("original 3\n"), std::string::npos) << out;
   }
 
   const std::string text = clitest::Slurp(photo);
@@ -217,6 +239,9 @@ TEST_F(Info, TheProductsDynamicDepthOpensWithoutGDepth) {
         "original: 160x120 image/jpeg (Dynamic Depth Original)", "depth units: Diopters"}) {
     EXPECT_TRUE(Has(r.out, line)) << "no line '" << line << "' in\n" << r.out;
   }
+  const std::string size = LineValue(r.out, "depth: ");
+  EXPECT_TRUE(StartsLine(r.out, "confidence: " + size + " image/png, ")) << r.out;
+  EXPECT_NE(r.out.find(" bytes (Dynamic Depth)\n"), std::string::npos) << r.out;
   r = Run({"rerender", stripped, "--focus", "80,60", "--out", Out()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err, "");
