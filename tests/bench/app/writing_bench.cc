@@ -1,7 +1,8 @@
 // Writing a 12 MP photo: the rendered strips encoded as they come, the all-in-focus
 // original encoded whole (GImage), the refocusable XMP built (the depth map as a 16-bit PNG,
 // base64, extended-XMP segments), with or without Dynamic Depth beside GDepth (its Device
-// element and its items, the same depth PNG and original again, raw), and the finished file
+// element and its items, the same depth PNG and original again, raw), with or without the
+// map's confidence (an 8-bit PNG in both formats), and the finished file
 // written, fsynced and renamed. The pictures are the synthetic burst's own reference frame and
 // depth (computed once, before timing), so the encoders see camera-like content.
 //   build/host/tests/bench/app/writing_bench --benchmark_repetitions=5
@@ -100,16 +101,18 @@ void BM_RefocusableXmp(benchmark::State& state) {
   std::vector<uint8_t> original;
   if (!EncodeYCbCr420(p.reference(), 92, &original).ok()) state.SkipWithError("original");
   FocusUsed focus;
-  focus.focus_disp_q8 = (p.disp_min_q8() + p.disp_max_q8()) / 2;
+  focus.focus_disp_q8 = (p.map_min_q8() + p.map_max_q8()) / 2;
   const bool dynamic_depth = state.range(0) != 0;
+  // The map's confidence (GDepth:Confidence, and Dynamic Depth's item), as every photo carries.
+  const ConstImageU8 confidence = state.range(1) != 0 ? p.map_confidence() : ConstImageU8();
   size_t bytes = 0, items = 0;
   std::vector<uint8_t> after_eoi;
   for (auto _ : state) {
     std::vector<JpegSegment> segments;
     DynamicDepthTrailer dd;
     Status s =
-        BuildRefocusableSegments(p.disparity_q8(), {p.disp_min_q8(), p.disp_max_q8()}, original,
-                                 focus, kWidth, &segments, dynamic_depth ? &dd : nullptr);
+        BuildRefocusableSegments(p.map_q8(), {p.map_min_q8(), p.map_max_q8()}, original, focus,
+                                 kWidth, &segments, dynamic_depth ? &dd : nullptr, confidence);
     // The items as the job writes them after the image, here into memory.
     after_eoi.clear();
     if (s.ok() && dynamic_depth) {
@@ -126,8 +129,14 @@ void BM_RefocusableXmp(benchmark::State& state) {
   state.counters["MB"] = static_cast<double>(bytes) / 1e6;
   state.counters["items_MB"] = static_cast<double>(items) / 1e6;
 }
-// Arg 0: GDepth only; 1: Dynamic Depth beside it, as the product writes.
-BENCHMARK(BM_RefocusableXmp)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+// Args (0, 0): GDepth only; (1, 0): Dynamic Depth beside it; (1, 1): both with the confidence
+// map, as the product writes.
+BENCHMARK(BM_RefocusableXmp)
+    ->Args({0, 0})
+    ->Args({1, 0})
+    ->Args({1, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
 
 // The finished photo's bytes through the storage rule: a hidden temporary, fsync, rename and
 // the folder's fsync, on TMPDIR (a card on the board).
