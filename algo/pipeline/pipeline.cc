@@ -22,7 +22,7 @@ Pipeline::Layout Pipeline::Plan(const PipelineConfig& c) {
   // gets no depth (ComputeDepth says so) and a scale that keeps a pixel for its flat map.
   const int32_t thin = c.width < c.height ? c.width : c.height;
   if (s > thin) s = thin;
-  return {s, c.width / s, c.height / s};
+  return {s, c.width / s, c.height / s, DepthRefiner::MapScale(c.width, c.height, s)};
 }
 
 // Working images smaller than the depth stage takes give a flat map and a warning.
@@ -69,13 +69,14 @@ static MotionConfig MakeMotionConfig(const PipelineConfig& c, int32_t w, int32_t
   return m;
 }
 
-static RenderConfig MakeRenderConfig(const PipelineConfig& c, int32_t s, int32_t w, int32_t h) {
+// The render reads the map, not the depth stage's grid.
+static RenderConfig MakeRenderConfig(const PipelineConfig& c, int32_t map_scale) {
   RenderConfig r;
   r.width = c.width;
   r.height = c.height;
-  r.working_scale = s;
-  r.working_width = w;
-  r.working_height = h;
+  r.working_scale = map_scale;
+  r.working_width = c.width / map_scale;
+  r.working_height = c.height / map_scale;
   r.max_radius = c.max_blur_radius;
   r.workers = c.workers;
   return r;
@@ -116,7 +117,7 @@ Status Pipeline::RequiredBytes(const PipelineConfig& c, size_t* bytes) {
     LB_RETURN_IF_ERROR(DepthStage::Validate(MakeDepthConfig(c, l.work_w, l.work_h)));
   }
   if (c.render) {
-    LB_RETURN_IF_ERROR(RenderStage::Validate(MakeRenderConfig(c, l.scale, l.work_w, l.work_h)));
+    LB_RETURN_IF_ERROR(RenderStage::Validate(MakeRenderConfig(c, l.map_scale)));
   }
   if (UsesMotion(c, l.work_w, l.work_h)) {
     LB_RETURN_IF_ERROR(MotionStage::Validate(MakeMotionConfig(c, l.work_w, l.work_h)));
@@ -129,6 +130,7 @@ Status Pipeline::RequiredBytes(const PipelineConfig& c, size_t* bytes) {
   planner.scale_ = l.scale;
   planner.work_w_ = l.work_w;
   planner.work_h_ = l.work_h;
+  planner.map_scale_ = l.map_scale;
   Arena plan;
   LB_RETURN_IF_ERROR(planner.Carve(plan));
   *bytes = plan.used();
@@ -145,6 +147,10 @@ Status Pipeline::Carve(Arena& arena) {
     working_[i] = arena.AllocateImage<uint8_t>(work_w_, work_h_, 3);
   disp_q8_ = arena.AllocateImage<uint16_t>(work_w_, work_h_);
   confidence_ = c.confidence ? arena.AllocateImage<uint8_t>(work_w_, work_h_) : ImageU8{};
+  const RefineConfig fc = MakeRefineConfig();
+  map_q8_ = arena.AllocateImage<uint16_t>(fc.map_width, fc.map_height);
+  map_confidence_ =
+      c.confidence ? arena.AllocateImage<uint8_t>(fc.map_width, fc.map_height) : ImageU8{};
   rgb_rows_[0] = arena.Allocate<uint8_t>(static_cast<size_t>(c.width) * 3);
   rgb_rows_[1] = arena.Allocate<uint8_t>(static_cast<size_t>(c.width) * 3);
   cols_ = arena.Allocate<uint32_t>(static_cast<size_t>(work_w_) * scale_ * 3);
@@ -158,13 +164,18 @@ Status Pipeline::Carve(Arena& arena) {
   const bool depth = HasDepth(work_w_, work_h_), motion = UsesMotion(c, work_w_, work_h_);
   const DepthConfig dc = MakeDepthConfig(c, work_w_, work_h_);
   const MotionConfig mc = MakeMotionConfig(c, work_w_, work_h_);
-  const RenderConfig rc = MakeRenderConfig(c, scale_, work_w_, work_h_);
-  // Each stage starts on a fresh alignment boundary: kAlign of slack per stage.
+  const RenderConfig rc = MakeRenderConfig(c, map_scale_);
+  // Each stage starts on a fresh alignment boundary: kAlign of slack per stage. The refinement
+  // comes after the analysis, whose motion result stays readable until the render begins.
   const size_t analysis = (depth ? DepthStage::RequiredBytes(dc) + Arena::kAlign : 0) +
                           (motion ? MotionStage::RequiredBytes(mc) + Arena::kAlign : 0);
+  const size_t refine = depth ? DepthRefiner::RequiredBytes(fc) + Arena::kAlign : 0;
   const size_t render = c.render ? RenderStage::RequiredBytes(rc) + Arena::kAlign : 0;
-  const size_t shared = analysis > render ? analysis : render;
+  const size_t shared = analysis + refine > render ? analysis + refine : render;
   uint8_t* region = arena.Allocate<uint8_t>(shared);
+  region_ = region;
+  region_bytes_ = shared;
+  analysis_bytes_ = analysis;
   if (arena.planning()) return Status::Ok();
   if (arena.overflowed()) {
     return Status(Code::kOutOfMemory, "pipeline arena of %zu bytes is too small (needs %zu)",
@@ -173,6 +184,10 @@ Status Pipeline::Carve(Arena& arena) {
   Arena analysis_arena(region, shared);
   if (depth) LB_RETURN_IF_ERROR(depth_.Configure(dc, analysis_arena));
   if (motion) LB_RETURN_IF_ERROR(motion_.Configure(mc, analysis_arena));
+  if (depth) {
+    Arena refine_arena(region + analysis, shared - analysis);
+    refine_.Carve(fc, refine_arena);
+  }
   if (!c.render) return Status::Ok();
   Arena render_arena(region, shared);
   return render_.Configure(rc, render_arena);
@@ -183,6 +198,36 @@ void Pipeline::SetRunner(TaskRunner* runner) {
   depth_.SetRunner(runner);
   motion_.SetRunner(runner);
   render_.SetRunner(runner);
+  refine_.SetRunner(runner);
+}
+
+RefineConfig Pipeline::MakeRefineConfig() const {
+  RefineConfig r;
+  r.width = config_.width;
+  r.height = config_.height;
+  r.work_scale = scale_;
+  r.work_width = work_w_;
+  r.work_height = work_h_;
+  r.map_scale = map_scale_;
+  r.map_width = config_.width / map_scale_;
+  r.map_height = config_.height / map_scale_;
+  r.workers = config_.workers;
+  return r;
+}
+
+void Pipeline::MakeMap(bool flat) {
+  if (!flat) {
+    refine_.Run(ref_.AsConst(), disp_q8_.AsConst(), confidence_.AsConst(), map_q8_,
+                map_confidence_);
+    return;
+  }
+  const uint16_t value = static_cast<uint16_t>(ToMapQ8(disp_min_q8_));
+  for (int32_t y = 0; y < map_q8_.height; ++y) {
+    uint16_t* row = map_q8_.Row(y);
+    for (int32_t x = 0; x < map_q8_.width; ++x) row[x] = value;
+  }
+  for (int32_t y = 0; y < map_confidence_.height; ++y)
+    memset(map_confidence_.Row(y), 0, static_cast<size_t>(map_confidence_.width));
 }
 
 Status Pipeline::Configure(const PipelineConfig& config, void* arena, size_t bytes) {
@@ -200,6 +245,7 @@ Status Pipeline::Configure(const PipelineConfig& config, void* arena, size_t byt
   scale_ = l.scale;
   work_w_ = l.work_w;
   work_h_ = l.work_h;
+  map_scale_ = l.map_scale;
   Arena a(arena, bytes);
   LB_RETURN_IF_ERROR(Carve(a));
   ResetBurst();
@@ -359,6 +405,7 @@ Status Pipeline::ComputeDepth() {
     for (int32_t y = 0; y < confidence_.height; ++y)
       memset(confidence_.Row(y), 0, static_cast<size_t>(work_w_));
     low_confidence_permille_ = config_.confidence ? 1000 : 0;
+    MakeMap(true);
     depth_ready_ = true;
     return Status::Ok();
   }
@@ -382,6 +429,7 @@ Status Pipeline::ComputeDepth() {
   const DepthConfig& d = depth_.config();
   disp_min_q8_ = d.disp_min_q8 + DepthStage::MapBiasQ8(d);
   disp_max_q8_ = d.disp_max_q8 + DepthStage::MapBiasQ8(d);
+  MakeMap(false);
   depth_ready_ = true;
   return Status::Ok();
 }
@@ -413,7 +461,7 @@ Status Pipeline::BeginRender(const RenderParams& params) {
   if (!config_.render)
     return Status(Code::kInvalidArgument, "a depth-only pipeline renders no photo");
   if (!depth_ready_) return Status(Code::kInvalidArgument, "render before depth was computed");
-  LB_RETURN_IF_ERROR(render_.Begin(ref_.AsConst(), disp_q8_.AsConst(), params));
+  LB_RETURN_IF_ERROR(render_.Begin(ref_.AsConst(), map_q8_.AsConst(), params));
   render_started_ = true;
   return Status::Ok();
 }

@@ -24,6 +24,7 @@
 #include "algo/depth/depth_stage.h"
 #include "algo/motion/camera.h"
 #include "algo/motion/motion_stage.h"
+#include "algo/render/depth_refine.h"
 #include "algo/render/render_stage.h"
 
 namespace lb {
@@ -125,24 +126,30 @@ class Pipeline : public FrameSink {
   int32_t low_confidence_permille() const { return low_confidence_permille_; }
   static constexpr int32_t kRetakePermille = 500;
   // The depth map a photo carries and the render uses (the file's GDepth and Dynamic Depth),
-  // after ComputeDepth: map_scale() full-resolution px per map px, its disparity in map px per
-  // view step (Q8.8) within map_min_q8()..map_max_q8(), and its confidence (0..255, empty
-  // without config().confidence), the same size as the map.
-  int32_t map_scale() const { return scale_; }
-  ConstImageU16 map_q8() const { return disp_q8_.AsConst(); }
-  ConstImageU8 map_confidence() const { return confidence_.AsConst(); }
-  int32_t map_min_q8() const { return disp_min_q8_; }
-  int32_t map_max_q8() const { return disp_max_q8_; }
+  // after ComputeDepth: the depth stage's disparity refined on a grid of map_scale()
+  // full-resolution px a map px (depth_refine.h), in map px per view step (Q8.8) within
+  // map_min_q8()..map_max_q8(), and its confidence (0..255, empty without config().confidence),
+  // the same size as the map.
+  int32_t map_scale() const { return map_scale_; }
+  ConstImageU16 map_q8() const { return map_q8_.AsConst(); }
+  ConstImageU8 map_confidence() const { return map_confidence_.AsConst(); }
+  int32_t map_min_q8() const { return ToMapQ8(disp_min_q8_); }
+  int32_t map_max_q8() const { return ToMapQ8(disp_max_q8_); }
   const DepthStage& depth() const { return depth_; }
   RenderStage& render() { return render_; }
 
  private:
   struct Layout {
-    int32_t scale, work_w, work_h;
+    int32_t scale, work_w, work_h, map_scale;
   };
   static Layout Plan(const PipelineConfig& config);
   Status Carve(Arena& arena);
   Status EstimateGeometry(const ConstImageU8* views);
+  void MakeMap(bool flat);
+  RefineConfig MakeRefineConfig() const;
+  int32_t ToMapQ8(int32_t working_q8) const {
+    return (working_q8 * scale_ + map_scale_ / 2) / map_scale_;
+  }
   // A band of columns of the ingest: full resolution [x0, x1), working [wx0, wx1).
   struct Columns {
     int32_t x0, x1, wx0, wx1;
@@ -152,17 +159,22 @@ class Pipeline : public FrameSink {
   void FlushChroma(int32_t y, const Columns& columns);
 
   PipelineConfig config_;
-  int32_t scale_ = 1, work_w_ = 0, work_h_ = 0;
+  int32_t scale_ = 1, work_w_ = 0, work_h_ = 0, map_scale_ = 1;
 
   PlanarU8 ref_;                                 // full-resolution reference, YCbCr 4:2:0
   ImageU8 working_[PipelineConfig::kMaxFrames];  // working-resolution views, RGB8
   ImageU16 disp_q8_;                             // working-resolution disparity, Q8.8
   ImageU8 confidence_;                           // its confidence (config_.confidence)
+  ImageU16 map_q8_;                              // the refined map, Q8.8 map px
+  ImageU8 map_confidence_;
   int32_t low_confidence_permille_ = 0;
   uint8_t* rgb_rows_[2] = {nullptr, nullptr};  // full-width RGB8 rows (even, odd)
   uint32_t* cols_ = nullptr;  // box downscale: column sums, working row x scale x 3 (ingest.h)
   DepthStage depth_;
   RenderStage render_;
+  DepthRefiner refine_;
+  uint8_t* region_ = nullptr;  // the stages' shared region
+  size_t region_bytes_ = 0, analysis_bytes_ = 0;
   MotionStage motion_;  // kAuto only
   InlineRunner inline_;
   TaskRunner* runner_ = &inline_;

@@ -22,9 +22,18 @@ void DepthUpsampler::Carve(Arena& arena, int32_t width, int32_t height, int32_t 
 
 // The tables are filled here, not at Carve: the pipeline lends the render's memory to the depth
 // stages between renders.
-void DepthUpsampler::Begin(const ConstPlanarU8& ref, ConstImageU16 disp_q8) {
+void DepthUpsampler::Begin(const ConstPlanarU8& ref, ConstImageU16 disp_q8, ConstImageU8 confidence,
+                           bool one_side) {
+  one_side_ = one_side;
   ref_ = ref;
   disp_ = disp_q8;
+  confidence_ = confidence;
+  int32_t lo = 65535, hi = 0;
+  for (int32_t y = 0; y < wh_; ++y) {
+    const uint16_t* row = disp_q8.Row(y);
+    for (int32_t x = 0; x < ww_; ++x) lo = Min(lo, row[x]), hi = Max(hi, row[x]);
+  }
+  smooth_q8_ = Max(kSmoothQ8, (hi - lo) / kSmoothShare);
   for (int32_t w = 0; w < workers_; ++w) {
     for (Guide& g : cache_[w].guide) g.tag = -1;
     cache_[w].uniform_tag = -1;
@@ -87,6 +96,32 @@ const uint8_t* DepthUpsampler::GuideRow(Cache& c, int32_t wy) {
   return g.yuv;
 }
 
+// A pixel on a depth edge takes one side's depth, never a mix of both (a mix is a depth no
+// surface has: a halo in the blur). The side is the group of neighbours within smooth_q8() of one
+// another with the most weight; the pixel takes that group's weighted mean.
+uint16_t DepthUpsampler::EdgeValue(const uint32_t* w, const int32_t* d, uint16_t fallback) const {
+  uint32_t best_w = 0;
+  int32_t best = -1;
+  for (int32_t j = 0; j < 9; ++j) {
+    uint32_t sum = 0;
+    for (int32_t i = 0; i < 9; ++i) sum += Abs(d[i] - d[j]) <= smooth_q8_ ? w[i] : 0;
+    if (sum > best_w) best_w = sum, best = j;
+  }
+  if (best < 0) return fallback;
+  // Weights Q8 <= 256: at most 9 * 256 * 65535 < 2^32.
+  uint32_t sum_wd = 0;
+  for (int32_t i = 0; i < 9; ++i)
+    if (Abs(d[i] - d[best]) <= smooth_q8_) sum_wd += w[i] * static_cast<uint32_t>(d[i]);
+  return static_cast<uint16_t>((sum_wd + best_w / 2) / best_w);
+}
+
+uint16_t DepthUpsampler::MeanValue(const uint32_t* w, const int32_t* d, uint16_t fallback) {
+  // Weights Q8 <= 256: at most 9 * 256 * 65535 < 2^32.
+  uint32_t sum_w = 0, sum_wd = 0;
+  for (int32_t i = 0; i < 9; ++i) sum_w += w[i], sum_wd += w[i] * static_cast<uint32_t>(d[i]);
+  return sum_w ? static_cast<uint16_t>((sum_wd + sum_w / 2) / sum_w) : fallback;
+}
+
 const uint8_t* DepthUpsampler::UniformRow(Cache& c, int32_t wy) {
   uint8_t* uniform = c.uniform;
   if (c.uniform_tag == wy) return uniform;
@@ -99,12 +134,12 @@ const uint8_t* DepthUpsampler::UniformRow(Cache& c, int32_t wy) {
     for (int32_t i = 0; i < 3; ++i) {
       for (int32_t q : {l, wx, r}) lo = Min(lo, rows[i][q]), hi = Max(hi, rows[i][q]);
     }
-    uniform[wx] = hi == lo ? kFlat : (hi - lo <= kSmoothQ8 ? kSmooth : kEdge);
+    uniform[wx] = hi == lo ? kFlat : (hi - lo <= smooth_q8_ ? kSmooth : kEdge);
   }
   return uniform;
 }
 
-void DepthUpsampler::Row(int32_t y, uint16_t* out, int32_t worker) {
+void DepthUpsampler::Row(int32_t y, uint16_t* out, int32_t worker, int32_t step, int32_t phase) {
   Cache& c = cache_[worker];
   const int32_t s = scale_;
   const int32_t wy = Min(y / s, wh_ - 1);
@@ -112,6 +147,10 @@ void DepthUpsampler::Row(int32_t y, uint16_t* out, int32_t worker) {
   const int32_t wys[3] = {Max(wy - 1, 0), wy, Min(wy + 1, wh_ - 1)};
   const uint8_t* guide[3] = {GuideRow(c, wys[0]), GuideRow(c, wys[1]), GuideRow(c, wys[2])};
   const uint16_t* disp[3] = {disp_.Row(wys[0]), disp_.Row(wys[1]), disp_.Row(wys[2])};
+  const uint8_t* sure[3] = {nullptr, nullptr, nullptr};
+  if (confidence_.data != nullptr) {
+    for (int32_t i = 0; i < 3; ++i) sure[i] = confidence_.Row(wys[i]);
+  }
   const uint8_t* uniform = UniformRow(c, wy);
   const uint8_t* luma = ref_.planes[0].Row(y);
   const uint8_t* cb = ref_.planes[1].Row(y / 2);
@@ -120,8 +159,10 @@ void DepthUpsampler::Row(int32_t y, uint16_t* out, int32_t worker) {
   // Block by block: a block whose 3x3 neighbourhood agrees is a plain fill.
   for (int32_t wx = 0; wx < ww_; ++wx) {
     const int32_t x0 = wx * s, x1 = wx + 1 == ww_ ? width_ : x0 + s;
+    // The block's first column on the lattice phase + k * step.
+    const int32_t xs = x0 <= phase ? phase : phase + (x0 - phase + step - 1) / step * step;
     if (uniform[wx] == kFlat) {
-      for (int32_t x = x0; x < x1; ++x) out[x] = disp[1][wx];
+      for (int32_t x = xs; x < x1; x += step) out[(x - phase) / step] = disp[1][wx];
       continue;
     }
     const int32_t qx[3] = {Max(wx - 1, 0), wx, Min(wx + 1, ww_ - 1)};
@@ -133,31 +174,34 @@ void DepthUpsampler::Row(int32_t y, uint16_t* out, int32_t worker) {
         wy_sum += wsy[oy];
         for (int32_t ox = 0; ox < 3; ++ox) col[ox] += wsy[oy] * disp[oy][qx[ox]];
       }
-      for (int32_t x = x0; x < x1; ++x) {
+      for (int32_t x = xs; x < x1; x += step) {
         const uint16_t* wsx = spatial_q8_ + Min(x - x0, s - 1) * 3;
         // col < 3 * 256 * 65535; times a Q8 weight it needs 64 bits.
         const uint64_t num =
             uint64_t{wsx[0]} * col[0] + uint64_t{wsx[1]} * col[1] + uint64_t{wsx[2]} * col[2];
         const uint64_t den = uint64_t{wy_sum} * (wsx[0] + wsx[1] + wsx[2]);
-        out[x] = static_cast<uint16_t>((num + den / 2) / den);
+        out[(x - phase) / step] = static_cast<uint16_t>((num + den / 2) / den);
       }
       continue;
     }
-    for (int32_t x = x0; x < x1; ++x) {
+    for (int32_t x = xs; x < x1; x += step) {
       const uint16_t* wsx = spatial_q8_ + Min(x - x0, s - 1) * 3;
       const int32_t py = luma[x], pb = cb[x / 2], pr = cr[x / 2];
-      uint32_t sum_w = 0, sum_wd = 0;  // weights Q8 <= 256: at most 9 * 256 * 65535 < 2^32
+      uint32_t w[9];
+      int32_t d[9];
       for (int32_t oy = 0; oy < 3; ++oy) {
         const uint8_t* g = guide[oy];
         for (int32_t ox = 0; ox < 3; ++ox) {
           const int32_t q = qx[ox];
           const int32_t dist = Abs(py - g[q]) + Abs(pb - g[ww_ + q]) + Abs(pr - g[2 * ww_ + q]);
-          const uint32_t w = ((wsy[oy] * wsx[ox]) >> 8) * range_q8_[dist] >> 8;
-          sum_w += w;
-          sum_wd += w * disp[oy][q];
+          w[oy * 3 + ox] = ((wsy[oy] * wsx[ox]) >> 8) * range_q8_[dist] >> 8;
+          if (sure[oy] != nullptr)
+            w[oy * 3 + ox] = w[oy * 3 + ox] * (sure[oy][q] + kConfidenceFloor) >> 8;
+          d[oy * 3 + ox] = disp[oy][q];
         }
       }
-      out[x] = sum_w ? static_cast<uint16_t>((sum_wd + sum_w / 2) / sum_w) : disp[1][wx];
+      out[(x - phase) / step] =
+          one_side_ ? EdgeValue(w, d, disp[1][wx]) : MeanValue(w, d, disp[1][wx]);
     }
   }
 }

@@ -23,15 +23,28 @@ class DepthUpsampler {
   // its own.
   void Carve(Arena& arena, int32_t width, int32_t height, int32_t scale, int32_t working_width,
              int32_t working_height, int32_t workers = 1);
-  void Begin(const ConstPlanarU8& ref, ConstImageU16 disp_q8);
+  // `confidence` (optional, the disparity's size, 255 sure): on a depth edge an unsure
+  // neighbour counts for less than a sure one of the same colour.
+  // `one_side`: a pixel on a depth edge takes one side's depth (EdgeValue), for a map that is
+  // kept; without, the weighted mean of both, which a render at full size shows as the soft
+  // transition a pixel the edge crosses has.
+  void Begin(const ConstPlanarU8& ref, ConstImageU16 disp_q8, ConstImageU8 confidence = {},
+             bool one_side = false);
   // Disparity (Q8.8, working px per view step) of every pixel of full-resolution row y. Rows of
   // different workers may be made at once; the values do not depend on which worker made them.
-  void Row(int32_t y, uint16_t* disp_q8, int32_t worker = 0);
+  // With `step` > 1 only columns phase + k * step are made, into disp_q8[k] (a coarser grid's
+  // samples, depth_refine.h).
+  void Row(int32_t y, uint16_t* disp_q8, int32_t worker = 0, int32_t step = 1, int32_t phase = 0);
 
   static constexpr int32_t kRangeSigma = 16;  // colour distance (|dY|+|dCb|+|dCr|) of weight 1/4
-  // Blocks whose 3x3 disparities span at most this (Q8, a quarter px) are a smooth surface: the
-  // colour term is skipped there.
+  // Blocks whose 3x3 disparities span at most smooth_q8() are a smooth surface: the colour term
+  // is skipped there. It is a share of the map's range (a slanted surface's label steps grow
+  // with the map's size, and a phone's units are its own), at least kSmoothQ8 (a quarter px).
   static constexpr int32_t kSmoothQ8 = 64;
+  static constexpr int32_t kSmoothShare = 32;
+  // An unsure neighbour's weight: (confidence + kConfidenceFloor) / 256 of a sure one's.
+  static constexpr int32_t kConfidenceFloor = 32;
+  int32_t smooth_q8() const { return smooth_q8_; }
 
  private:
   struct Guide {
@@ -46,11 +59,16 @@ class DepthUpsampler {
     int32_t uniform_tag = -1;
   };
   const uint8_t* GuideRow(Cache& c, int32_t wy);
+  uint16_t EdgeValue(const uint32_t* w, const int32_t* d, uint16_t fallback) const;
+  static uint16_t MeanValue(const uint32_t* w, const int32_t* d, uint16_t fallback);
   const uint8_t* UniformRow(Cache& c, int32_t wy);
 
   int32_t width_ = 0, height_ = 0, scale_ = 1, ww_ = 0, wh_ = 0, workers_ = 1;
+  int32_t smooth_q8_ = kSmoothQ8;
+  bool one_side_ = false;
   ConstPlanarU8 ref_;
   ConstImageU16 disp_;
+  ConstImageU8 confidence_;
   Cache cache_[kMaxWorkers];
   enum : uint8_t { kEdge = 0, kSmooth = 1, kFlat = 2 };
   uint16_t* spatial_q8_ = nullptr;  // [f * 3 + o]: offset o-1 seen from sub-position f
