@@ -22,7 +22,6 @@ size_t DepthRefiner::RequiredBytes(const RefineConfig& config) {
 void DepthRefiner::Carve(const RefineConfig& c, Arena& arena) {
   config_ = c;
   config_.workers = Clamp(c.workers, 1, kMaxWorkers);
-  if (c.map_scale >= c.work_scale) return;
   upsampler_.Carve(arena, c.width, c.height, c.work_scale, c.work_width, c.work_height,
                    config_.workers);
   for (int32_t w = 0; w < config_.workers; ++w) {
@@ -42,32 +41,27 @@ uint16_t DepthRefiner::ToMap(uint32_t working_q8) const {
   return static_cast<uint16_t>(v > 65535 ? 65535 : v);
 }
 
-void DepthRefiner::Rows(ConstImageU16 disp, ConstImageU8 conf, ImageU16 map, ImageU8 map_conf,
-                        int32_t y0, int32_t y1, int32_t worker) {
+void DepthRefiner::Rows(ConstImageU8 conf, ImageU16 map, ImageU8 map_conf, int32_t y0, int32_t y1,
+                        int32_t worker) {
   const RefineConfig& c = config_;
   const int32_t s = c.map_scale, ws = c.work_scale, mw = c.map_width;
+  uint16_t* const* rows = samples_[worker];
   // The full-resolution pixels around each map pixel's centre: one when s is odd, two a side
   // when it is even.
   const int32_t taps = s % 2 == 1 ? 1 : 2;
   const int32_t first = s % 2 == 1 ? s / 2 : s / 2 - 1;
   for (int32_t my = y0; my < y1; ++my) {
     uint16_t* out = map.Row(my);
-    if (s == ws) {
-      const uint16_t* src = disp.Row(my);
-      for (int32_t mx = 0; mx < mw; ++mx) out[mx] = ToMap(src[mx]);
-    } else {
-      uint16_t* const* rows = samples_[worker];
-      for (int32_t ty = 0; ty < taps; ++ty) {
-        for (int32_t tx = 0; tx < taps; ++tx) {
-          upsampler_.Row(my * s + first + ty, rows[ty * taps + tx], worker, s, first + tx);
-        }
+    for (int32_t ty = 0; ty < taps; ++ty) {
+      for (int32_t tx = 0; tx < taps; ++tx) {
+        upsampler_.Row(my * s + first + ty, rows[ty * taps + tx], worker, s, first + tx);
       }
-      const int32_t n = taps * taps;
-      for (int32_t mx = 0; mx < mw; ++mx) {
-        uint32_t sum = 0;
-        for (int32_t i = 0; i < n; ++i) sum += rows[i][mx];
-        out[mx] = ToMap((sum + static_cast<uint32_t>(n / 2)) / static_cast<uint32_t>(n));
-      }
+    }
+    const int32_t n = taps * taps;
+    for (int32_t mx = 0; mx < mw; ++mx) {
+      uint32_t sum = 0;
+      for (int32_t i = 0; i < n; ++i) sum += rows[i][mx];
+      out[mx] = ToMap((sum + static_cast<uint32_t>(n / 2)) / static_cast<uint32_t>(n));
     }
     if (map_conf.data == nullptr || conf.data == nullptr) continue;
     const uint8_t* src = conf.Row(Min((my * s + s / 2) / ws, c.work_height - 1));
@@ -80,12 +74,11 @@ void DepthRefiner::Rows(ConstImageU16 disp, ConstImageU8 conf, ImageU16 map, Ima
 void DepthRefiner::Run(const ConstPlanarU8& ref, ConstImageU16 disp, ConstImageU8 conf,
                        ImageU16 map, ImageU8 map_conf) {
   const RefineConfig& c = config_;
-  if (c.map_scale < c.work_scale) upsampler_.Begin(ref, disp, conf, /*one_side=*/true);
+  upsampler_.Begin(ref, disp, conf, /*one_side=*/true);
   // Bands of whole map rows, several a worker: the upsampler's guide rows are cached per worker.
   const int32_t bands = runner_->workers() > 1 ? 4 * runner_->workers() : 1;
   ParallelFor(*runner_, bands, [&](int32_t b, int32_t worker) {
-    Rows(disp, conf, map, map_conf, c.map_height * b / bands, c.map_height * (b + 1) / bands,
-         worker);
+    Rows(conf, map, map_conf, c.map_height * b / bands, c.map_height * (b + 1) / bands, worker);
   });
 }
 

@@ -2,22 +2,24 @@
 // as the photo needs (at least half its side, or a megapixel when that is smaller), its edges
 // taken from the photo.
 //
-// Where the map's grid is finer than the depth stage's, each map pixel is the render's edge-aware
-// upsampling (depth_upsample.h) at its centre: a pixel on a depth edge takes the side whose
-// colour it shares (and, between neighbours of one colour, the sure ones over the unsure), never
-// a mix of both. An odd map_scale has a full-resolution pixel at each map pixel's centre; an even
-// one takes the mean of the four around it. Values become map px per view step, so a reader
-// that knows only the map and the photo gets the blur the product rendered. On the depth
-// stage's own grid the map is the stage's disparity in those units.
+// Each map pixel is the render's edge-aware upsampling of the stage's disparity
+// (depth_upsample.h) at its centre, in the mode that keeps one side of a depth edge: a pixel
+// there takes the side whose colour it shares (between neighbours of one colour, the sure ones
+// over the unsure), never a mix of both; on the stage's own grid this moves a label edge that
+// missed the photo's by a pixel onto it. An odd map_scale has a full-resolution pixel at each
+// map pixel's centre; an even one takes the mean of the four around it. Values become map px
+// per view step, so a reader that knows only the map and the photo gets the blur the product
+// rendered.
 //
 // Measured alternatives (docs/accuracy.md): smoothing the whole map along the photo's surfaces
 // (a confidence-weighted domain-transform filter), and filling unsure pixels from sure ones of
 // their colour, both made the synthetic scenes' maps worse: the labels' errors are not where the
-// confidence is low, and a surface that slants is flattened by any fill that looks only at its
-// neighbours' depths.
+// confidence is low, and any fill that looks only at its neighbours' depths flattens a surface
+// that slants.
 //
-// Fixed point; the same bits for any number of workers. Memory: one upsampler and a row per
-// worker, carved once (RequiredBytes) in the region the depth stage and the render take turns in.
+// Fixed point; the same bits for any number of workers. Memory: one upsampler and four rows of
+// samples per worker, carved once (RequiredBytes) in the region the depth stage and the render
+// take turns in.
 #pragma once
 
 #include <cstddef>
@@ -49,13 +51,13 @@ class DepthRefiner {
 
   // Makes the map (Q8.8, map px per view step) and its confidence (the depth stage's, at the
   // nearest of its pixels; left alone when empty) from the stage's disparity (Q8.8, working px)
-  // and confidence (empty: all equally sure).
+  // and confidence (empty: all equally sure), guided by the reference `ref`.
   void Run(const ConstPlanarU8& ref, ConstImageU16 disp_q8, ConstImageU8 confidence,
            ImageU16 map_q8, ImageU8 map_confidence);
 
  private:
-  void Rows(ConstImageU16 disp_q8, ConstImageU8 confidence, ImageU16 map_q8, ImageU8 map_confidence,
-            int32_t y0, int32_t y1, int32_t worker);
+  void Rows(ConstImageU8 confidence, ImageU16 map_q8, ImageU8 map_confidence, int32_t y0,
+            int32_t y1, int32_t worker);
   uint16_t ToMap(uint32_t working_q8) const;
 
   RefineConfig config_;

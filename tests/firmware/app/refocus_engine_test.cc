@@ -93,8 +93,8 @@ Photo MakePhoto(const ScratchDir& dir, const char* name, int32_t width, int32_t 
   JobReport report;
   s = job.Run(photo.path.c_str(), &report);
   EXPECT_TRUE(s.ok()) << s.message();
-  ConstImageU16 d = job.pipeline().disparity_q8();
-  // The most different depth from the focus whose 7x7 working px are within 1/4 px of each other.
+  ConstImageU16 d = job.pipeline().map_q8();
+  // The most different depth from the focus whose 7x7 map px are within 1/4 px of each other.
   int32_t best = -1;
   for (int32_t y = 4; y + 4 < d.height; ++y) {
     for (int32_t x = 4; x + 4 < d.width; ++x) {

@@ -78,10 +78,10 @@ TEST_F(Refocusable, DepthMapComesBackExactly) {
   ASSERT_TRUE(s.ok()) << s.message();
   EXPECT_EQ(r.width(), 256);
   EXPECT_EQ(r.height(), 192);
-  ConstImageU16 want = job_.pipeline().disparity_q8(), got = r.disparity_q8();
+  ConstImageU16 want = job_.pipeline().map_q8(), got = r.disparity_q8();
   ASSERT_EQ(got.width, want.width);
   ASSERT_EQ(got.height, want.height);
-  EXPECT_EQ(r.working_scale(), job_.pipeline().working_scale());
+  EXPECT_EQ(r.working_scale(), job_.pipeline().map_scale());
   int32_t differ = 0;
   for (int32_t y = 0; y < want.height; ++y)
     for (int32_t x = 0; x < want.width; ++x) differ += got.Row(y)[x] != want.Row(y)[x];
@@ -100,13 +100,13 @@ TEST_F(Refocusable, RerenderEqualsRenderingFromTheBurstDepth) {
   Status s = r.Render(o, Path("new.jpg").c_str(), &rerendered);
   ASSERT_TRUE(s.ok()) << s.message();
 
-  // Straight from the burst: the pipeline's own disparity, the stored original as reference.
+  // Straight from the burst: the pipeline's own map, the stored original as reference.
   RenderConfig rc;
   rc.width = 256;
   rc.height = 192;
-  rc.working_scale = job_.pipeline().working_scale();
-  rc.working_width = job_.pipeline().working_width();
-  rc.working_height = job_.pipeline().working_height();
+  rc.working_scale = job_.pipeline().map_scale();
+  rc.working_width = job_.pipeline().map_q8().width;
+  rc.working_height = job_.pipeline().map_q8().height;
   rc.max_radius = 16;
   std::vector<uint8_t> block(RenderStage::RequiredBytes(rc) + Arena::kAlign);
   void* base =
@@ -114,7 +114,7 @@ TEST_F(Refocusable, RerenderEqualsRenderingFromTheBurstDepth) {
   Arena arena(base, block.size() - Arena::kAlign);
   RenderStage direct;
   ASSERT_TRUE(direct.Configure(rc, arena).ok());
-  ASSERT_TRUE(direct.Begin(r.reference(), job_.pipeline().disparity_q8(), o.render).ok());
+  ASSERT_TRUE(direct.Begin(r.reference(), job_.pipeline().map_q8(), o.render).ok());
   LumaRecorder straight;
   for (;;) {
     ConstPlanarU8 strip;
