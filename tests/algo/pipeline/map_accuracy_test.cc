@@ -9,8 +9,8 @@
 // from an affine function of inverse depth (docs/accuracy.md). Two enlargements are scored:
 // bilinear (what a viewer that knows nothing of the photo does) and the product's, guided by the
 // photo, each pixel on a depth edge taking one side (depth_upsample.h, the map's own making);
-// the bounds hold for the product's. The depth stage's own grid, enlarged bilinearly, is what
-// photos carried before the map (printed beside).
+// the bounds hold for the product's. The depth stage's own grid is what photos carried before
+// the map: printed beside, enlarged as the render did and bilinearly.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -107,19 +107,18 @@ std::vector<float> Bilinear(ConstImageU16 map, int32_t scale, int32_t w, int32_t
   return out;
 }
 
-// The product's enlargement of the same map, guided by the photo.
-std::vector<float> Guided(const Pipeline& p, int32_t w, int32_t h) {
-  const ConstImageU16 map = p.map_q8();
+// An image enlarged by the edge-aware upsampling, guided by the photo: the product's enlargement
+// of its map (one side at a depth edge), or the render's of the depth stage's grid (the mean of
+// both sides, as photos were rendered before the map).
+std::vector<float> Guided(const Pipeline& p, ConstImageU16 img, int32_t scale, bool one_side) {
+  const int32_t w = p.config().width, h = p.config().height;
   DepthUpsampler up;
   Arena plan;
-  up.Carve(plan, w, h, p.map_scale(), map.width, map.height);
+  up.Carve(plan, w, h, scale, img.width, img.height);
   std::vector<uint8_t> block(plan.used() + Arena::kAlign);
-  void* base =
-      block.data() +
-      (Arena::kAlign - reinterpret_cast<uintptr_t>(block.data()) % Arena::kAlign) % Arena::kAlign;
-  Arena arena(base, plan.used());
-  up.Carve(arena, w, h, p.map_scale(), map.width, map.height);
-  up.Begin(p.reference(), map, p.map_confidence(), /*one_side=*/true);
+  Arena arena(Arena::AlignUp(block.data()), plan.used());
+  up.Carve(arena, w, h, scale, img.width, img.height);
+  up.Begin(p.reference(), img, one_side ? p.map_confidence() : ConstImageU8{}, one_side);
   std::vector<uint16_t> row(static_cast<size_t>(w));
   std::vector<float> out(static_cast<size_t>(w) * h);
   for (int32_t y = 0; y < h; ++y) {
@@ -169,17 +168,19 @@ void ScoreBurst(const Case& c, MapScore* bilinear, MapScore* guided) {
   const std::vector<uint8_t> band = EdgeBand(object, w, h, 4);
   const ConstImageU16 map = b.pipeline.map_q8();
   *bilinear = Score(truth, Bilinear(map, b.pipeline.map_scale(), w, h), band, w, h, tol);
-  *guided = Score(truth, Guided(b.pipeline, w, h), band, w, h, tol);
-  const MapScore grid =
-      Score(truth, Bilinear(b.pipeline.disparity_q8(), b.pipeline.working_scale(), w, h), band, w,
-            h, tol);
+  const Pipeline& p = b.pipeline;
+  *guided = Score(truth, Guided(p, map, p.map_scale(), true), band, w, h, tol);
+  const ConstImageU16 grid = p.disparity_q8();
+  const MapScore before = Score(truth, Guided(p, grid, p.working_scale(), false), band, w, h, tol);
+  const MapScore grid_bilinear =
+      Score(truth, Bilinear(grid, p.working_scale(), w, h), band, w, h, tol);
   printf(
-      "[ map ] %s %dx%d seed %llu: map %dx%d (1/%d); within 3 %% of the range on all / "
-      "edge-band pixels: guided %.2f / %.2f %%, bilinear %.2f / %.2f %%; the depth stage's "
-      "%dx%d grid, bilinear %.2f / %.2f %%\n",
+      "[ map ] %s %dx%d seed %llu: within 3 %% of the range on all / edge-band pixels: the map "
+      "(%dx%d) guided %.2f / %.2f %%, bilinear %.2f / %.2f %%; the depth stage's grid (%dx%d) "
+      "as rendered before %.2f / %.2f %%, bilinear %.2f / %.2f %%\n",
       c.handheld ? "handheld" : "rig", w, h, static_cast<unsigned long long>(c.seed), map.width,
-      map.height, b.pipeline.map_scale(), guided->all, guided->edge, bilinear->all, bilinear->edge,
-      b.pipeline.working_width(), b.pipeline.working_height(), grid.all, grid.edge);
+      map.height, guided->all, guided->edge, bilinear->all, bilinear->edge, grid.width, grid.height,
+      before.all, before.edge, grid_bilinear.all, grid_bilinear.edge);
 }
 
 class MapAccuracy : public ::testing::TestWithParam<Case> {};
