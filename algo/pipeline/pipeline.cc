@@ -414,11 +414,13 @@ Status Pipeline::ComputeDepth() {
   low_confidence_permille_ = 0;
   if (depth_.confidence() != nullptr && confidence_.data != nullptr) {
     // Out of the stage's memory, which the render takes over.
-    for (int32_t y = 0; y < work_h_; ++y)
-      memcpy(confidence_.Row(y), depth_.confidence() + static_cast<size_t>(y) * work_w_,
-             static_cast<size_t>(work_w_));
-    low_confidence_permille_ =
-        static_cast<int32_t>(depth_.stats().low_confidence * 1000 / (int64_t{work_w_} * work_h_));
+    int64_t guesses = 0;
+    for (int32_t y = 0; y < work_h_; ++y) {
+      const uint8_t* row = depth_.confidence() + static_cast<size_t>(y) * work_w_;
+      memcpy(confidence_.Row(y), row, static_cast<size_t>(work_w_));
+      for (int32_t x = 0; x < work_w_; ++x) guesses += row[x] < kGuessConfidence;
+    }
+    low_confidence_permille_ = static_cast<int32_t>(guesses * 1000 / (int64_t{work_w_} * work_h_));
   }
   if (config_.geometry == ViewGeometry::kAuto) {
     // SetDepthGeometry rebuilds the planes for every burst, so they are still this one's.

@@ -120,11 +120,16 @@ class Pipeline : public FrameSink {
   // 0..255 (255: sure; algo/depth/confidence.h), all 0 when the burst gave no depth; an empty
   // image without it. Kept until the next burst's ComputeDepth, the render does not touch it.
   ConstImageU8 confidence() const { return confidence_.AsConst(); }
-  // The whole burst's: the share of its pixels below DepthStage::kLowConfidence, per mille (1000
-  // when it gave no depth, 0 without the map). Above kRetakePermille most of the picture's depth
-  // is a guess (a white wall, the sky, a burst without texture): worth a retake hint.
+  // The whole burst's: the share of its pixels whose depth is a guess (confidence below
+  // kGuessConfidence), per mille (1000 when it gave no depth, 0 without the map). Above
+  // kRetakePermille most of the picture's depth is a guess (a white wall, the sky, a burst
+  // without texture): worth a retake hint. A guess is far below DepthStage::kLowConfidence: a
+  // fully textured scene has a fifth to a quarter of its pixels under kGuessConfidence (where
+  // the smoothness chose a label the data did not: docs/accuracy.md) and about half under
+  // kLowConfidence, a flat patch all of them.
   int32_t low_confidence_permille() const { return low_confidence_permille_; }
   static constexpr int32_t kRetakePermille = 500;
+  static constexpr uint8_t kGuessConfidence = 8;
   // The depth map a photo carries and the render uses (the file's GDepth and Dynamic Depth),
   // after ComputeDepth: the depth stage's disparity refined on a grid of map_scale()
   // full-resolution px a map px (depth_refine.h), in map px per view step (Q8.8) within

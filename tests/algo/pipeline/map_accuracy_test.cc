@@ -169,6 +169,8 @@ void ScoreBurst(const Case& c, MapScore* bilinear, MapScore* guided) {
   const ConstImageU16 map = b.pipeline.map_q8();
   *bilinear = Score(truth, Bilinear(map, b.pipeline.map_scale(), w, h), band, w, h, tol);
   const Pipeline& p = b.pipeline;
+  // A textured scene: no retake hint.
+  EXPECT_LT(p.low_confidence_permille(), Pipeline::kRetakePermille);
   *guided = Score(truth, Guided(p, map, p.map_scale(), true), band, w, h, tol);
   const ConstImageU16 grid = p.disparity_q8();
   const MapScore before = Score(truth, Guided(p, grid, p.working_scale(), false), band, w, h, tol);
