@@ -1,23 +1,21 @@
 #include "algo/motion/motion_stage.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "algo/motion/parallax.h"
 #include "algo/motion/rail.h"
+#include "algo/motion/view_tree.h"
 
 namespace lb {
 namespace {
 
-static_assert(MotionConfig::kMaxViews <= kMaxRailViews);
+static_assert(MotionConfig::kMaxViews <= kMaxRailViews &&
+              MotionConfig::kMaxViews <= kMaxTreePoints);
 
 int32_t Cell(const MotionConfig& c) {
   if (c.cell > 0) return c.cell;
   return c.width / 80 > 8 ? c.width / 80 : 8;
-}
-
-// View steps between frame v and the reference.
-int32_t StepsFrom(int32_t reference, int32_t v) {
-  return v > reference ? v - reference : reference - v;
 }
 
 // Chord |R - I|_F = 2 sqrt(2) sin(angle / 2): monotone in the angle, no acos needed.
@@ -161,32 +159,137 @@ Status MotionStage::Track(const ConstImageU8* views, int32_t reference, MotionRe
     pos_q16_[i] = corner_[i].x << 16;
     pos_q16_[max_points_ + i] = corner_[i].y << 16;
   }
-  // Outward from the reference, each frame starting from the one before it on its side, its
-  // motion scaled by the steps: a frame several steps out then starts within a step of its
-  // points, where a repetitive texture cannot lock onto the wrong period (the tracker also
-  // tries no motion, for a hand that went back).
-  for (int32_t d = 1; d < c.views; ++d) {
-    for (int32_t side = -1; side <= 1; side += 2) {
-      const int32_t v = reference + side * d;
-      if (v < 0 || v >= c.views) continue;
-      LB_RETURN_IF_ERROR(view_.Build(views[v]));
-      result->sharpness_q4[v] = SharpnessQ4(view_.level(0));
-      int32_t* dx = disp_q16_ + 2 * static_cast<size_t>(v) * max_points_;
-      int32_t* dy = dx + max_points_;
-      const int32_t u = v - side;  // the frame before, toward the reference
-      const int32_t* ux = disp_q16_ + 2 * static_cast<size_t>(u) * max_points_;
-      const int32_t* uy = ux + max_points_;
-      const uint8_t* u_ok = obs_ok_ + static_cast<size_t>(u) * n;
-      for (int32_t i = 0; i < n; ++i) {
-        const bool guess = u != reference && u_ok[i];
-        dx[i] = guess ? static_cast<int32_t>(int64_t{ux[i]} * d / (d - 1)) : 0;
-        dy[i] = guess ? static_cast<int32_t>(int64_t{uy[i]} * d / (d - 1)) : 0;
-      }
-      tracker_.Track(ref_, view_, pos_q16_, pos_q16_ + max_points_, n, dx, dy,
-                     obs_ok_ + static_cast<size_t>(v) * n, runner_);
-    }
+  // Every frame from no motion first, over the whole pyramid. How far it went is the 90th
+  // percentile of its points' displacements: the median can be a repetitive texture's wrong
+  // period, locked onto by most points, where the nearest surfaces' large motion shows.
+  double reach[MotionConfig::kMaxViews] = {};
+  for (int32_t v = 0; v < c.views; ++v) {
+    if (v == reference) continue;
+    LB_RETURN_IF_ERROR(view_.Build(views[v]));
+    result->sharpness_q4[v] = SharpnessQ4(view_.level(0));
+    int32_t* dx = Displacements(v);
+    for (int32_t i = 0; i < 2 * max_points_; ++i) dx[i] = 0;
+    tracker_.Track(ref_, view_, pos_q16_, pos_q16_ + max_points_, n, dx, dx + max_points_,
+                   obs_ok_ + static_cast<size_t>(v) * n, runner_);
+    reach[v] = ReachPx(v, n);
   }
+  // Then outward, in that order, whatever the frames' places in the list: a frame whose points
+  // lie, most of them, where a nearer frame's went times one scale above 1 (the farther frame of
+  // a line) starts again from that frame's motion times the scale. A frame several steps out
+  // then starts within a step of its points, where a repetitive texture cannot lock onto the
+  // wrong period (the tracker also tries no motion, for a hand that went back).
+  int32_t order[MotionConfig::kMaxViews];
+  int32_t count = 0;
+  for (int32_t v = 0; v < c.views; ++v) {
+    if (v != reference) order[count++] = v;
+  }
+  std::sort(order, order + count, [&](int32_t a, int32_t b) {
+    return reach[a] < reach[b] || (reach[a] == reach[b] && a < b);
+  });
+  for (int32_t k = 1; k < count; ++k) {
+    const int32_t v = order[k];
+    // The farthest of the nearer frames that agrees: the smallest scale, the shortest reach.
+    int32_t u = -1;
+    double scale = 0;
+    for (int32_t j = k - 1; j >= 0 && u < 0; --j) {
+      int32_t votes = 0;
+      scale = FartherScale(order[j], v, n, &votes);
+      if (votes > 0) u = order[j];
+    }
+    if (u < 0) continue;
+    LB_RETURN_IF_ERROR(view_.Build(views[v]));
+    int32_t* dx = Displacements(v);
+    int32_t* dy = dx + max_points_;
+    const int32_t* ux = Displacements(u);
+    const int32_t* uy = ux + max_points_;
+    const uint8_t* u_ok = obs_ok_ + static_cast<size_t>(u) * n;
+    // Q16 starts, held within +-2^30 (16384 px, beyond any frame: such a start just fails).
+    auto start = [scale](int32_t d) {
+      const double q = d * scale, limit = 1073741824.0;
+      return static_cast<int32_t>(std::lround(q > limit ? limit : (q < -limit ? -limit : q)));
+    };
+    for (int32_t i = 0; i < n; ++i) {
+      dx[i] = u_ok[i] ? start(ux[i]) : 0;
+      dy[i] = u_ok[i] ? start(uy[i]) : 0;
+    }
+    tracker_.Track(ref_, view_, pos_q16_, pos_q16_ + max_points_, n, dx, dy,
+                   obs_ok_ + static_cast<size_t>(v) * n, runner_);
+  }
+  for (int32_t v = 0; v < c.views; ++v) MedianShift(v, reference, n);
   return Status::Ok();
+}
+
+double MotionStage::ReachPx(int32_t v, int32_t n) {
+  const int32_t* d = Displacements(v);
+  const uint8_t* ok = obs_ok_ + static_cast<size_t>(v) * n;
+  int32_t m = 0;
+  for (int32_t i = 0; i < n; ++i) {
+    if (!ok[i]) continue;
+    const double x = d[i] / 65536.0, y = d[max_points_ + i] / 65536.0;
+    sorted_[m++] = x * x + y * y;
+  }
+  if (m == 0) return 0;
+  std::nth_element(sorted_, sorted_ + m * 9 / 10, sorted_ + m);
+  return __builtin_sqrt(sorted_[m * 9 / 10]);
+}
+
+double MotionStage::FartherScale(int32_t u, int32_t v, int32_t n, int32_t* votes) {
+  // Point i agrees with the scales s whose s d_u lies within kTolerancePx of d_v: an interval
+  // of s around its projection, if it lies that near the line of d_u at all. The scale most
+  // points agree with, above 1 (v is the farther), in bins of 1/kBins.
+  constexpr double kTolerancePx = 1.0, kMinPx = 1.0;
+  constexpr int32_t kBins = 32, kMaxScale = MotionConfig::kMaxViews;
+  constexpr int32_t kLast = kBins * (kMaxScale - 1);
+  int32_t histogram[kLast + 1] = {};
+  const int32_t* du = Displacements(u);
+  const int32_t* dv = Displacements(v);
+  const uint8_t* u_ok = obs_ok_ + static_cast<size_t>(u) * n;
+  const uint8_t* v_ok = obs_ok_ + static_cast<size_t>(v) * n;
+  for (int32_t i = 0; i < n; ++i) {
+    if (!u_ok[i] || !v_ok[i]) continue;
+    const double ax = du[i] / 65536.0, ay = du[max_points_ + i] / 65536.0;
+    const double bx = dv[i] / 65536.0, by = dv[max_points_ + i] / 65536.0;
+    const double aa = ax * ax + ay * ay;
+    if (aa < kMinPx * kMinPx) continue;
+    const double along = (ax * bx + ay * by) / aa, across = ax * by - ay * bx;
+    if (across * across > kTolerancePx * kTolerancePx * aa) continue;
+    const double half = kTolerancePx / __builtin_sqrt(aa);
+    const double lo = (along - half - 1) * kBins, hi = (along + half - 1) * kBins;
+    if (hi < 0 || lo > kLast) continue;
+    const int32_t b0 = lo < 0 ? 0 : static_cast<int32_t>(__builtin_ceil(lo));
+    const int32_t b1 = hi > kLast ? kLast : static_cast<int32_t>(__builtin_floor(hi));
+    for (int32_t b = b0; b <= b1; ++b) ++histogram[b];
+  }
+  // The middle of the first run of bins at the most votes.
+  int32_t best = 0;
+  for (int32_t b = 1; b <= kLast; ++b) best = histogram[b] > histogram[best] ? b : best;
+  int32_t end = best;
+  while (end < kLast && histogram[end + 1] == histogram[best]) ++end;
+  // Most of the points the two frames share, and enough to stand on.
+  int32_t shared = 0;
+  for (int32_t i = 0; i < n; ++i) shared += u_ok[i] && v_ok[i];
+  const int32_t need = shared / 4 > config_.min_features ? shared / 4 : config_.min_features;
+  *votes = histogram[best] >= need ? histogram[best] : 0;
+  return 1 + 0.5 * (best + end) / kBins;
+}
+
+void MotionStage::MedianShift(int32_t v, int32_t reference, int32_t n) {
+  shift_[v][0] = shift_[v][1] = 0;
+  if (v == reference) return;
+  const int32_t* d = Displacements(v);
+  const uint8_t* ok = obs_ok_ + static_cast<size_t>(v) * n;
+  for (int32_t axis = 0; axis < 2; ++axis) {
+    int32_t m = 0;
+    for (int32_t i = 0; i < n; ++i) {
+      if (ok[i]) sorted_[m++] = d[axis * max_points_ + i] / 65536.0;
+    }
+    if (m == 0) {
+      shift_[v][axis] = 0;
+      continue;
+    }
+    std::nth_element(sorted_, sorted_ + m / 2, sorted_ + m);
+    shift_[v][axis] = sorted_[m / 2];
+  }
 }
 
 Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionResult* result) {
@@ -237,20 +340,27 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
   constexpr double kSeedGain = 1e-6;
   const double final_gain = in.min_gain;
   // Far frames start from the near ones: from the identity, a frame many steps out (18 px on
-  // barn1's ninth view) can send the first adjustment into a wrong minimum. The frames within
-  // kNearSteps of the reference are adjusted first; each farther frame then starts from the
-  // nearest adjusted one on its side, its translation scaled by the steps.
+  // barn1's ninth view) can send the first adjustment into a wrong minimum. Steps are hops along
+  // the tree of the frames' shifts (Track; view_tree.h), not places in the list, so the same
+  // frames in any order start alike. The frames within kNearSteps of the reference are adjusted
+  // first; each farther frame then starts from the one kNearSteps out on its branch, its
+  // translation scaled by the steps.
   constexpr int32_t kNearSteps = 2;
-  int32_t far = 0;
+  double points[2 * MotionConfig::kMaxViews] = {};
   for (int32_t v = 0; v < c.views; ++v) {
-    const int32_t d = StepsFrom(reference, v);
-    far = d > far ? d : far;
+    points[2 * v] = shift_[v][0];
+    points[2 * v + 1] = shift_[v][1];
+  }
+  int32_t parent[MotionConfig::kMaxViews], hops[MotionConfig::kMaxViews];
+  int32_t far = 0;
+  if (ViewTree(points, c.views, 2, reference, parent, hops)) {
+    for (int32_t v = 0; v < c.views; ++v) far = hops[v] > far ? hops[v] : far;
   }
   if (far > kNearSteps) {
     for (int32_t v = 0; v < c.views; ++v) {
-      const int32_t d = StepsFrom(reference, v);
       const size_t at = static_cast<size_t>(v) * n;
-      for (int32_t i = 0; i < n; ++i) near_ok_[at + i] = d <= kNearSteps ? obs_ok_[at + i] : 0;
+      for (int32_t i = 0; i < n; ++i)
+        near_ok_[at + i] = hops[v] <= kNearSteps ? obs_ok_[at + i] : 0;
     }
     in.obs_ok = near_ok_;
     in.min_gain = kSeedGain;
@@ -258,12 +368,12 @@ Status MotionStage::Adjust(const CameraIntrinsics& k, int32_t reference, MotionR
                                      inv_depth_, nullptr, nullptr, &report));
     in.obs_ok = obs_ok_;
     for (int32_t v = 0; v < c.views; ++v) {
-      const int32_t d = StepsFrom(reference, v);
-      if (d <= kNearSteps) continue;
-      const int32_t u = v > reference ? reference + kNearSteps : reference - kNearSteps;
+      if (hops[v] <= kNearSteps) continue;
+      int32_t u = v;
+      while (hops[u] > kNearSteps) u = parent[u];
       result->motion[v] = result->motion[u];
       for (int32_t k = 0; k < 3; ++k) {
-        result->motion[v].translation[k] *= static_cast<double>(d) / kNearSteps;
+        result->motion[v].translation[k] *= static_cast<double>(hops[v]) / kNearSteps;
       }
     }
   }

@@ -146,6 +146,14 @@ class MotionStage {
  private:
   Status Carve(Arena& arena);
   Status Track(const ConstImageU8* views, int32_t reference, MotionResult* result);
+  int32_t* Displacements(int32_t v) { return disp_q16_ + 2 * static_cast<size_t>(v) * max_points_; }
+  // The 90th percentile of view v's followed points' displacements, px.
+  double ReachPx(int32_t v, int32_t n);
+  // The scale s > 1 with which most of the points both views followed move in v by s times their
+  // motion in u; `votes` receives how many (0 when too few for a chain).
+  double FartherScale(int32_t u, int32_t v, int32_t n, int32_t* votes);
+  // shift_[v]: the median of view v's followed points' displacements, px (0 for the reference).
+  void MedianShift(int32_t v, int32_t reference, int32_t n);
   Status Adjust(const CameraIntrinsics& k, int32_t reference, MotionResult* result);
   Status Check(MotionResult* result);
 
@@ -169,6 +177,7 @@ class MotionStage {
   double* out_xy_ = nullptr;     // inliers: pixel positions
   double* out_w_ = nullptr;      // inliers: inverse depths (sorted copy for percentiles too)
   double* sorted_ = nullptr;
+  double shift_[MotionConfig::kMaxViews][2] = {};  // MedianShift, per view
 };
 
 }  // namespace lb

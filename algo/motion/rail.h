@@ -20,11 +20,11 @@ struct RailTolerance {
 };
 
 // True when the `views` poses (the reference's the identity) lie on a rail: 3..kMaxRailViews
-// frames, every non-reference translation forward along one line (later frames the way of the
-// line) and at equal steps. `axis` then receives the unit axis of the turn that shifts the image
-// along the rail (z x the rail's direction, the one small motion confuses with depth); a rail
-// along the optical axis confuses nothing and is not one. Double arithmetic without
-// transcendentals.
+// frames, every non-reference translation along one line, and the frames, counted in their
+// order along it from the reference (not in the list's order), at equal steps. `axis` then
+// receives the unit axis of the turn that shifts the image along the rail (z x the rail's
+// direction, the one small motion confuses with depth); a rail along the optical axis confuses
+// nothing and is not one. Double arithmetic without transcendentals.
 bool IsRail(const ViewMotion* motion, int32_t views, int32_t reference,
             const RailTolerance& tolerance, double axis[3]);
 

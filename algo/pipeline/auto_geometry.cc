@@ -1,18 +1,31 @@
 #include "algo/pipeline/auto_geometry.h"
 
 #include "algo/depth/depth_order.h"
+#include "algo/motion/view_tree.h"
 #include "algo/pipeline/planes.h"
 
 namespace lb {
 
+static_assert(MotionConfig::kMaxViews <= kMaxTreePoints);
+
 Status PlanLabelRange(const MotionResult& m, const LabelPlan& plan, LabelRange* out) {
+  // The unit: the mean baseline per step, the steps counted along the viewpoints' tree
+  // (view_tree.h), not along the list, so the same frames in any order get the same labels.
+  double positions[3 * MotionConfig::kMaxViews] = {};
+  int32_t parent[MotionConfig::kMaxViews], hops[MotionConfig::kMaxViews];
+  const int32_t views = m.views <= MotionConfig::kMaxViews ? m.views : 0;
+  for (int32_t v = 0; v < views; ++v) {
+    for (int32_t k = 0; k < 3; ++k) positions[3 * v + k] = m.motion[v].translation[k];
+  }
   double baseline = 0;
   int32_t steps = 0;
-  for (int32_t v = 0; v < m.views; ++v) {
-    if (v == m.reference) continue;
-    const double* t = m.motion[v].translation;
-    baseline += __builtin_sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
-    steps += v > m.reference ? v - m.reference : m.reference - v;
+  if (ViewTree(positions, views, 3, m.reference, parent, hops)) {
+    for (int32_t v = 0; v < views; ++v) {
+      if (v == m.reference) continue;
+      const double* t = m.motion[v].translation;
+      baseline += __builtin_sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2]);
+      steps += hops[v];
+    }
   }
   const double s = steps > 0 ? m.intrinsics.fx * baseline / steps : 0;
   const double span = m.inv_depth_max - m.inv_depth_min;

@@ -1,15 +1,17 @@
 // Auto geometry: from the motion stage's estimate of a handheld burst to the depth stage's label
 // range. Labels are planes of constant inverse depth rho, written as the disparity they cause
-// for the burst's mean baseline per frame step:
+// for the burst's mean baseline per view step:
 //   disparity (working px per view step) = rho * px_per_inv_depth,
-//   px_per_inv_depth = fx * sum_v |t_v| / sum_v |v - reference|,
-// so on a rectified, equally spaced rig it is the rig's disparity per view step, whatever scale
-// the motion estimate chose (only rho * t reaches pixels), and on a handheld burst it is the
-// parallax of an average frame. Signed: rho may be negative (beyond the motion's infinity,
-// motion_stage.h), and the range goes on through 0. The range covers the tracked points'
-// inverse-depth range (2nd to 98th percentile) widened by a fifth of its span on each side, so
-// surfaces the corners missed (a textureless wall, the ground at the frame's edge) still find a
-// label.
+//   px_per_inv_depth = fx * sum_v |t_v| / sum_v steps_v,
+// a frame's steps being its hops from the reference along the shortest tree joining the
+// frames' translations (view_tree.h), not its place in the list. So on a rectified, equally
+// spaced rig (a row, a cross) it is the rig's disparity per view step, whatever scale the
+// motion estimate chose (only rho * t reaches pixels) and whatever order the frames came in,
+// and on a handheld burst it is the parallax of a step between neighbouring viewpoints. Signed: rho
+// may be negative (beyond the motion's infinity, motion_stage.h), and the range goes on through 0.
+// The range covers the tracked points' inverse-depth range (2nd to 98th percentile) widened by a
+// fifth of its span on each side, so surfaces the corners missed (a textureless wall, the ground at
+// the frame's edge) still find a label.
 //
 // The labels are a window of a fixed lattice, not the range cut into equal parts: the spacing
 // is a whole number of sixteenths of a pixel per view step, and label 0 sits on a multiple of

@@ -6,7 +6,7 @@ namespace lb {
 
 double FittedBadPercent(const std::vector<float>& truth, const std::vector<float>& e, int32_t width,
                         int32_t height, double threshold, int32_t border, double* scale_out,
-                        double* offset_out) {
+                        double* offset_out, const std::vector<uint8_t>* mask) {
   double a = 1, c = 0;
   double band = -1;  // the first fit takes every pixel
   for (int round = 0; round < 3; ++round) {
@@ -14,7 +14,7 @@ double FittedBadPercent(const std::vector<float>& truth, const std::vector<float
     for (int32_t y = border; y < height - border; ++y) {
       for (int32_t x = border; x < width - border; ++x) {
         const size_t i = static_cast<size_t>(y) * width + x;
-        if (!std::isfinite(e[i])) continue;
+        if ((mask && !(*mask)[i]) || !std::isfinite(e[i])) continue;
         if (band > 0 && std::fabs(a * e[i] + c - truth[i]) > band) continue;
         n += 1;
         se += e[i];
@@ -33,6 +33,7 @@ double FittedBadPercent(const std::vector<float>& truth, const std::vector<float
   for (int32_t y = border; y < height - border; ++y) {
     for (int32_t x = border; x < width - border; ++x) {
       const size_t i = static_cast<size_t>(y) * width + x;
+      if (mask && !(*mask)[i]) continue;
       ++total;
       bad += !std::isfinite(e[i]) || std::fabs(a * e[i] + c - truth[i]) > threshold;
     }

@@ -10,8 +10,10 @@ namespace lb {
 
 // Percentage of pixels (outside `border`) whose fitted estimate is off the truth by more than
 // `threshold`; NaN estimates count as bad. `scale` and `offset` receive the fit when set.
+// `mask`, when set, holds a byte per pixel: only the pixels where it is non-zero are fitted and
+// scored (a truth with unknown pixels, an occlusion mask).
 double FittedBadPercent(const std::vector<float>& truth, const std::vector<float>& estimate,
                         int32_t width, int32_t height, double threshold, int32_t border,
-                        double* scale, double* offset);
+                        double* scale, double* offset, const std::vector<uint8_t>* mask = nullptr);
 
 }  // namespace lb

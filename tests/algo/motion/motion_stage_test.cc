@@ -305,7 +305,9 @@ double Blobs(double x, double y) {
   return 128 + 50 * std::sin(x * 0.31 + std::sin(y * 0.17) * 2) * std::cos(y * 0.23 - x * 0.07);
 }
 
-TEST(MotionStage, ARepetitiveTextureIsFollowedFramesOut) {
+// The brick wall and board below, frames 5 px of wall (10 of board) a step apart, the
+// reference the middle one; `order` lists the frames by their place on the line.
+void RepetitiveTexture(const std::vector<int32_t>& order) {
   constexpr int32_t kW = 320, kH = 240, kN = 5, kRef = 2;
   constexpr double kStep = 5.0;
   std::vector<std::vector<uint8_t>> px(kN, std::vector<uint8_t>(kW * kH * 3));
@@ -325,7 +327,11 @@ TEST(MotionStage, ARepetitiveTextureIsFollowedFramesOut) {
     }
   }
   std::vector<ConstImageU8> views;
-  for (const auto& p : px) views.push_back(MakeView(p.data(), kW, kH, 3));
+  int32_t reference = -1;
+  for (size_t i = 0; i < order.size(); ++i) {
+    views.push_back(MakeView(px[order[i]].data(), kW, kH, 3));
+    if (order[i] == kRef) reference = static_cast<int32_t>(i);
+  }
   MotionConfig c;
   c.width = kW;
   c.height = kH;
@@ -335,16 +341,29 @@ TEST(MotionStage, ARepetitiveTextureIsFollowedFramesOut) {
   MotionStage stage;
   ASSERT_TRUE(stage.Configure(c, arena).ok());
   MotionResult r;
-  const Status st = stage.Estimate(views.data(), kRef, DefaultIntrinsics(kW, kH), &r);
+  const Status st = stage.Estimate(views.data(), reference, DefaultIntrinsics(kW, kH), &r);
   ASSERT_TRUE(st.ok()) << st.message();
-  const double step = r.motion[kRef + 1].translation[0];
-  printf("repetitive: %d points, rms %.3f px, step %.4f\n", r.points, r.rms_px, step);
+  // Translation per step of the frame one step to the right.
+  const int32_t right =
+      static_cast<int32_t>(std::find(order.begin(), order.end(), kRef + 1) - order.begin());
+  const double step = r.motion[right].translation[0];
+  printf("repetitive, reference listed %d of %d: %d points, rms %.3f px, step %.4f\n", reference,
+         kN, r.points, r.rms_px, step);
   EXPECT_LT(r.rms_px, 0.15);
-  for (int32_t v = 0; v < kN; ++v) {
-    if (v == kRef) continue;
-    EXPECT_NEAR(r.motion[v].translation[0] / (v - kRef), step, 0.05 * std::fabs(step))
-        << "frame " << v;
+  for (int32_t i = 0; i < kN; ++i) {
+    if (order[i] == kRef) continue;
+    EXPECT_NEAR(r.motion[i].translation[0] / (order[i] - kRef), step, 0.05 * std::fabs(step))
+        << "frame " << order[i] << " listed " << i;
   }
+}
+
+TEST(MotionStage, ARepetitiveTextureIsFollowedFramesOut) { RepetitiveTexture({0, 1, 2, 3, 4}); }
+
+// The same frames with the reference listed first and last, the others shuffled: the frames
+// are still followed outward, from their measured motion, not from their places in the list.
+TEST(MotionStage, ARepetitiveTextureIsFollowedFramesOutInAnyOrder) {
+  RepetitiveTexture({2, 0, 1, 3, 4});
+  RepetitiveTexture({4, 0, 3, 1, 2});
 }
 
 TEST(MotionStage, RejectsViewsThatDoNotMatchTheConfiguration) {

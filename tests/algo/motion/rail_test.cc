@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 namespace lb {
 namespace {
@@ -61,6 +62,31 @@ TEST(Rail, AFrameThatWentBackIsNoRail) {
   double axis[3] = {};
   rig.motion[3].translation[0] = -0.02;
   EXPECT_FALSE(IsRail(rig.motion, rig.views, rig.reference, {}, axis));
+}
+
+TEST(Rail, TheListsOrderPlaysNoPart) {
+  // The rig's frames listed with the reference first, then last, and shuffled: still a rail,
+  // about the same axis up to its sign; a frame that went back is no rail in any order.
+  Rig rig(0.02, 0.001, 0);
+  double want[3] = {};
+  ASSERT_TRUE(IsRail(rig.motion, rig.views, rig.reference, {}, want));
+  for (const auto& order :
+       {std::vector<int32_t>{2, 0, 1, 3, 4}, std::vector<int32_t>{0, 1, 3, 4, 2},
+        std::vector<int32_t>{4, 1, 2, 0, 3}}) {
+    ViewMotion listed[kMaxRailViews];
+    int32_t reference = -1;
+    for (int32_t i = 0; i < 5; ++i) {
+      listed[i] = rig.motion[order[i]];
+      if (order[i] == rig.reference) reference = i;
+    }
+    double axis[3] = {};
+    ASSERT_TRUE(IsRail(listed, 5, reference, {}, axis));
+    EXPECT_NEAR(std::fabs(axis[0] * want[0] + axis[1] * want[1] + axis[2] * want[2]), 1, 1e-12);
+    // The first two other frames listed: the second moved onto the first's place.
+    const int32_t a = reference == 0 ? 1 : 0, b = reference <= 1 ? 2 : 1;
+    listed[b] = listed[a];
+    EXPECT_FALSE(IsRail(listed, 5, reference, {}, axis)) << "two frames at one place";
+  }
 }
 
 TEST(Rail, ALineAlongTheOpticalAxisTwoFramesOrNoToleranceAreNoRail) {

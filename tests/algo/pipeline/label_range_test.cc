@@ -109,6 +109,36 @@ TEST(LabelRange, StaysInsideTheDepthStagesLimits) {
   EXPECT_EQ(r.disp_min_q8 + 63 * Step(r, 64), r.disp_max_q8);
 }
 
+TEST(LabelRange, TheSameFramesInAnyOrderGetTheSameLabels) {
+  // A row of 5 and a cross of 5: the reference listed first, in the middle and last.
+  MotionResult row = Rig(5, 1, 400, 0.01, 0.03);
+  MotionResult cross = row;
+  const double at[5][2] = {{0, -1}, {-1, 0}, {0, 0}, {1, 0}, {0, 1}};
+  for (int32_t v = 0; v < 5; ++v) {
+    cross.motion[v].translation[0] = at[v][0];
+    cross.motion[v].translation[1] = at[v][1];
+  }
+  for (const MotionResult& m : {row, cross}) {
+    LabelRange want;
+    ASSERT_TRUE(PlanLabelRange(m, Plan(64), &want).ok());
+    EXPECT_NEAR(want.px_per_inv_depth, 400, 1e-9);  // f b: one step, in a row or a cross
+    for (const int32_t first : {0, 1}) {
+      MotionResult listed = m;
+      listed.reference = first ? 0 : 4;
+      int32_t i = first ? 1 : 0;
+      for (int32_t v = 0; v < 5; ++v) {
+        if (v != m.reference) listed.motion[i++] = m.motion[v];
+      }
+      listed.motion[listed.reference] = m.motion[m.reference];
+      LabelRange r;
+      ASSERT_TRUE(PlanLabelRange(listed, Plan(64), &r).ok());
+      EXPECT_NEAR(r.px_per_inv_depth, want.px_per_inv_depth, 1e-9);
+      EXPECT_EQ(r.disp_min_q8, want.disp_min_q8);
+      EXPECT_EQ(r.disp_max_q8, want.disp_max_q8);
+    }
+  }
+}
+
 TEST(LabelRange, ABadPlanIsAnInvalidArgument) {
   LabelRange r;
   LabelPlan p = Plan(16);
