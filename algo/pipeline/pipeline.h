@@ -124,7 +124,7 @@ class Pipeline : public FrameSink {
   // kGuessConfidence), per mille (1000 when it gave no depth, 0 without the map). Above
   // kRetakePermille most of the picture's depth is a guess (a white wall, the sky, a burst
   // without texture): worth a retake hint. A guess is far below DepthStage::kLowConfidence: a
-  // fully textured scene has a fifth to a quarter of its pixels under kGuessConfidence (where
+  // fully textured scene has a quarter or so of its pixels under kGuessConfidence (where
   // the smoothness chose a label the data did not: docs/accuracy.md) and about half under
   // kLowConfidence, a flat patch all of them.
   int32_t low_confidence_permille() const { return low_confidence_permille_; }
