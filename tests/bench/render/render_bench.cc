@@ -1,12 +1,17 @@
 // Render stage at 12 MP (4056x3040), one thread: Begin plus every strip, for a scene of layered
 // depths (a far wall, a slanted ground, objects at several depths), focus on the middle object.
+// And the map a 12 MP photo carries (depth_refine.h: the 579x434 depth grid onto 1352x1013), on
+// 1 and 2 workers.
 //   build/<release>/tests/bench/render/render_bench --benchmark_filter=Render
+//   build/<release>/tests/bench/render/render_bench --benchmark_filter=Map
 #include <benchmark/benchmark.h>
 
 #include <cstdint>
 #include <vector>
 
+#include "algo/render/depth_refine.h"
 #include "algo/render/render_stage.h"
+#include "firmware/platform/worker_pool.h"
 
 namespace lb {
 namespace {
@@ -92,6 +97,44 @@ BENCHMARK(BM_Render12MP)
     ->Args({8, 0})
     ->Unit(benchmark::kMillisecond)
     ->MinTime(0.5);
+
+void BM_Map12MP(benchmark::State& state) {
+  static const Scene scene(4056, 3040, 7);
+  RefineConfig config;
+  config.width = scene.w, config.height = scene.h;
+  config.work_scale = scene.scale, config.work_width = scene.ww, config.work_height = scene.wh;
+  config.map_scale = DepthRefiner::MapScale(scene.w, scene.h, scene.scale);
+  config.map_width = scene.w / config.map_scale, config.map_height = scene.h / config.map_scale;
+  config.workers = static_cast<int32_t>(state.range(0));
+  const size_t bytes = DepthRefiner::RequiredBytes(config);
+  std::vector<uint8_t> block(bytes + Arena::kAlign);
+  Arena arena(Arena::AlignUp(block.data()), bytes);
+  DepthRefiner refiner;
+  refiner.Carve(config, arena);
+  WorkerPool pool;
+  if (!pool.Start(config.workers).ok()) {
+    state.SkipWithError("no workers");
+    return;
+  }
+  refiner.SetRunner(&pool);
+  ConstPlanarU8 ref;
+  ref.count = 3;
+  ref.planes[0] = MakeView(scene.y.data(), scene.w, scene.h).AsConst();
+  ref.planes[1] = MakeView(scene.cb.data(), (scene.w + 1) / 2, (scene.h + 1) / 2).AsConst();
+  ref.planes[2] = MakeView(scene.cr.data(), (scene.w + 1) / 2, (scene.h + 1) / 2).AsConst();
+  std::vector<uint16_t> map(static_cast<size_t>(config.map_width) * config.map_height);
+  std::vector<uint8_t> confidence(static_cast<size_t>(scene.ww) * scene.wh, 200);
+  std::vector<uint8_t> map_confidence(map.size());
+  for (auto _ : state) {
+    refiner.Run(ref, MakeView(scene.disp.data(), scene.ww, scene.wh).AsConst(),
+                MakeView(confidence.data(), scene.ww, scene.wh).AsConst(),
+                MakeView(map.data(), config.map_width, config.map_height),
+                MakeView(map_confidence.data(), config.map_width, config.map_height));
+  }
+  benchmark::DoNotOptimize(map.data());
+  state.counters["scratch_KiB"] = static_cast<double>(bytes) / 1024;
+}
+BENCHMARK(BM_Map12MP)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(0.5);
 
 }  // namespace
 }  // namespace lb
