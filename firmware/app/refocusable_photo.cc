@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "algo/core/color.h"
 #include "firmware/app/focus.h"
@@ -49,8 +50,8 @@ Status Ycc420Sink::Rows(const FrameRows& rows) {
 
 }  // namespace
 
-// Where the reader puts the extended XMP, the depth image and GImage: the photo's buffers, at
-// most their Configure sizes when fixed.
+// Where the reader puts the extended XMP, the depth image, its confidence and GImage: the photo's
+// buffers, at most their Configure sizes when fixed (a confidence without room is left out).
 class RefocusablePhoto::Memory final : public RefocusableMemory {
  public:
   explicit Memory(RefocusablePhoto* photo) : photo_(photo) {}
@@ -58,10 +59,11 @@ class RefocusablePhoto::Memory final : public RefocusableMemory {
     return photo_->Fit(&photo_->chunks_, count) ? photo_->chunks_.data() : nullptr;
   }
   uint8_t* Bytes(Part part, size_t count) override {
-    std::vector<uint8_t>* v = part == Part::kExtendedXmp ? &photo_->extended_
-                              : part == Part::kDepthPng  ? &photo_->depth_image_
-                              : part == Part::kImage     ? &photo_->original_
-                                                         : nullptr;  // the confidence: not read
+    std::vector<uint8_t>* v = part == Part::kExtendedXmp  ? &photo_->extended_
+                              : part == Part::kDepthPng   ? &photo_->depth_image_
+                              : part == Part::kImage      ? &photo_->original_
+                              : part == Part::kConfidence ? &photo_->confidence_image_
+                                                          : nullptr;
     return v != nullptr && photo_->Fit(v, count) ? v->data() : nullptr;
   }
 
@@ -99,6 +101,8 @@ Status RefocusablePhoto::Configure(const RefocusableLimits& limits) {
   const size_t depth_px =
       std::min(pixels, static_cast<size_t>(std::max(1, limits.max_depth_pixels)));
   depth_image_.resize(std::min(file / 4 * 3, depth_px * 2 + depth_px / 64 + 65536));
+  // The confidence, an 8-bit PNG the depth's size: its bytes, a filter byte a row and a little.
+  confidence_image_.resize(std::min(file / 4 * 3, depth_px + depth_px / 16 + 65536));
   original_.reserve(file / 4 * 3);
   rgb_rows_.resize(static_cast<size_t>(max_side_) * 6);
   // The readers' strip: the original's RGB rows, then the depth image's.
@@ -110,16 +114,17 @@ Status RefocusablePhoto::Configure(const RefocusableLimits& limits) {
   depth_values_.resize(depth_px);
   depth_disp_.resize(depth_px);
   disp_q8_.resize(depth_px);
+  confidence_.resize(depth_px);
   fixed_ = true;
   reserved_bytes_ = chunks_.size() * sizeof(ExtendedXmpChunk) + extended_.size() +
-                    depth_image_.size() + original_.capacity() + rgb_rows_.size() + strip_.size() +
-                    pixels + 2 * cpx + 6 * depth_px;
+                    depth_image_.size() + confidence_image_.size() + original_.capacity() +
+                    rgb_rows_.size() + strip_.size() + pixels + 2 * cpx + 7 * depth_px;
   return Status::Ok();
 }
 
 Status RefocusablePhoto::Decode(const uint8_t* bytes, size_t size, const char* name) {
   width_ = 0;  // nothing decoded until the end
-  from_primary_ = has_file_focus_ = false;
+  from_primary_ = has_file_focus_ = has_confidence_ = false;
   Memory memory(this);
   RefocusableFields f;
   LB_RETURN_IF_ERROR(ReadRefocusableFields(bytes, size, name, memory, &f));
@@ -174,6 +179,7 @@ Status RefocusablePhoto::Decode(const uint8_t* bytes, size_t size, const char* n
   depth_w_ = gw;
   depth_h_ = gh;
   if (resample) ResampleDisparity(decoded.AsConst(), MakeView(disp_q8_.data(), gw, gh));
+  DecodeConfidence(f, name, dw, dh);
   width_ = width;
   orientation_ = f.orientation;
   has_file_focus_ = f.has_focus;
@@ -209,6 +215,43 @@ Status RefocusablePhoto::DecodeDepth(const RefocusableFields& f, const char* nam
   depth_h_ = depth.height;
   depth_bits_ = depth.bits;
   return Status::Ok();
+}
+
+// The file's confidence (dw x dh, the depth image's size, as the reader checked) onto the working
+// grid, decoded in the depth values' buffer, which the disparity no longer needs. Optional as
+// the reader has it: pixels that do not decode leave the photo without one, and it still
+// renders.
+void RefocusablePhoto::DecodeConfidence(const RefocusableFields& f, const char* name, int32_t dw,
+                                        int32_t dh) {
+  const int32_t gw = depth_w_, gh = depth_h_;
+  if (f.confidence == nullptr || !Fit(&confidence_, static_cast<size_t>(gw) * gh)) return;
+  char what[320];
+  snprintf(what, sizeof(what), "%s: %s", name,
+           f.dynamic_depth ? "Dynamic Depth confidence item" : "GDepth:Confidence");
+  DepthImageBuffer image;
+  image.values = depth_values_.data();
+  image.capacity = depth_values_.size();
+  image.strip = strip_.data();
+  image.strip_bytes = strip_.size();
+  if (!DecodeDepthImageInto(f.confidence, f.confidence_size, f.confidence_mime, what,
+                            f.depth_max_side, dw, dh, &image)
+           .ok()) {
+    return;
+  }
+  // A 16-bit map (another writer's) keeps its high byte. A depth map of another size than the
+  // grid was resampled bilinearly; its confidence takes the nearest pixel's, centres aligned: a
+  // mix of a sure pixel and an unsure one would be a measure of neither.
+  const int shift = image.bits - 8;
+  for (int32_t y = 0; y < gh; ++y) {
+    const int64_t sy = (int64_t{2} * y + 1) * dh / (int64_t{2} * gh);
+    const uint16_t* in = depth_values_.data() + static_cast<size_t>(sy) * dw;
+    uint8_t* out = confidence_.data() + static_cast<size_t>(y) * gw;
+    for (int32_t x = 0; x < gw; ++x) {
+      const int64_t sx = (int64_t{2} * x + 1) * dw / (int64_t{2} * gw);
+      out[x] = static_cast<uint8_t>(in[sx] >> shift);
+    }
+  }
+  has_confidence_ = true;
 }
 
 Status RefocusablePhoto::DecodeOriginal(const uint8_t* jpeg, size_t size, const char* name,
@@ -317,6 +360,11 @@ ConstPlanarU8 RefocusablePhoto::reference() const {
 
 ConstImageU16 RefocusablePhoto::disparity_q8() const {
   return {disp_q8_.data(), depth_w_, depth_h_, 1, depth_w_};
+}
+
+ConstImageU8 RefocusablePhoto::confidence() const {
+  if (!has_confidence_) return ConstImageU8();
+  return {confidence_.data(), depth_w_, depth_h_, 1, depth_w_};
 }
 
 RenderConfig RefocusablePhoto::RenderConfigFor(int32_t max_blur_radius, int32_t workers) const {

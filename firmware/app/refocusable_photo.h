@@ -2,7 +2,8 @@
 // one road from such a file to the render stage, for `refocus rerender` (Rerenderer) and the
 // camera's page (RefocusEngine): the same reader (GDepth, GImage, GFocus, Dynamic Depth), the
 // same depth image in any colour type, the same depth units (the product's 1 / px or a phone's
-// own), the same working grid (a map of another size resampled onto it) and the same focus.
+// own), the same working grid (a map of another size resampled onto it, its confidence with it)
+// and the same focus.
 //
 // Memory: Configure sizes every buffer once for the largest photo (the engine: nothing is
 // allocated after it, the codec libraries' own scratch aside, and a larger file is
@@ -67,6 +68,10 @@ class RefocusablePhoto {
 
   ConstPlanarU8 reference() const;  // the original, YCbCr 4:2:0
   ConstImageU16 disparity_q8() const;
+  // How sure each pixel of disparity_q8() is (0..255, 255: sure; its size): the file's confidence
+  // map (GDepth:Confidence or Dynamic Depth's item), so that a re-render carries it on. Empty
+  // when the file has none, the reader ignored it, or its pixels do not decode.
+  ConstImageU8 confidence() const;
   const DisparityRange& range() const { return range_; }
   // The all-in-focus original's JPEG bytes; empty when from_primary().
   const std::vector<uint8_t>& original_jpeg() const { return original_; }
@@ -84,6 +89,7 @@ class RefocusablePhoto {
   bool Fit(std::vector<T>* v, size_t count);
   Status DecodeOriginal(const uint8_t* jpeg, size_t size, const char* name, const char* what);
   Status DecodeDepth(const RefocusableFields& f, const char* name);
+  void DecodeConfidence(const RefocusableFields& f, const char* name, int32_t dw, int32_t dh);
   FocusRegion FocusNear(double point_x, double point_y, double target_q8) const;
 
   bool fixed_ = false;  // Configure sized the buffers: they never grow
@@ -92,20 +98,22 @@ class RefocusablePhoto {
   int32_t width_ = 0, height_ = 0, scale_ = 1, depth_w_ = 0, depth_h_ = 0;
   int32_t orientation_ = 0;
   int depth_bits_ = 16;  // the stored depth image's values
-  bool from_primary_ = false, has_file_focus_ = false;
+  bool from_primary_ = false, has_file_focus_ = false, has_confidence_ = false;
   FocusRegion file_focus_;
   float file_f_number_ = 2.8f;
   DisparityRange range_;
 
-  std::vector<ExtendedXmpChunk> chunks_;  // the reader's extended-XMP chunk descriptors
-  std::vector<uint8_t> extended_;         // the reassembled extended XMP
-  std::vector<uint8_t> depth_image_;      // GDepth:Data, base64-decoded (PNG or JPEG)
-  std::vector<uint8_t> original_;         // GImage:Data, the all-in-focus JPEG
-  std::vector<uint8_t> strip_;            // the image readers' rows
-  std::vector<uint8_t> rgb_rows_;         // two RGB rows of the original, for its chroma
+  std::vector<ExtendedXmpChunk> chunks_;   // the reader's extended-XMP chunk descriptors
+  std::vector<uint8_t> extended_;          // the reassembled extended XMP
+  std::vector<uint8_t> depth_image_;       // GDepth:Data, base64-decoded (PNG or JPEG)
+  std::vector<uint8_t> confidence_image_;  // GDepth:Confidence, base64-decoded
+  std::vector<uint8_t> original_;          // GImage:Data, the all-in-focus JPEG
+  std::vector<uint8_t> strip_;             // the image readers' rows
+  std::vector<uint8_t> rgb_rows_;          // two RGB rows of the original, for its chroma
   std::vector<uint8_t> y_, cb_, cr_;
   std::vector<uint16_t> depth_values_, depth_disp_;  // the image as stored, as disparity
   std::vector<uint16_t> disp_q8_;                    // on the working grid
+  std::vector<uint8_t> confidence_;                  // on the working grid
 };
 
 }  // namespace lb

@@ -33,6 +33,7 @@ void Rerenderer::StartFromFile(RenderParams* params, bool keep_focus, bool keep_
 RerenderSource SourceOf(const RefocusablePhoto& photo) {
   RerenderSource source;
   source.disp_q8 = photo.disparity_q8();
+  source.confidence = photo.confidence();
   source.range = photo.range();
   source.original_jpeg = &photo.original_jpeg();
   source.orientation = photo.orientation();
@@ -75,7 +76,8 @@ Status WriteRerendered(RenderStage* render, const RenderParams& params,
   DynamicDepthTrailer dd;
   LB_RETURN_IF_ERROR(BuildRefocusableSegments(source.disp_q8, source.range, *source.original_jpeg,
                                               FocusOf(*render, params, source.width, source.height),
-                                              source.width, &meta.extra_segments, &dd));
+                                              source.width, &meta.extra_segments, &dd,
+                                              source.confidence));
   JpegWriter writer;
   LB_RETURN_IF_ERROR(writer.Begin(&file, source.width, source.height, quality, meta));
   LB_RETURN_IF_ERROR(WriteStrips(render, observer, &writer, progress));

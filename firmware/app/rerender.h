@@ -27,10 +27,11 @@ struct RerenderOptions {
   Progress* progress = nullptr;  // told how far the render is (borrowed)
 };
 
-// What a re-render writes besides the pixels: the depth the file carried, its all-in-focus
-// original and its orientation, so the new photo is refocusable again.
+// What a re-render writes besides the pixels: the depth the file carried, its confidence, its
+// all-in-focus original and its orientation, so the new photo is refocusable again.
 struct RerenderSource {
   ConstImageU16 disp_q8;
+  ConstImageU8 confidence;  // disp_q8's size; empty when the file had none (the new one has none)
   DisparityRange range;
   const std::vector<uint8_t>* original_jpeg = nullptr;
   int32_t orientation = 0;
