@@ -86,6 +86,7 @@ int DepthCommand(int argc, char** argv) {
   PipelineConfig& c = settings.pipeline;
   c.subpixel = false;
   c.render = false;
+  c.confidence = false;  // the PFM and the preview carry no confidence
   bool range_given = false;
   std::string error;
   std::vector<option> table = WithSettings(
