@@ -76,6 +76,8 @@ class Pipeline : public FrameSink {
 
   // The integer factor between the full and the working resolution for this configuration.
   static int32_t WorkingScale(const PipelineConfig& config) { return Plan(config).scale; }
+  // The same for the map a photo carries (map_scale()).
+  static int32_t MapScale(const PipelineConfig& config) { return Plan(config).map_scale; }
 
   // Carves `arena` (at least RequiredBytes, 64-byte aligned). Resets any previous burst.
   Status Configure(const PipelineConfig& config, void* arena, size_t bytes);

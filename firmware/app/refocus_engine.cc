@@ -10,6 +10,7 @@
 #include <cstring>
 #include <ctime>
 
+#include "algo/pipeline/pipeline.h"
 #include "firmware/app/focus.h"
 #include "firmware/app/job.h"
 #include "firmware/app/rerender.h"
@@ -87,7 +88,13 @@ Status RefocusEngine::Configure(const RefocusEngineConfig& config) {
   limits.max_width = W;
   limits.max_height = H;
   limits.max_file_bytes = default_size ? xmp_bytes : file;
-  limits.max_depth_pixels = config.max_depth_pixels;
+  // The camera's photos carry a map of at least half their side or 1 MP: more than 1 MP at some
+  // sizes (12 MP among them).
+  PipelineConfig camera;
+  camera.width = W;
+  camera.height = H;
+  const int32_t map_scale = Pipeline::MapScale(camera);
+  limits.max_depth_pixels = std::max(config.max_depth_pixels, (W / map_scale) * (H / map_scale));
   LB_RETURN_IF_ERROR(file_.Configure(limits));
   py_.resize(ppx);
   pcb_.resize(pcpx);

@@ -46,7 +46,8 @@ struct RefocusEngineConfig {
   // camera's photo holds the original three times (the photo itself, GImage, Dynamic Depth's
   // Original item) and the depth twice.
   size_t max_file_bytes = 0;
-  // The largest depth map (the pipeline's working size is at most 640x480 by default).
+  // The largest depth map of another writer's photo (a phone's); the map the camera's own photos
+  // carry at max_width x max_height (Pipeline::MapScale) is always taken.
   int32_t max_depth_pixels = 1 << 20;
 };
 

@@ -9,14 +9,17 @@
 
 #include <cstdlib>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "algo/render/depth_refine.h"
 #include "firmware/app/focus.h"
 #include "firmware/app/job.h"
 #include "firmware/app/refocus_engine.h"
 #include "firmware/app/refocusable.h"
 #include "firmware/app/refocusable_photo.h"
 #include "firmware/app/rerender.h"
+#include "firmware/codecs/jpeg_writer.h"
 #include "firmware/refocusable/refocusable_reader.h"
 #include "sim/synthetic/synthetic_sensor.h"
 #include "tests/firmware/codecs/jpeg_test_util.h"
@@ -166,10 +169,14 @@ TEST_F(RerenderConfidence, ThePagesSaveKeepsIt) {
   ExpectCarries(out, original);
 }
 
-// A refocusable file written here, GDepth only: a 480x320 original, a depth map of `dw` x `dh`,
-// and `confidence` (that size, or empty for none).
-std::vector<uint8_t> BuiltFile(int32_t dw, int32_t dh, const std::vector<uint8_t>& confidence) {
-  const test::RefocusSample sample = test::MakeRefocusSample(true);
+// A refocusable file written here, GDepth only: a `width` x `height` original, a depth map of
+// `dw` x `dh` (two depths, left and right), and `confidence` (that size, or empty for none).
+std::vector<uint8_t> BuiltFile(int32_t width, int32_t height, int32_t dw, int32_t dh,
+                               const std::vector<uint8_t>& confidence) {
+  test::RefocusSample sample = test::MakeRefocusSample(false);
+  sample.picture = test::MakeTexture(width, height);
+  std::vector<uint8_t> original;
+  EXPECT_TRUE(EncodeYCbCr420(sample.picture.View(), 90, &original).ok());
   std::vector<uint16_t> disp(static_cast<size_t>(dw) * dh);
   for (int32_t y = 0; y < dh; ++y) {
     for (int32_t x = 0; x < dw; ++x) {
@@ -179,9 +186,9 @@ std::vector<uint8_t> BuiltFile(int32_t dw, int32_t dh, const std::vector<uint8_t
   const ConstImageU8 conf =
       confidence.empty() ? ConstImageU8() : MakeView<const uint8_t>(confidence.data(), dw, dh);
   std::vector<JpegSegment> segments;
-  const Status s = BuildRefocusableSegments(MakeView<const uint16_t>(disp.data(), dw, dh),
-                                            sample.range, sample.xmp.image, FocusUsed(),
-                                            sample.picture.width, &segments, nullptr, conf);
+  const Status s =
+      BuildRefocusableSegments(MakeView<const uint16_t>(disp.data(), dw, dh), sample.range,
+                               original, FocusUsed(), width, &segments, nullptr, conf);
   EXPECT_TRUE(s.ok()) << s.message();
   return test::WriteRefocusJpeg(sample, segments);
 }
@@ -194,7 +201,7 @@ TEST(RerenderConfidenceResampled, TheNearestPixelsConfidence) {
   for (size_t i = 0; i < confidence.size(); ++i) confidence[i] = static_cast<uint8_t>(i * 37 % 251);
   test::ScratchDir dir;
   const std::string in = dir.Path("built.jpg"), out = dir.Path("again.jpg");
-  ASSERT_TRUE(test::WriteFile(in, BuiltFile(dw, dh, confidence)));
+  ASSERT_TRUE(test::WriteFile(in, BuiltFile(480, 320, dw, dh, confidence)));
   Rerenderer rerenderer;
   Status s = rerenderer.Load(in.c_str());
   ASSERT_TRUE(s.ok()) << s.message();
@@ -216,10 +223,42 @@ TEST(RerenderConfidenceResampled, TheNearestPixelsConfidence) {
   ExpectCarries(out, want);
 }
 
+// The page, configured for a camera's photos, opens the map the job gives them (at least half
+// the photo's side or 1 MP: over 1 MP for some sizes) and saves its confidence.
+class RerenderConfidenceOnThePage : public ::testing::TestWithParam<std::pair<int32_t, int32_t>> {};
+
+TEST_P(RerenderConfidenceOnThePage, ACameraSizedMap) {
+  const int32_t width = GetParam().first, height = GetParam().second;
+  const int32_t s = DepthRefiner::MapScale(width, height, 4);
+  const int32_t dw = width / s, dh = height / s;
+  RecordProperty("map", std::to_string(dw) + "x" + std::to_string(dh));
+  std::vector<uint8_t> confidence(static_cast<size_t>(dw) * dh);
+  for (size_t i = 0; i < confidence.size(); ++i) confidence[i] = static_cast<uint8_t>(i * 37 % 251);
+  test::ScratchDir dir;
+  const std::string in = dir.Path("built.jpg"), out = dir.Path("saved.jpg");
+  ASSERT_TRUE(test::WriteFile(in, BuiltFile(width, height, dw, dh, confidence)));
+  RefocusEngine engine;
+  RefocusEngineConfig c;
+  c.max_width = width;
+  c.max_height = height;
+  c.threads = 2;
+  ASSERT_TRUE(engine.Configure(c).ok());
+  RecordProperty("reserved_bytes", std::to_string(engine.reserved_bytes()));
+  Status st = engine.Load(in.c_str());
+  ASSERT_TRUE(st.ok()) << st.message();
+  st = engine.Save(engine.photo().current, out.c_str());
+  ASSERT_TRUE(st.ok()) << st.message();
+  ExpectCarries(out, {dw, dh, 8, std::vector<uint16_t>(confidence.begin(), confidence.end())});
+}
+
+// 1200x900 and 1352x1013 maps.
+INSTANTIATE_TEST_SUITE_P(Sizes, RerenderConfidenceOnThePage,
+                         ::testing::Values(std::make_pair(2400, 1800), std::make_pair(4056, 3040)));
+
 TEST(RerenderWithoutConfidence, AFileWrittenWithoutOneGivesOneWithout) {
   test::ScratchDir dir;
   const std::string in = dir.Path("built.jpg"), out = dir.Path("again.jpg");
-  ASSERT_TRUE(test::WriteFile(in, BuiltFile(240, 160, {})));
+  ASSERT_TRUE(test::WriteFile(in, BuiltFile(480, 320, 240, 160, {})));
   ExpectNone(in);
   Rerenderer rerenderer;
   Status s = rerenderer.Load(in.c_str());
