@@ -71,6 +71,23 @@ Status DepthStage::Validate(const DepthConfig& c) {
   return Status::Ok();
 }
 
+DepthStage::Smoothness DepthStage::SmoothnessFor(const DepthConfig& c) {
+  // Labels (span / steps) apart against kSmoothSpacingQ8: the weight scales with the spacing and
+  // the truncation against it, so min(|a - b| * spacing, trunc * kSmoothSpacingQ8) keeps its
+  // price in px. Validate keeps both products far inside 64 bits.
+  const int64_t span = int64_t{c.disp_max_q8} - c.disp_min_q8;
+  const int64_t per = int64_t{DepthConfig::kSmoothSpacingQ8} * (c.labels > 1 ? c.labels - 1 : 1);
+  if (span <= 0) return Smoothness{c.smooth_weight, c.smooth_trunc};
+  Smoothness s;
+  const int64_t trunc = (int64_t{c.smooth_trunc} * per + span / 2) / span;
+  s.trunc = static_cast<int32_t>(trunc < 1 ? 1 : (trunc > 64 ? 64 : trunc));
+  int64_t weight = (int64_t{c.smooth_weight} * span + per / 2) / per;
+  if (weight < 1 && c.smooth_weight > 0) weight = 1;
+  const int32_t cap = MaxSmoothWeight(s.trunc);
+  s.weight = static_cast<int32_t>(weight > cap ? cap : weight);
+  return s;
+}
+
 size_t DepthStage::RequiredBytes(const DepthConfig& config) {
   DepthStage planner;
   planner.config_ = config;
@@ -183,9 +200,8 @@ LB_CLONES_AVX2 static void WeightRow(const uint8_t* __restrict row, const uint8_
 
 void DepthStage::EdgeWeights(const ConstImageU8& ref) {
   const int32_t w = config_.width, h = config_.height;
-  const uint16_t flat = static_cast<uint16_t>(config_.smooth_weight);
-  const uint16_t edge =
-      static_cast<uint16_t>((config_.smooth_weight * config_.edge_weight_q8 + 128) >> 8);
+  const uint16_t flat = static_cast<uint16_t>(smooth_.weight);
+  const uint16_t edge = static_cast<uint16_t>((smooth_.weight * config_.edge_weight_q8 + 128) >> 8);
   for (int32_t y = 0; y < h; ++y) {
     WeightRow(ref.Row(y), ref.Row(y + 1 < h ? y + 1 : y), w, y + 1 >= h, config_.edge_threshold,
               flat, edge, fine_.weight_right + y * w, fine_.weight_down + y * w);
@@ -225,7 +241,7 @@ int64_t DepthStageProbe::Energy(DepthStage& s, const uint8_t* labels) {
   MoveGrid g = s.fine_;
   g.labels = const_cast<uint8_t*>(labels);
   g.cost = scratch;
-  const int64_t e = data + GridEnergy(g, s.config_.smooth_trunc);
+  const int64_t e = data + GridEnergy(g, s.smooth_.trunc);
   for (int32_t p = 0; p < w * h; ++p) scratch[p] = MoveGrid::kNotComputed;  // as the moves expect
   s.fine_.written_count = 0;
   return e;
@@ -258,7 +274,7 @@ bool DepthStage::Expand(int32_t alpha) {
 void DepthStage::CoarseMoves() {
   const LabelTerm term = Term();
   coarse_.Start(fine_, term, move_.solver());
-  energy_ = GridEnergy(coarse_.grid(), config_.smooth_trunc);
+  energy_ = GridEnergy(coarse_.grid(), smooth_.trunc);
   stats_.initial_energy = energy_;
   on_coarse_ = true;
   window_ = DepthConfig::kMaxLabels;
@@ -268,7 +284,7 @@ void DepthStage::CoarseMoves() {
   stats_.coarse_energy = energy_;
   on_coarse_ = false;
   coarse_.Finish(fine_, term, book_.runs(), book_.run_marks());
-  energy_ = GridEnergy(fine_, config_.smooth_trunc);
+  energy_ = GridEnergy(fine_, smooth_.trunc);
   stats_.handover_energy = energy_;
 }
 
@@ -328,9 +344,10 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
   const int32_t total = 1 + c.max_cycles * c.labels;
   if (progress_ != nullptr) progress_->Report(0, total);
   data_.Prepare(views);
+  smooth_ = SmoothnessFor(c);
   EdgeWeights(views[c.reference]);
-  move_.Start();
-  book_.Start();
+  move_.Start(smooth_.trunc);
+  book_.Start(smooth_.trunc);
   stats_.cycles = 0;
   stats_.moves = 0;
   stats_.cut_pixels = 0;
@@ -343,7 +360,7 @@ Status DepthStage::Compute(const ConstImageU8* views, ImageU16 disp_q8) {
   } else {
     WinnerTakeAll();
     for (int32_t y = 0; y < h; ++y) RowLabels(fine_, c.labels, y);
-    energy_ = GridEnergy(fine_, c.smooth_trunc);
+    energy_ = GridEnergy(fine_, smooth_.trunc);
     stats_.initial_energy = energy_;
   }
   book_.StartFine(fine_);

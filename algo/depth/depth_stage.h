@@ -62,6 +62,14 @@ class DepthStage {
     const int32_t arcs = GridMaxflow::kMaxArc / (4 * (smooth_trunc > 0 ? smooth_trunc : 1));
     return arcs < 4096 ? arcs : 4096;
   }
+  // The weight and truncation a Compute uses: the configuration's, stated for labels
+  // kSmoothSpacingQ8 apart, carried to its own label spacing (the truncation within 1..64, the
+  // weight within MaxSmoothWeight of it, and above 0 unless the configuration's is 0).
+  struct Smoothness {
+    int32_t weight = 0;
+    int32_t trunc = 1;
+  };
+  static Smoothness SmoothnessFor(const DepthConfig& config);
 
   Status Configure(const DepthConfig& config, Arena& arena);
   // Where the data term runs its tasks (borrowed; nullptr: on the caller), with at most
@@ -116,6 +124,7 @@ class DepthStage {
   void Refine(ImageU16 disp_q8);
 
   DepthConfig config_;
+  Smoothness smooth_;  // the Compute's, from SmoothnessFor
   ProgressSink* progress_ = nullptr;
   DepthStats stats_;
   DataTerm data_;

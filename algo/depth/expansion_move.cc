@@ -22,14 +22,14 @@ void ExpansionMove::Carve(Arena& arena, const DepthConfig& config, size_t spare_
   const int32_t w = config.width, h = config.height;
   width_ = w;
   labels_ = config.labels;
-  trunc_ = config.smooth_trunc;
   maxflow_.Carve(arena, w, h, spare_bytes, (w + 1) / 2, (h + 1) / 2);
   move_rows_ = arena.Allocate<int32_t>(11 * static_cast<size_t>(w));
   keep_row_ = arena.Allocate<uint8_t>(static_cast<size_t>(w));
   free_span_ = arena.Allocate<int32_t>(2 * static_cast<size_t>(h));
 }
 
-void ExpansionMove::Start() {
+void ExpansionMove::Start(int32_t smooth_trunc) {
+  trunc_ = smooth_trunc;
   for (int32_t x = 0; x < width_; ++x) keep_row_[x] = kKeep;
   for (int32_t x = 0; x < width_; ++x) move_rows_[9 * width_ + x] = 0;  // ZeroRow
 }

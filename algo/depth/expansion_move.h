@@ -19,8 +19,8 @@ class ExpansionMove {
   // Carves the solver for the fine grid (with spare_bytes of room left Spare on the coarse
   // grid's graphs) and the rows of the graph's build.
   void Carve(Arena& arena, const DepthConfig& config, size_t spare_bytes);
-  // Before the moves of a Compute.
-  void Start();
+  // Before the moves of a Compute, with its truncation (DepthStage::SmoothnessFor).
+  void Start(int32_t smooth_trunc);
   // Cuts rectangle r of g's move to alpha, over the nodes with a label within `window` of
   // alpha in their 3x3 neighbourhood (all of them for a window of labels - 1 or more): every
   // node of r is then kKeep or kTake, and g.row_took marks the rows where one takes alpha. The
@@ -55,7 +55,7 @@ class ExpansionMove {
   GridMaxflow maxflow_;
   int32_t width_ = 0;                         // the fine grid's: the stride of the rows below
   int32_t labels_ = 0;                        // DepthConfig::labels
-  int32_t trunc_ = 1;                         // DepthConfig::smooth_trunc
+  int32_t trunc_ = 1;                         // the Compute's truncation, in labels
   int32_t window_ = DepthConfig::kMaxLabels;  // of the cut in progress
   // Three rings of pass 1's terms per row (kPairRight, kPairDown, kHigh; row y % 3), ZeroRow,
   // and pass 1's near marks.

@@ -20,9 +20,6 @@ void MoveBook::Carve(Arena& arena, const DepthConfig& config) {
   height_ = h;
   labels_ = config.labels;
   subpixel_ = config.subpixel;
-  for (int32_t d = 0; d < DepthConfig::kMaxLabels; ++d) {
-    smooth_[d] = d < config.smooth_trunc ? d : config.smooth_trunc;
-  }
   want_span_ = arena.Allocate<int32_t>(2 * static_cast<size_t>(h));
   split_ = arena.Allocate<uint8_t>(static_cast<size_t>(w > h ? w : h) + 2);
   runs_ = arena.Allocate<RowRuns>(static_cast<size_t>(h));
@@ -35,7 +32,10 @@ void MoveBook::SetFitMemory(uint16_t* fit) {
   above_ = fit == nullptr ? nullptr : fit + static_cast<size_t>(width_) * height_;
 }
 
-void MoveBook::Start() {
+void MoveBook::Start(int32_t smooth_trunc) {
+  for (int32_t d = 0; d < DepthConfig::kMaxLabels; ++d) {
+    smooth_[d] = d < smooth_trunc ? d : smooth_trunc;
+  }
   prev_label_ = -1;
   for (int32_t y = 0; y < height_; ++y) {
     want_span_[2 * y] = width_;

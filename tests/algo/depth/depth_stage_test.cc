@@ -314,6 +314,45 @@ TEST(DepthStageTest, DepthMapBitsArePinned) {
          "map within its tolerance; re-pin on x86-64, check under qemu";
 }
 
+// The smoothness prices a step of disparity, not of a label: labels half as far apart cost half
+// as much a step and truncate twice as many steps later, within the solver's limits.
+TEST(DepthStageTest, SmoothnessFollowsTheLabelSpacing) {
+  DepthConfig c;
+  c.labels = 65;
+  c.smooth_weight = 96;
+  c.smooth_trunc = 8;
+  auto at = [&c](int32_t spacing_q8) {
+    c.disp_min_q8 = -32 * spacing_q8;
+    c.disp_max_q8 = c.disp_min_q8 + 64 * spacing_q8;
+    return DepthStage::SmoothnessFor(c);
+  };
+  const DepthStage::Smoothness stated = at(DepthConfig::kSmoothSpacingQ8);
+  EXPECT_EQ(stated.weight, 96);
+  EXPECT_EQ(stated.trunc, 8);
+  const DepthStage::Smoothness fine = at(DepthConfig::kSmoothSpacingQ8 / 2);
+  EXPECT_EQ(fine.weight, 48);
+  EXPECT_EQ(fine.trunc, 16);
+  const DepthStage::Smoothness coarse = at(DepthConfig::kSmoothSpacingQ8 * 4);
+  EXPECT_EQ(coarse.weight, 384);
+  EXPECT_EQ(coarse.trunc, 2);
+  // A step over the truncation costs the same whatever the spacing.
+  EXPECT_EQ(fine.weight * fine.trunc, stated.weight * stated.trunc);
+  EXPECT_EQ(coarse.weight * coarse.trunc, stated.weight * stated.trunc);
+  // Very fine labels: the truncation stops at 64, a weight never rounds to nothing.
+  c.smooth_weight = 2;
+  const DepthStage::Smoothness finest = at(1);
+  EXPECT_EQ(finest.trunc, 64);
+  EXPECT_EQ(finest.weight, 1);
+  // Very coarse ones: the weight stays within what the graph's arcs hold.
+  c.smooth_weight = DepthStage::MaxSmoothWeight(1);
+  c.smooth_trunc = 1;
+  const DepthStage::Smoothness widest = at(1000);
+  EXPECT_EQ(widest.trunc, 1);
+  EXPECT_EQ(widest.weight, DepthStage::MaxSmoothWeight(1));
+  c.smooth_weight = 0;
+  EXPECT_EQ(at(1000).weight, 0);  // no smoothness stays none
+}
+
 TEST(DepthStageTest, ArenaFor640x480With7ViewsAnd64LabelsIsAtMost24MiB) {
   DepthConfig c;
   c.width = 640;
