@@ -201,7 +201,8 @@ TEST_P(MapAccuracy, TheSavedMapFollowsTheSceneAndItsEdges) {
 INSTANTIATE_TEST_SUITE_P(Sizes, MapAccuracy,
                          ::testing::Values(Case{1280, 960, 11, false}, Case{1280, 960, 12, false},
                                            Case{1280, 960, 13, false}, Case{4056, 3040, 11, false},
-                                           Case{4056, 3040, 12, false}, Case{1280, 960, 11, true},
+                                           Case{4056, 3040, 12, false}, Case{4056, 3040, 13, false},
+                                           Case{4056, 3040, 14, false}, Case{1280, 960, 11, true},
                                            Case{4056, 3040, 11, true}));
 
 }  // namespace
