@@ -40,7 +40,8 @@ const char kUsage[] =
     "  --disparity MIN,MAX    label range in px per view step, signed for a converged rig\n"
     "                         (rectified default 0 and (N-1)/4: quarter-pixel labels; auto:\n"
     "                         from the tracked points)\n"
-    "  --smoothness W         smoothness weight, 0..%d (default %d)\n"
+    "  --smoothness W         smoothness weight, for a step of a quarter px of disparity,\n"
+    "                         0..%d (default %d)\n"
     "  --cycles N             expansion cycle cap, 0..32 (default %d)\n"
     "  --subpixel             write the sub-label refinement the renderer uses (default: the\n"
     "                         labels' disparities, which score best against whole-pixel truth)\n";
