@@ -82,6 +82,16 @@ static RenderConfig MakeRenderConfig(const PipelineConfig& c, int32_t map_scale)
   return r;
 }
 
+int32_t Pipeline::GuessPermille(ConstImageU8 confidence) {
+  if (confidence.data == nullptr || confidence.width <= 0 || confidence.height <= 0) return 0;
+  int64_t guesses = 0;
+  for (int32_t y = 0; y < confidence.height; ++y) {
+    const uint8_t* row = confidence.Row(y);
+    for (int32_t x = 0; x < confidence.width; ++x) guesses += row[x] < kGuessConfidence;
+  }
+  return static_cast<int32_t>(guesses * 1000 / (int64_t{confidence.width} * confidence.height));
+}
+
 Status Pipeline::RequiredBytes(const PipelineConfig& c, size_t* bytes) {
   *bytes = 0;
   const int32_t min_side = c.render ? 16 : DepthConfig::kMinSize;
@@ -414,13 +424,11 @@ Status Pipeline::ComputeDepth() {
   low_confidence_permille_ = 0;
   if (depth_.confidence() != nullptr && confidence_.data != nullptr) {
     // Out of the stage's memory, which the render takes over.
-    int64_t guesses = 0;
     for (int32_t y = 0; y < work_h_; ++y) {
       const uint8_t* row = depth_.confidence() + static_cast<size_t>(y) * work_w_;
       memcpy(confidence_.Row(y), row, static_cast<size_t>(work_w_));
-      for (int32_t x = 0; x < work_w_; ++x) guesses += row[x] < kGuessConfidence;
     }
-    low_confidence_permille_ = static_cast<int32_t>(guesses * 1000 / (int64_t{work_w_} * work_h_));
+    low_confidence_permille_ = GuessPermille(confidence_.AsConst());
   }
   if (config_.geometry == ViewGeometry::kAuto) {
     // SetDepthGeometry rebuilds the planes for every burst, so they are still this one's.

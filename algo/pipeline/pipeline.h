@@ -132,6 +132,9 @@ class Pipeline : public FrameSink {
   int32_t low_confidence_permille() const { return low_confidence_permille_; }
   static constexpr int32_t kRetakePermille = 500;
   static constexpr uint8_t kGuessConfidence = 8;
+  // The same share for any confidence map (a photo's, read back from its file): per mille of
+  // its pixels under kGuessConfidence, 0 for an empty map.
+  static int32_t GuessPermille(ConstImageU8 confidence);
   // The depth map a photo carries and the render uses (the file's GDepth and Dynamic Depth),
   // after ComputeDepth: the depth stage's disparity refined on a grid of map_scale()
   // full-resolution px a map px (depth_refine.h), in map px per view step (Q8.8) within

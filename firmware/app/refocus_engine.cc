@@ -185,6 +185,8 @@ Status RefocusEngine::Decode(const char* path, size_t size) {
   cur.focus = file_.has_file_focus() ? file_.file_focus()
                                      : FocusAtPoint(photo_.width / 2, photo_.height / 2);
   cur.f_number = file_.has_file_focus() ? file_.file_f_number() : 2.8f;
+  const ConstImageU8 confidence = file_.confidence();
+  photo_.guess_permille = confidence.data != nullptr ? Pipeline::GuessPermille(confidence) : -1;
   return Status::Ok();
 }
 

@@ -60,6 +60,9 @@ struct EnginePhoto {
   // The focus and f-number it was rendered with (GFocus; an f-number estimated from its blur at
   // infinity), a focus point as FocusAtPoint at full size.
   RenderParams current;
+  // Per mille of its depth that the file's confidence map calls a guess
+  // (Pipeline::GuessPermille); -1 when the file carries no confidence map.
+  int32_t guess_permille = -1;
 };
 
 class RefocusEngine {

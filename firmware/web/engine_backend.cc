@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "algo/pipeline/pipeline.h"
 #include "firmware/app/focus.h"
 #include "firmware/codecs/exif.h"
 #include "firmware/codecs/image_file.h"
@@ -249,6 +250,7 @@ Status EngineBackend::Process(Request* r) {
     info.current.y0 = info.current.y1 = static_cast<float>(v);
     info.current.f_number = p.current.f_number;
     info.current.aperture = p.current.aperture;
+    info.depth_guess = p.guess_permille > Pipeline::kRetakePermille;
     return Status::Ok();
   }
   LB_RETURN_IF_ERROR(s);

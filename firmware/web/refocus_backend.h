@@ -24,6 +24,9 @@ struct PhotoInfo {
   int32_t width = 0, height = 0;  // as displayed (after EXIF orientation)
   bool refocusable = false;       // has GDepth and GImage: the page can refocus it
   RefocusParams current;          // the focus and aperture it was rendered with (from its XMP)
+  // Most of its depth is a guess, as its confidence map says (Pipeline::kRetakePermille): a
+  // flat or textureless scene, whose blur may fall in the wrong places.
+  bool depth_guess = false;
 };
 
 // A growable output the caller owns and reuses (its capacity is kept between calls, so a

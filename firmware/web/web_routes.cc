@@ -173,9 +173,9 @@ bool WebServer::Info(MHD_Connection* c, Request* r, const char* name) {
   const RefocusParams& p = info.current;
   snprintf(json, sizeof(json),
            "{\"width\":%d,\"height\":%d,\"refocusable\":%s,\"current\":{\"x0\":%.4f,\"y0\":%.4f,"
-           "\"x1\":%.4f,\"y1\":%.4f,\"f\":%.2f,\"blades\":%d}}",
+           "\"x1\":%.4f,\"y1\":%.4f,\"f\":%.2f,\"blades\":%d},\"depthGuess\":%s}",
            info.width, info.height, info.refocusable ? "true" : "false", p.x0, p.y0, p.x1, p.y1,
-           p.f_number, p.aperture.blades);
+           p.f_number, p.aperture.blades, info.depth_guess ? "true" : "false");
   return Reply(c, r, MHD_HTTP_OK, "application/json", json, strlen(json), nullptr);
 }
 

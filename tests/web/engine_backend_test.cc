@@ -86,6 +86,7 @@ TEST_F(EngineBackendTest, DescribesRendersAndSaves) {
   EXPECT_EQ(info.width, 320);
   EXPECT_EQ(info.height, 240);
   EXPECT_TRUE(info.refocusable);
+  EXPECT_FALSE(info.depth_guess) << "a textured scene's depth is not a guess";
   EXPECT_NEAR(info.current.x0, 0.5f, 0.05f);  // the default focus: the central ninth
 
   VectorSink preview, full;

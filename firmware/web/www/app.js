@@ -129,6 +129,7 @@ async function openPhoto(name) {
   view.params = null;
   show('viewer');
   $('saved').hidden = true;
+  $('guess').hidden = true;
   $('save').disabled = true;
   $('selection').hidden = true;
   $('download').href = '/photos/' + encodeURIComponent(name) + '?download=1';
@@ -148,6 +149,7 @@ async function openPhoto(name) {
     $('blades').value = String(c.blades || 0);
     markFocus(c.x0 ?? 0.5, c.y0 ?? 0.5);
     $('hint').hidden = !info.refocusable;
+    $('guess').hidden = !(info.refocusable && info.depthGuess);
     $('controls').hidden = false;
     for (const el of [$('f'), $('blades')]) el.disabled = !info.refocusable;
     status(info.refocusable ? '' : 'this photo has no depth map: it cannot be refocused');

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "firmware/app/job.h"
+#include "firmware/app/refocus_engine.h"
 #include "firmware/codecs/codec_decoder.h"
 #include "firmware/refocusable/refocusable_reader.h"
 #include "sim/files/file_sensor.h"
@@ -46,6 +47,21 @@ class ConfidencePhoto : public ::testing::Test {
     ASSERT_TRUE(s.ok()) << s.message();
   }
   std::string Photo() const { return dir_ + "/photo.jpg"; }
+
+  // What the camera's page reads of the photo: the share of its depth its confidence map calls
+  // a guess (-1: no map).
+  static void PageGuessPermille(const std::string& path, int32_t* permille) {
+    RefocusEngineConfig c;
+    c.max_width = 1280;  // the synthetic sensor's photos and the files' below
+    c.max_height = 960;
+    c.threads = 1;
+    c.max_blur_radius = 16;
+    RefocusEngine engine;
+    ASSERT_TRUE(engine.Configure(c).ok());
+    const Status s = engine.Load(path.c_str());
+    ASSERT_TRUE(s.ok()) << s.message();
+    *permille = engine.photo().guess_permille;
+  }
 
   // The frames of `b` as PPM files.
   std::vector<std::string> Write(const motiontest::Burst& b) {
@@ -88,6 +104,11 @@ TEST_F(ConfidencePhoto, TheFileCarriesThePipelinesMapInBothFormats) {
   // The hint follows the pipeline's share, whatever the scene.
   RecordProperty("low_confidence_permille", std::to_string(report.low_confidence_permille));
   EXPECT_EQ(report.hint != nullptr, report.low_confidence_permille > Pipeline::kRetakePermille);
+  // The page reads the same share back from the file, and gives the same verdict.
+  int32_t page = -1;
+  ASSERT_NO_FATAL_FAILURE(PageGuessPermille(Photo(), &page));
+  EXPECT_NEAR(page, report.low_confidence_permille, 30);
+  EXPECT_EQ(page > Pipeline::kRetakePermille, report.hint != nullptr);
 
   RefocusableImage back;
   Status s = ReadRefocusableFile(Photo().c_str(), &back);
@@ -149,6 +170,10 @@ TEST_F(ConfidencePhoto, ATexturelessBurstGivesTheRetakeHint) {
   ASSERT_NE(report.hint, nullptr);
   EXPECT_STREQ(report.hint, kRetakeHint);
   EXPECT_EQ(std::string(report.hint).find('\n'), std::string::npos);
+  // The camera's page says so too, from the file alone.
+  int32_t page = -1;
+  ASSERT_NO_FATAL_FAILURE(PageGuessPermille(Photo(), &page));
+  EXPECT_GT(page, Pipeline::kRetakePermille);
 }
 
 // A handheld burst whose middle is a blank wall: the camera's motion is found from the border,

@@ -70,6 +70,7 @@ class FakeBackend : public RefocusBackend {
     info->current.y0 = info->current.y1 = 0.75f;
     info->current.f_number = 4.0f;
     info->current.aperture.blades = 6;
+    info->depth_guess = strstr(path, "wall") != nullptr;
     return Status::Ok();
   }
   Status Render(const char* path, const RefocusParams& p, bool preview, ByteSink* out) override {
@@ -270,8 +271,13 @@ TEST_F(WebServerTest, InfoPreviewRenderAndSaveReachTheRenderer) {
   ASSERT_EQ(r.status, 200) << r.body;
   EXPECT_EQ(r.body,
             "{\"width\":1280,\"height\":960,\"refocusable\":true,\"current\":{\"x0\":0.2500,"
-            "\"y0\":0.7500,\"x1\":0.2500,\"y1\":0.7500,\"f\":4.00,\"blades\":6}}");
+            "\"y0\":0.7500,\"x1\":0.2500,\"y1\":0.7500,\"f\":4.00,\"blades\":6},"
+            "\"depthGuess\":false}");
   EXPECT_EQ(backend_.last_path, photos_.Path(kPhoto));
+  WriteFile(photos_.Path("wall.jpg"), photo_);
+  r = Get("/api/info/wall.jpg");
+  ASSERT_EQ(r.status, 200) << r.body;
+  EXPECT_NE(r.body.find("\"depthGuess\":true"), std::string::npos) << r.body;
   r = Get("/api/info/flat.jpg");
   EXPECT_EQ(r.status, 422);
   EXPECT_EQ(r.body, "{\"error\":\"no depth in it\"}");
