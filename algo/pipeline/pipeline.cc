@@ -1,5 +1,6 @@
 #include "algo/pipeline/pipeline.h"
 
+#include <algorithm>
 #include <cstring>
 
 #include "algo/core/color.h"
@@ -16,8 +17,15 @@ static_assert(PipelineConfig::kMaxWidth / 8 <= ingest::kMaxBoxScale &&
               "the ingest's box sums could overflow uint32");
 
 Pipeline::Layout Pipeline::Plan(const PipelineConfig& c) {
+  // The bound is a budget of pixels, whichever way the frame is turned: a square or portrait
+  // frame gets as many working pixels as a landscape one (512x512 into 640x480 stays whole).
+  const int64_t budget = int64_t{c.max_working_width} * c.max_working_height;
+  const int32_t longest = std::max(c.max_working_width, c.max_working_height);
   int32_t s = 1;
-  while (c.width / s > c.max_working_width || c.height / s > c.max_working_height) ++s;
+  while (int64_t{c.width / s} * (c.height / s) > budget ||
+         std::max(c.width / s, c.height / s) > longest) {
+    ++s;
+  }
   // A frame far thinner than the bound (16x8192 into 640x480) would shrink below one pixel: it
   // gets no depth (ComputeDepth says so) and a scale that keeps a pixel for its flat map.
   const int32_t thin = c.width < c.height ? c.width : c.height;

@@ -39,7 +39,8 @@ struct PipelineConfig {
   int32_t frames = 5;     // burst length
   int32_t reference = 2;  // the view the output is rendered from
   // The depth stage runs at the full resolution divided by the smallest integer factor that
-  // brings it within these bounds.
+  // brings it within this many pixels (width x height), neither side longer than the longer of
+  // the two: a 4:3 frame fits the box either way round, a square one keeps its pixel budget.
   int32_t max_working_width = 640;
   int32_t max_working_height = 480;
   int32_t labels = 64;

@@ -197,7 +197,9 @@ const Setting kSettings[] = {
    [](const char* t, JobOptions* j, std::string* w) {
      return ParseWholeNumber(t, 2, 256, &j->pipeline.labels, w); }},
   {"working-size", nullptr, SettingGroup::kDepth, "WxH",
-   "largest working resolution for depth, 16x16 .. 8192x8192 (default 640x480)", WorkingSize},
+   "working resolution for depth: at most W x H pixels, neither side over the longer of W and "
+   "H, 16x16 .. 8192x8192 (default 640x480)",
+   WorkingSize},
   {"threads", nullptr, SettingGroup::kWork, "N",
    "worker threads for depth and render, 1..16, or 0: one per core (default 0); the photo is "
    "the same whatever the number",

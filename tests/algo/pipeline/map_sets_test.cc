@@ -1,12 +1,11 @@
 // The map a photo carries on the multi-view sets in ../shared/data (captures we did not make), at
 // the ground truth's size, against the depth stage's own grid (what photos carried before the
-// map); each enlarged to the truth's size where smaller (HCI's 512 px square is over the working
-// bound: both are at half its side), the map as the product enlarges it (one side at a depth
-// edge), the grid as the render did. The product's default path (auto geometry, 64 labels), each
-// scored as its benchmark does after the scale and offset small motion cannot know: Middlebury,
-// more than 1 px in the evaluated pair's units on the nonocc mask (every pixel of known disparity
-// for sawtooth and barn1); HCI, BadPix 0.3 outside a 16 px border. The map must be no worse
-// anywhere and better on the whole. Label data: skips without the sets.
+// map); each enlarged to the truth's size where smaller, the map as the product enlarges it (one
+// side at a depth edge), the grid as the render did. The product's default path (auto geometry, 64
+// labels), each scored as its benchmark does after the scale and offset small motion cannot know:
+// Middlebury, more than 1 px in the evaluated pair's units on the nonocc mask (every pixel of known
+// disparity for sawtooth and barn1); HCI, BadPix 0.3 outside a 16 px border. The map must be no
+// worse anywhere and better on the whole. Label data: skips without the sets.
 #include <gtest/gtest.h>
 
 #include <cmath>

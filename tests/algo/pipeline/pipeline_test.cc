@@ -12,6 +12,7 @@
 #include <memory>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "algo/core/color.h"
@@ -384,6 +385,35 @@ TEST(Pipeline, ABurstOfOneFrameIsRejectedBeforeAnythingIsAllocated) {
   EXPECT_EQ(s.code(), Code::kInvalidArgument);
   EXPECT_EQ(bytes, 0u);
   EXPECT_NE(std::string(s.message()).find("at least 2"), std::string::npos) << s.message();
+}
+
+// The working bound is a budget of pixels: a frame turned on its side, or square, is not
+// shrunk further than a landscape one of the same size (a light field's 512x512 views keep
+// their parallax; a portrait 12 MP burst gets the landscape one's grid).
+TEST(Pipeline, TheWorkingSizeIsAPixelBudgetWhicheverWayTheFrameIsTurned) {
+  auto scale = [](int32_t w, int32_t h) {
+    PipelineConfig c;
+    c.width = w;
+    c.height = h;
+    return Pipeline::WorkingScale(c);
+  };
+  EXPECT_EQ(scale(1280, 960), 2);
+  EXPECT_EQ(scale(4056, 3040), 7);
+  EXPECT_EQ(scale(3040, 4056), 7);
+  EXPECT_EQ(scale(960, 1280), 2);
+  EXPECT_EQ(scale(512, 512), 1);
+  EXPECT_EQ(scale(1920, 1080), 3);
+  EXPECT_EQ(scale(1080, 1920), 3);
+  // Within the budget but longer than its longer side: still shrunk.
+  EXPECT_EQ(scale(1000, 100), 2);
+  for (const auto& [w, h] : {std::pair{4056, 3040}, {3040, 4056}, {700, 700}, {6000, 4000}}) {
+    const int32_t s = scale(w, h);
+    EXPECT_LE((w / s) * (h / s), 640 * 480) << w << "x" << h;
+    EXPECT_LE(std::max(w / s, h / s), 640) << w << "x" << h;
+    EXPECT_TRUE(s == 1 || (w / (s - 1)) * (h / (s - 1)) > 640 * 480 ||
+                std::max(w / (s - 1), h / (s - 1)) > 640)
+        << w << "x" << h << ": " << s - 1 << " would fit";
+  }
 }
 
 TEST(Pipeline, TakesRectifiedOrAutoGeometryOnly) {
