@@ -180,6 +180,8 @@ def main():
     ap.add_argument("--www", required=True)
     ap.add_argument("--out", required=True, help="where the screenshot goes (build tree)")
     ap.add_argument("--resolution", default="2048x1536")
+    ap.add_argument("--refocus", help="the command line, to add a photo of a textureless burst "
+                    "whose depth the page must call a guess")
     # The latency is a measurement (docs/performance.md, under chrt -f 10), not a pass mark: CI
     # machines are shared, and the renderer runs at low priority by design. A bound given here is
     # checked.
@@ -301,6 +303,26 @@ def main():
         shot = os.path.join(args.out, "browser_refocus.png")
         browser.save_screenshot(shot)
 
+        guess_lines = {name: browser.find_element(By.ID, "guess").is_displayed()}
+        if args.refocus:
+            # A burst with nothing to match: its depth is a guess, and the page says so.
+            frames = []
+            for k in range(5):
+                frames.append(os.path.join(work, f"flat{k}.ppm"))
+                with open(frames[-1], "wb") as f:
+                    f.write(b"P6\n320 240\n255\n" + bytes([180]) * (320 * 240 * 3))
+            flat = "IMG_flat.jpg"
+            subprocess.run([os.path.abspath(args.refocus), "run", "--geometry", "rectified",
+                            "--labels", "16", *frames, "--out", os.path.join(out_dir, flat)],
+                           check=True, capture_output=True)
+            browser.find_element(By.ID, "back").click()
+            state("gallery")
+            thumb = f'#thumbs li[data-name="{flat}"]'
+            wait.until(lambda b: b.find_elements(By.CSS_SELECTOR, thumb))
+            browser.find_element(By.CSS_SELECTOR, thumb).click()
+            state("photo")
+            guess_lines[flat] = browser.find_element(By.ID, "guess").is_displayed()
+
         for k, (at_tap, at_old) in measures.items():
             print(f"sharpness {k:>26}: at the tap {at_tap:8.1f}, at the old focus {at_old:8.1f}")
         print(f"tap -> preview shown: best {latency:.0f} ms of "
@@ -320,6 +342,12 @@ def main():
               f"{rss_last / 1024:.1f} MiB after three more renders and a save")
         if rss_last - rss_first > 8 * 1024:
             failures.append("refocusd's memory grew by more than 8 MiB")
+        print("the page's guess line: " + ", ".join(f"{k} {'shown' if v else 'hidden'}"
+                                                      for k, v in guess_lines.items()))
+        if guess_lines[name]:
+            failures.append(f"{name}: a textured scene's depth called a guess")
+        if args.refocus and not guess_lines.get("IMG_flat.jpg"):
+            failures.append("IMG_flat.jpg: a textureless burst's depth not called a guess")
         if daemon.poll() is not None:
             failures.append("refocusd ended")
         for f in failures:
