@@ -30,16 +30,18 @@ struct DepthConfig {
   // Potts when smooth_trunc is 1. w_pq is smooth_weight where the reference is flat and
   // smooth_weight * edge_weight_q8 / 256 across a colour edge (largest channel step above
   // edge_threshold), so label changes prefer image edges.
-  // Both are stated for labels kSmoothSpacingQ8 apart. The stage holds the cost of a step of
-  // disparity, not of a label, whatever the range and the label count: labels half as far apart
-  // get half the weight and twice the truncation (DepthStage::SmoothnessFor). Otherwise a burst
-  // with little parallax, which gets finer labels, would be smoothed harder than one with more.
-  static constexpr int32_t kSmoothSpacingQ8 = 64;  // a quarter px per view step
-  int32_t smooth_weight = 96;                      // 0..4096, times smooth_trunc at most 16383
-  int32_t smooth_trunc = 8;                        // 1..64
-  int32_t edge_threshold = 16;                     // 0..255
-  int32_t edge_weight_q8 = 64;                     // 0..256
-  int32_t max_cycles = 1;  // expansion cycles over every label, 0..32 (0: winner-take-all)
+  // Both are stated for labels kSmoothSpacingQ8 (a quarter px per view step) apart. The stage
+  // holds the cost of a step of disparity, not of a label, whatever the range and the label
+  // count: labels half as far apart get half the weight and twice the truncation
+  // (DepthStage::SmoothnessFor). Otherwise a burst with little parallax, which gets finer
+  // labels, would be smoothed harder than one with more.
+  static constexpr int32_t kSmoothSpacingQ8 = 64;
+
+  int32_t smooth_weight = 96;   // 0..4096, times smooth_trunc at most 16383
+  int32_t smooth_trunc = 8;     // 1..64
+  int32_t edge_threshold = 16;  // 0..255
+  int32_t edge_weight_q8 = 64;  // 0..256
+  int32_t max_cycles = 1;       // expansion cycles over every label, 0..32 (0: winner-take-all)
   // Coarse to fine: with coarse_step > 1, one pass of full moves over every coarse_step-th
   // label comes first, and the cycles' moves then free only pixels whose label is within
   // fine_window of alpha (a restricted move: still an exact cut over the pixels it frees). The

@@ -62,10 +62,9 @@ class MoveBook {
   static constexpr uint16_t kWanted = 0xfffe;
   int32_t width_ = 0, height_ = 0, labels_ = 0;
   bool subpixel_ = true;
-  int32_t smooth_[DepthConfig::kMaxLabels] =
-      {};                         // min(d, the Compute's truncation) for a label distance d
-  uint16_t* below_ = nullptr;     // D_p(f_p - 1), 0xffff when not seen
-  uint16_t* above_ = nullptr;     // D_p(f_p + 1)
+  int32_t smooth_[DepthConfig::kMaxLabels] = {};  // min(d, the truncation) for a label distance d
+  uint16_t* below_ = nullptr;                     // D_p(f_p - 1), 0xffff when not seen
+  uint16_t* above_ = nullptr;                     // D_p(f_p + 1)
   int32_t* want_span_ = nullptr;  // per row, the columns where below_ holds kWanted ([w, 0): none)
   uint8_t* split_ = nullptr;      // max(width, height) + 2 bytes: SplitRect's column or row marks
   // Per row, the runs of columns whose D a restricted move or the hand-over computes.
