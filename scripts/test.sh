@@ -10,6 +10,7 @@ jobs=${JOBS:-$(nproc)}
 passed=0
 failed=0
 skipped=0
+failures=()
 log=$(mktemp -d)
 
 step() { printf '\n=== %s\n' "$*"; }
@@ -30,6 +31,10 @@ run_ctest() {
   # ctest counts a skipped test (GTEST_SKIP, exit 77) as not failed: report it apart.
   skips=$(grep -cE '\(Skipped\)$' "$log/$name.log" || true)
   passed=$((passed + total - fails - skips)); failed=$((failed + fails)); skipped=$((skipped + skips))
+  # CI shows only the tail of this output: the names of what failed are repeated at the end.
+  local t
+  while read -r t; do failures+=("$name: $t"); done < <(
+    sed -n '/^The following tests FAILED:/,/^$/{s/^[[:space:]]*[0-9]* - //p}' "$log/$name.log")
 }
 
 step "set-up"
@@ -108,5 +113,6 @@ else
 fi
 
 echo
+for f in "${failures[@]}"; do echo "failed: $f"; done
 echo "tests: $passed passed, $failed failed, $skipped skipped"
 [ "$failed" -eq 0 ]
