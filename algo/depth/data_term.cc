@@ -57,7 +57,9 @@ void DataTerm::Carve(Arena& arena, int32_t width, int32_t height, int32_t views,
   views_ = views;
   workers_ = Clamp(workers, 1, kMaxWorkers);
   const size_t n = static_cast<size_t>(width) * height;
+  const size_t start = arena.used();
   for (int32_t v = 0; v < views; ++v) census_[v] = arena.Allocate<uint8_t>(3 * n);
+  census_bytes_ = arena.used() - start;
   for (int32_t i = 0; i < workers_; ++i) {
     Scratch& s = scratch_[i];
     s.luma = arena.Allocate<uint8_t>(static_cast<size_t>(width + 2 * kLumaPad) * kLumaRows);

@@ -116,6 +116,10 @@ class DataTerm {
   // Census of a view: per row, three planes of `width` bytes (neighbours 0-7, 8-15, 16-23 in
   // raster order, the first one in the top bit).
   const uint8_t* census(int32_t view) const { return census_[view]; }
+  // The census images' memory, one block at the start of what Carve took: Prepare rewrites all
+  // of it, so between a caller's last ComputeRows and the next Prepare it is free to lend.
+  uint8_t* census_block() const { return census_[0]; }
+  size_t census_block_bytes() const { return census_bytes_; }
 
   struct Kernels;
 
@@ -167,6 +171,7 @@ class DataTerm {
   const Kernels* kernels_ = nullptr;
   const PlaneHomography* planes_ = nullptr;
   uint8_t* census_[16] = {};
+  size_t census_bytes_ = 0;
   Scratch scratch_[kMaxWorkers];
   int32_t workers_ = 1;
   InlineRunner inline_;

@@ -96,6 +96,13 @@ size_t DepthStage::RequiredBytes(const DepthConfig& config) {
   return plan.used();
 }
 
+size_t DepthStage::SpareBytes(const DepthConfig& config) {
+  DataTerm data;
+  Arena plan;
+  data.Carve(plan, config.width, config.height, config.views, config.workers);
+  return data.census_block_bytes();
+}
+
 Status DepthStage::Carve(Arena& arena) {
   const size_t start = arena.used();
   const int32_t w = config_.width, h = config_.height;

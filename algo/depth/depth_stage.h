@@ -100,6 +100,11 @@ class DepthStage {
   // confidence.h), row stride = width; nullptr without it.
   const uint8_t* confidence() const { return margins_.confidence; }
   static constexpr uint8_t kLowConfidence = LabelMargins::kLow;
+  // After Compute and until the next one: memory of the stage that no later call reads (the
+  // census of the views, at least 6 bytes a pixel), for a caller's scratch; labels() and
+  // confidence() lie outside it. SpareBytes says its size before Configure.
+  uint8_t* spare() const { return data_.census_block(); }
+  static size_t SpareBytes(const DepthConfig& config);
   int32_t LabelDispQ8(int32_t label) const { return LabelDispQ8(config_, label); }
   // The disparity of a label, Q8.8, for any valid configuration.
   static int32_t LabelDispQ8(const DepthConfig& config, int32_t label);

@@ -57,34 +57,44 @@ Status MotionStage::Validate(const MotionConfig& c) {
   return Status::Ok();
 }
 
-size_t MotionStage::RequiredBytes(const MotionConfig& config) {
+size_t MotionStage::RequiredBytes(const MotionConfig& config, bool scratch_apart) {
   if (!Validate(config).ok()) return 0;
   MotionStage planner;
-  Arena counting;
+  Arena counting, apart;
   planner.config_ = config;
-  if (!planner.Carve(counting).ok()) return 0;
+  if (!planner.Carve(counting, scratch_apart ? apart : counting).ok()) return 0;
   return counting.used();
 }
 
-Status MotionStage::Configure(const MotionConfig& config, Arena& arena) {
+size_t MotionStage::ScratchBytes(const MotionConfig& config) {
+  if (!Validate(config).ok()) return 0;
+  MotionStage planner;
+  Arena counting, scratch;
+  planner.config_ = config;
+  if (!planner.Carve(counting, scratch).ok()) return 0;
+  return scratch.used();
+}
+
+Status MotionStage::Configure(const MotionConfig& config, Arena& arena, Arena* scratch) {
   LB_RETURN_IF_ERROR(Validate(config));
   config_ = config;
   const size_t before = arena.used();
-  LB_RETURN_IF_ERROR(Carve(arena));
+  const size_t scratch_before = scratch != nullptr ? scratch->used() : 0;
+  LB_RETURN_IF_ERROR(Carve(arena, scratch != nullptr ? *scratch : arena));
   arena_bytes_ = arena.used() - before;
-  if (arena.overflowed()) {
-    return Status(Code::kOutOfMemory, "motion: arena of %zu bytes too small (needs %zu more)",
-                  arena.size(), arena_bytes_);
+  if (arena.overflowed() || (scratch != nullptr && scratch->overflowed())) {
+    return Status(Code::kOutOfMemory, "motion: arena too small (needs %zu bytes, %zu of scratch)",
+                  arena_bytes_, scratch != nullptr ? scratch->used() - scratch_before : 0);
   }
   return Status::Ok();
 }
 
-Status MotionStage::Carve(Arena& arena) {
+Status MotionStage::Carve(Arena& arena, Arena& scratch) {
   const MotionConfig& c = config_;
-  LB_RETURN_IF_ERROR(ref_.Carve(c.width, c.height, c.pyramid_levels, arena));
-  LB_RETURN_IF_ERROR(view_.Carve(c.width, c.height, c.pyramid_levels, arena));
-  LB_RETURN_IF_ERROR(corners_.Carve(c.width, c.height, Cell(c), arena));
-  LB_RETURN_IF_ERROR(tracker_.Carve(c.tracker, arena, c.workers));
+  LB_RETURN_IF_ERROR(ref_.Carve(c.width, c.height, c.pyramid_levels, scratch));
+  LB_RETURN_IF_ERROR(view_.Carve(c.width, c.height, c.pyramid_levels, scratch));
+  LB_RETURN_IF_ERROR(corners_.Carve(c.width, c.height, Cell(c), scratch));
+  LB_RETURN_IF_ERROR(tracker_.Carve(c.tracker, scratch, c.workers));
   max_points_ = corners_.max_corners();
   LB_RETURN_IF_ERROR(bundle_.Carve(c.views, max_points_, arena));
   const size_t n = static_cast<size_t>(max_points_);

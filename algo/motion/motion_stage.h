@@ -123,8 +123,14 @@ struct MotionResult {
 class MotionStage {
  public:
   static Status Validate(const MotionConfig& config);
-  static size_t RequiredBytes(const MotionConfig& config);
-  Status Configure(const MotionConfig& config, Arena& arena);
+  // Bytes of arena Configure carves; with `scratch_apart`, those it carves from `arena` when it
+  // gets a scratch arena too.
+  static size_t RequiredBytes(const MotionConfig& config, bool scratch_apart = false);
+  // Bytes of the memory only Estimate reads, and only while it runs (the pyramids, the corner
+  // detector's and the tracker's): a caller may lend memory it needs only before or after.
+  static size_t ScratchBytes(const MotionConfig& config);
+  // Carves from `arena`, and the memory of ScratchBytes from `scratch` when given.
+  Status Configure(const MotionConfig& config, Arena& arena, Arena* scratch = nullptr);
   // Where the tracker runs its points (borrowed; nullptr: on the caller), with at most
   // config.workers workers. The result does not depend on it.
   void SetRunner(TaskRunner* runner) { runner_ = runner; }
@@ -144,7 +150,7 @@ class MotionStage {
   size_t arena_bytes() const { return arena_bytes_; }
 
  private:
-  Status Carve(Arena& arena);
+  Status Carve(Arena& arena, Arena& scratch);
   Status Track(const ConstImageU8* views, int32_t reference, MotionResult* result);
   int32_t* Displacements(int32_t v) { return disp_q16_ + 2 * static_cast<size_t>(v) * max_points_; }
   // The 90th percentile of view v's followed points' displacements, px.

@@ -166,30 +166,36 @@ Status Pipeline::Carve(Arena& arena) {
   disp_q8_ = arena.AllocateImage<uint16_t>(work_w_, work_h_);
   confidence_ = c.confidence ? arena.AllocateImage<uint8_t>(work_w_, work_h_) : ImageU8{};
   const RefineConfig fc = MakeRefineConfig();
-  map_q8_ = arena.AllocateImage<uint16_t>(fc.map_width, fc.map_height);
-  map_confidence_ =
-      c.confidence ? arena.AllocateImage<uint8_t>(fc.map_width, fc.map_height) : ImageU8{};
   rgb_rows_[0] = arena.Allocate<uint8_t>(static_cast<size_t>(c.width) * 3);
   rgb_rows_[1] = arena.Allocate<uint8_t>(static_cast<size_t>(c.width) * 3);
   cols_ = arena.Allocate<uint32_t>(static_cast<size_t>(work_w_) * scale_ * 3);
-  if (UsesMotion(c, work_w_, work_h_)) {
-    planes_ = arena.Allocate<PlaneHomography>(static_cast<size_t>(c.frames) * c.labels);
-    order_scratch_ = arena.Allocate<uint8_t>(DepthOrderScratchBytes(work_w_, work_h_));
-  }
-  // Motion and depth are done with before the render starts, and the render keeps nothing
-  // between renders that it does not rebuild at Begin, so they share one region: its size is the
-  // larger of the two, not their sum.
   const bool depth = HasDepth(work_w_, work_h_), motion = UsesMotion(c, work_w_, work_h_);
+  if (motion) planes_ = arena.Allocate<PlaneHomography>(static_cast<size_t>(c.frames) * c.labels);
+  // The stages share one region, each in memory the one before is done with: the depth stage
+  // first, the motion stage after it (its points stay readable until the render begins), the
+  // refinement after both. The motion stage's pyramids and the depth order's vote use the
+  // depth stage's census, which Compute writes only after the first and reads only before the
+  // second; the map the refinement writes lies over the depth stage, and the render follows the
+  // map (it keeps nothing between renders that it does not rebuild at Begin).
   const DepthConfig dc = MakeDepthConfig(c, work_w_, work_h_);
   const MotionConfig mc = MakeMotionConfig(c, work_w_, work_h_);
   const RenderConfig rc = MakeRenderConfig(c, map_scale_);
-  // Each stage starts on a fresh alignment boundary: kAlign of slack per stage. The refinement
-  // comes after the analysis, whose motion result stays readable until the render begins.
-  const size_t analysis = (depth ? DepthStage::RequiredBytes(dc) + Arena::kAlign : 0) +
-                          (motion ? MotionStage::RequiredBytes(mc) + Arena::kAlign : 0);
+  // Each stage starts on a fresh alignment boundary: kAlign of slack per stage.
+  const size_t depth_bytes = depth ? DepthStage::RequiredBytes(dc) + Arena::kAlign : 0;
+  const size_t spare = depth ? DepthStage::SpareBytes(dc) : 0;
+  const bool motion_scratch_shared = motion && depth && MotionStage::ScratchBytes(mc) <= spare;
+  const size_t analysis =
+      depth_bytes +
+      (motion ? MotionStage::RequiredBytes(mc, motion_scratch_shared) + Arena::kAlign : 0);
   const size_t refine = depth ? DepthRefiner::RequiredBytes(fc) + Arena::kAlign : 0;
+  Arena map_plan;
+  CarveMap(fc, map_plan);
+  const size_t map = map_plan.used() + Arena::kAlign;
+  const bool map_shared = depth && map <= depth_bytes;
+  if (!map_shared) CarveMap(fc, arena);
   const size_t render = c.render ? RenderStage::RequiredBytes(rc) + Arena::kAlign : 0;
-  const size_t shared = analysis + refine > render ? analysis + refine : render;
+  const size_t after_map = (map_shared ? map : 0) + render;
+  const size_t shared = analysis + refine > after_map ? analysis + refine : after_map;
   uint8_t* region = arena.Allocate<uint8_t>(shared);
   region_ = region;
   region_bytes_ = shared;
@@ -201,14 +207,36 @@ Status Pipeline::Carve(Arena& arena) {
   }
   Arena analysis_arena(region, shared);
   if (depth) LB_RETURN_IF_ERROR(depth_.Configure(dc, analysis_arena));
-  if (motion) LB_RETURN_IF_ERROR(motion_.Configure(mc, analysis_arena));
+  if (motion) {
+    Arena scratch(depth_.spare(), spare);
+    LB_RETURN_IF_ERROR(
+        motion_.Configure(mc, analysis_arena, motion_scratch_shared ? &scratch : nullptr));
+  }
+  order_scratch_ = nullptr;
+  if (depth && motion) {
+    if (spare < DepthOrderScratchBytes(work_w_, work_h_)) {
+      return Status(Code::kInternal, "depth order: the depth stage's spare memory is too small");
+    }
+    order_scratch_ = depth_.spare();
+  }
   if (depth) {
     Arena refine_arena(region + analysis, shared - analysis);
     refine_.Carve(fc, refine_arena);
   }
+  if (map_shared) {
+    Arena map_arena(region, map);
+    CarveMap(fc, map_arena);
+  }
   if (!c.render) return Status::Ok();
-  Arena render_arena(region, shared);
+  const size_t render_at = map_shared ? map : 0;
+  Arena render_arena(region + render_at, shared - render_at);
   return render_.Configure(rc, render_arena);
+}
+
+void Pipeline::CarveMap(const RefineConfig& fc, Arena& arena) {
+  map_q8_ = arena.AllocateImage<uint16_t>(fc.map_width, fc.map_height);
+  map_confidence_ =
+      config_.confidence ? arena.AllocateImage<uint8_t>(fc.map_width, fc.map_height) : ImageU8{};
 }
 
 void Pipeline::SetRunner(TaskRunner* runner) {

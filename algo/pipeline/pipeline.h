@@ -106,8 +106,9 @@ class Pipeline : public FrameSink {
   // kRectified), in the map's units: a signed range is lifted to start at 0 (depth_stage.h).
   int32_t disp_min_q8() const { return disp_min_q8_; }
   int32_t disp_max_q8() const { return disp_max_q8_; }
-  // The motion stage's result; its point arrays (point_xy, inv_depth) and the depth stage's
-  // labels() live in memory the render reuses: valid until BeginRender.
+  // The motion stage's result; its point arrays (point_xy, inv_depth) live in memory the render
+  // reuses: valid until BeginRender. The depth stage's labels() and confidence() are taken over
+  // by the map before ComputeDepth returns.
   const MotionResult& motion() const { return motion_result_; }
   Status BeginRender(const RenderParams& params);
   Status NextStrip(ConstPlanarU8* strip, int32_t* y0, int32_t* rows);
@@ -155,6 +156,7 @@ class Pipeline : public FrameSink {
   };
   static Layout Plan(const PipelineConfig& config);
   Status Carve(Arena& arena);
+  void CarveMap(const RefineConfig& fc, Arena& arena);
   Status EstimateGeometry(const ConstImageU8* views);
   void MakeMap(bool flat);
   RefineConfig MakeRefineConfig() const;
@@ -191,7 +193,7 @@ class Pipeline : public FrameSink {
   TaskRunner* runner_ = &inline_;
   MotionResult motion_result_;
   PlaneHomography* planes_ = nullptr;  // kAuto: frames x labels, view-major
-  uint8_t* order_scratch_ = nullptr;   // kAuto: DepthOrderScratchBytes (auto_geometry.h)
+  uint8_t* order_scratch_ = nullptr;   // kAuto: DepthOrderScratchBytes, in depth_.spare()
   int32_t disp_min_q8_ = 0, disp_max_q8_ = 0;
   Status depth_warning_;
 

@@ -129,8 +129,9 @@ TEST(Pipeline, IngestGivesTheSameBytesForAnyNumberOfThreads) {
   }
 }
 
-// The motion and depth stages and the render share memory (pipeline.h): a second burst through
-// the same pipeline, after a render, gives the first one's depth and photo again.
+// The motion and depth stages, the map and the render share memory (pipeline.h): the map and its
+// confidence outlive every render, a second render gives the same photo, and a second burst
+// through the same pipeline, after a render, gives the first one's depth and photo again.
 TEST(Pipeline, ASecondBurstAfterARenderGivesTheSameResult) {
   Burst b;
   b.config.max_working_width = 320;
@@ -138,19 +139,41 @@ TEST(Pipeline, ASecondBurstAfterARenderGivesTheSameResult) {
   b.SetupBoard(640, 480, 5, 0.02);
   RenderParams params;
   params.f_number = 2.0f;
-  uint64_t disparity[2] = {}, photo[2] = {};
+  uint64_t disparity[2] = {}, map[2] = {}, photo[2] = {};
   for (int32_t run = 0; run < 2; ++run) {
     b.pipeline.ResetBurst();
     ASSERT_TRUE(b.sensor->CaptureBurst(b.pipeline).ok());
     ASSERT_TRUE(b.pipeline.ComputeDepth().ok());
     ASSERT_TRUE(b.pipeline.depth_warning().ok()) << b.pipeline.depth_warning().message();
     disparity[run] = ImageChecksum(b.pipeline.disparity_q8());
+    map[run] = ImageChecksum(b.pipeline.map_q8()) ^ ImageChecksum(b.pipeline.map_confidence());
     int32_t rows = 0;
     photo[run] = RenderChecksum(b.pipeline, params, &rows);
     ASSERT_EQ(rows, 480);
+    EXPECT_EQ(ImageChecksum(b.pipeline.map_q8()) ^ ImageChecksum(b.pipeline.map_confidence()),
+              map[run])
+        << "the render wrote over the map";
+    EXPECT_EQ(RenderChecksum(b.pipeline, params, &rows), photo[run]) << "a second render";
   }
   EXPECT_EQ(disparity[1], disparity[0]);
+  EXPECT_EQ(map[1], map[0]);
   EXPECT_EQ(photo[1], photo[0]);
+}
+
+// The board's 12 MP sensor with the defaults (motion, depth with its confidence, the map and the
+// render) within the board's 48 MiB of arena.
+TEST(Pipeline, TheTwelveMegapixelPhotoFitsTheBoardsArena) {
+  PipelineConfig c;
+  c.width = 4056;
+  c.height = 3040;
+  c.frames = 5;
+  c.reference = 2;
+  c.geometry = ViewGeometry::kAuto;
+  c.labels = 32;
+  c.workers = 4;
+  size_t bytes = 0;
+  ASSERT_TRUE(Pipeline::RequiredBytes(c, &bytes).ok());
+  EXPECT_LE(bytes, size_t{48} << 20) << Pipeline::WorkingScale(c);
 }
 
 // The board's path gives the same depth and photo, bit for bit, whatever the number of threads:
