@@ -41,8 +41,8 @@ struct PipelineConfig {
   // The depth stage runs at the full resolution divided by the smallest integer factor that
   // brings it within this many pixels (width x height), neither side longer than the longer of
   // the two: a 4:3 frame fits the box either way round, a square one keeps its pixel budget.
-  int32_t max_working_width = 640;
-  int32_t max_working_height = 480;
+  int32_t max_working_width = 680;
+  int32_t max_working_height = 510;
   int32_t labels = 64;
   // kRectified (laboratory data) or kAuto (a handheld burst, or any whose poses are unknown).
   ViewGeometry geometry = ViewGeometry::kRectified;
@@ -133,6 +133,8 @@ class Pipeline : public FrameSink {
   // kLowConfidence, a flat patch all of them.
   int32_t low_confidence_permille() const { return low_confidence_permille_; }
   static constexpr int32_t kRetakePermille = 500;
+  // The one rule the camera's hint and its page both apply to such a share.
+  static bool MostlyGuess(int32_t permille) { return permille > kRetakePermille; }
   static constexpr uint8_t kGuessConfidence = 8;
   // The same share for any confidence map (a photo's, read back from its file): per mille of
   // its pixels under kGuessConfidence, 0 for an empty map.

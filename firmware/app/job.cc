@@ -236,7 +236,7 @@ Status Job::Run(const char* out_path, JobReport* report, StripObserver* observer
   r.warning = p.depth_warning();
   r.low_confidence_permille = p.low_confidence_permille();
   // A burst without depth has its own warning, which says what to do.
-  if (r.warning.ok() && r.low_confidence_permille > Pipeline::kRetakePermille) r.hint = kRetakeHint;
+  if (r.warning.ok() && Pipeline::MostlyGuess(r.low_confidence_permille)) r.hint = kRetakeHint;
 
   LB_RETURN_IF_ERROR(p.BeginRender(options_.render));
   r.focus_disp_q8 = p.render().focus_disp_q8();

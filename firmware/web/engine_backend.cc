@@ -250,7 +250,7 @@ Status EngineBackend::Process(Request* r) {
     info.current.y0 = info.current.y1 = static_cast<float>(v);
     info.current.f_number = p.current.f_number;
     info.current.aperture = p.current.aperture;
-    info.depth_guess = p.guess_permille > Pipeline::kRetakePermille;
+    info.depth_guess = Pipeline::MostlyGuess(p.guess_permille);
     return Status::Ok();
   }
   LB_RETURN_IF_ERROR(s);

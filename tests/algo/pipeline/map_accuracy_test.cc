@@ -193,9 +193,7 @@ TEST_P(MapAccuracy, TheSavedMapFollowsTheSceneAndItsEdges) {
   ASSERT_NO_FATAL_FAILURE(ScoreBurst(c, &bilinear, &guided));
   if (c.handheld) return;  // printed only (above)
   EXPECT_GE(guided.edge, 85.0);
-  // 12 MP falls short of 97 % (docs/accuracy.md): the depth stage's grid, a seventh of the
-  // photo's side, already misses it; the bound there keeps what the map reaches.
-  EXPECT_GE(guided.all, c.width * c.height > (1 << 22) ? 95.5 : 97.0);
+  EXPECT_GE(guided.all, 97.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Sizes, MapAccuracy,

@@ -421,20 +421,23 @@ TEST(Pipeline, TheWorkingSizeIsAPixelBudgetWhicheverWayTheFrameIsTurned) {
     return Pipeline::WorkingScale(c);
   };
   EXPECT_EQ(scale(1280, 960), 2);
-  EXPECT_EQ(scale(4056, 3040), 7);
-  EXPECT_EQ(scale(3040, 4056), 7);
+  EXPECT_EQ(scale(4056, 3040), 6);  // the board's 12 MP sensor: 676x506
+  EXPECT_EQ(scale(3040, 4056), 6);
   EXPECT_EQ(scale(960, 1280), 2);
   EXPECT_EQ(scale(512, 512), 1);
   EXPECT_EQ(scale(1920, 1080), 3);
   EXPECT_EQ(scale(1080, 1920), 3);
   // Within the budget but longer than its longer side: still shrunk.
   EXPECT_EQ(scale(1000, 100), 2);
+  const PipelineConfig defaults;
+  const int32_t budget = defaults.max_working_width * defaults.max_working_height;
+  const int32_t longest = std::max(defaults.max_working_width, defaults.max_working_height);
   for (const auto& [w, h] : {std::pair{4056, 3040}, {3040, 4056}, {700, 700}, {6000, 4000}}) {
     const int32_t s = scale(w, h);
-    EXPECT_LE((w / s) * (h / s), 640 * 480) << w << "x" << h;
-    EXPECT_LE(std::max(w / s, h / s), 640) << w << "x" << h;
-    EXPECT_TRUE(s == 1 || (w / (s - 1)) * (h / (s - 1)) > 640 * 480 ||
-                std::max(w / (s - 1), h / (s - 1)) > 640)
+    EXPECT_LE((w / s) * (h / s), budget) << w << "x" << h;
+    EXPECT_LE(std::max(w / s, h / s), longest) << w << "x" << h;
+    EXPECT_TRUE(s == 1 || (w / (s - 1)) * (h / (s - 1)) > budget ||
+                std::max(w / (s - 1), h / (s - 1)) > longest)
         << w << "x" << h << ": " << s - 1 << " would fit";
   }
 }

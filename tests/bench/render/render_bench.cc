@@ -99,7 +99,7 @@ BENCHMARK(BM_Render12MP)
     ->MinTime(0.5);
 
 void BM_Map12MP(benchmark::State& state) {
-  static const Scene scene(4056, 3040, 7);
+  static const Scene scene(4056, 3040, 6);  // the default working size's 676x506
   RefineConfig config;
   config.width = scene.w, config.height = scene.h;
   config.work_scale = scene.scale, config.work_width = scene.ww, config.work_height = scene.wh;
