@@ -5,8 +5,8 @@
 // Synthetic bursts of a rig whose geometry is known (the command line's 64 labels over the
 // scene's range), at 1280x960 and 12 MP (4056x3040), so the figure is the map's and not the
 // camera motion's; handheld bursts through the board's default path (auto geometry, 32 labels)
-// are scored too and printed, not bounded: there the motion's small errors bend the map away
-// from an affine function of inverse depth (docs/accuracy.md). Two enlargements are scored:
+// are scored too and printed, not bounded: there one of the 32 labels is about twice the
+// tolerance (docs/accuracy.md). Two enlargements are scored:
 // bilinear (what a viewer that knows nothing of the photo does) and the product's, guided by the
 // photo, each pixel on a depth edge taking one side (depth_upsample.h, the map's own making);
 // the bounds hold for the product's. The depth stage's own grid is what photos carried before
