@@ -169,6 +169,7 @@ Status Pipeline::Carve(Arena& arena) {
   rgb_rows_[0] = arena.Allocate<uint8_t>(static_cast<size_t>(c.width) * 3);
   rgb_rows_[1] = arena.Allocate<uint8_t>(static_cast<size_t>(c.width) * 3);
   cols_ = arena.Allocate<uint32_t>(static_cast<size_t>(work_w_) * scale_ * 3);
+  trim_.Carve(arena, work_w_, c.workers);
   const bool depth = HasDepth(work_w_, work_h_), motion = UsesMotion(c, work_w_, work_h_);
   if (motion) planes_ = arena.Allocate<PlaneHomography>(static_cast<size_t>(c.frames) * c.labels);
   // The stages share one region, each in memory the one before is done with: the depth stage
@@ -245,6 +246,7 @@ void Pipeline::SetRunner(TaskRunner* runner) {
   motion_.SetRunner(runner);
   render_.SetRunner(runner);
   refine_.SetRunner(runner);
+  trim_.SetRunner(runner);
 }
 
 RefineConfig Pipeline::MakeRefineConfig() const {
@@ -471,8 +473,14 @@ Status Pipeline::ComputeDepth() {
     LB_RETURN_IF_ERROR(OrderDepth(views, planes_, order_scratch_, &depth_, &motion_,
                                   &motion_result_, disp_q8_, nullptr));
   }
-  // The map's own range: a signed one is lifted by the stage's bias (depth_stage.h).
+  // Near and far are settled: the near side's overreach goes back (fattening_trim.h), from a
+  // copy in the depth stage's census, which is free until the next burst.
   const DepthConfig& d = depth_.config();
+  const ImageU16 copy = MakeView(reinterpret_cast<uint16_t*>(depth_.spare()), work_w_, work_h_);
+  for (int32_t y = 0; y < work_h_; ++y)
+    memcpy(copy.Row(y), disp_q8_.Row(y), static_cast<size_t>(work_w_) * sizeof(uint16_t));
+  trim_.Run(views[config_.reference], copy.AsConst(), disp_q8_, FatteningTrim::LabelStepQ8(d));
+  // The map's own range: a signed one is lifted by the stage's bias (depth_stage.h).
   disp_min_q8_ = d.disp_min_q8 + DepthStage::MapBiasQ8(d);
   disp_max_q8_ = d.disp_max_q8 + DepthStage::MapBiasQ8(d);
   MakeMap(false);

@@ -22,6 +22,7 @@
 #include "algo/core/status.h"
 #include "algo/core/task_runner.h"
 #include "algo/depth/depth_stage.h"
+#include "algo/depth/fattening_trim.h"
 #include "algo/motion/camera.h"
 #include "algo/motion/motion_stage.h"
 #include "algo/render/depth_refine.h"
@@ -187,6 +188,7 @@ class Pipeline : public FrameSink {
   uint32_t* cols_ = nullptr;  // box downscale: column sums, working row x scale x 3 (ingest.h)
   DepthStage depth_;
   RenderStage render_;
+  FatteningTrim trim_;
   DepthRefiner refine_;
   uint8_t* region_ = nullptr;  // the stages' shared region
   size_t region_bytes_ = 0, analysis_bytes_ = 0;

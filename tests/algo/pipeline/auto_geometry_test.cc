@@ -26,6 +26,7 @@
 #include "tests/algo/depth/fit_score.h"
 #include "tests/algo/depth/middlebury.h"
 #include "tests/algo/motion/burst.h"
+#include "tests/algo/pipeline/pipeline_depth.h"
 
 namespace lb {
 namespace {
@@ -84,6 +85,7 @@ Status SignedPlaneDepth(const std::vector<ConstImageU8>& views, const MotionResu
   std::vector<uint8_t> scratch(DepthOrderScratchBytes(c.width, c.height));
   LB_RETURN_IF_ERROR(OrderDepth(views.data(), planes.data(), scratch.data(), &stage, nullptr,
                                 nullptr, image, nullptr));
+  TrimAsThePipelineDoes(views[static_cast<size_t>(c.reference)], image, stage.config());
   const int32_t bias = DepthStage::MapBiasQ8(stage.config());
   out->resize(map.size());
   for (size_t i = 0; i < map.size(); ++i) (*out)[i] = static_cast<float>(map[i] - bias) / 256.0f;

@@ -23,6 +23,7 @@
 #include "algo/pipeline/planes.h"
 #include "tests/algo/depth/hci.h"
 #include "tests/algo/depth/middlebury.h"
+#include "tests/algo/pipeline/pipeline_depth.h"
 
 namespace lb {
 namespace {
@@ -150,6 +151,7 @@ Status AutoDepth(const hci::Burst& b, double focal_35mm, std::vector<float>* out
   std::vector<uint8_t> scratch(DepthOrderScratchBytes(b.width, b.height));
   LB_RETURN_IF_ERROR(
       OrderDepth(views.data(), planes.data(), scratch.data(), &stage, &motion, m, image, reversed));
+  TrimAsThePipelineDoes(views[static_cast<size_t>(b.reference)], image, stage.config());
   const int32_t bias = DepthStage::MapBiasQ8(stage.config());
   out->resize(map.size());
   for (size_t i = 0; i < map.size(); ++i) (*out)[i] = static_cast<float>(map[i] - bias) / 256.0f;

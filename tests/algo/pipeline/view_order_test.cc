@@ -21,6 +21,7 @@
 #include "tests/algo/depth/fit_score.h"
 #include "tests/algo/depth/hci.h"
 #include "tests/algo/depth/middlebury.h"
+#include "tests/algo/pipeline/pipeline_depth.h"
 
 namespace lb {
 namespace {
@@ -84,6 +85,7 @@ Status AutoDepth(const Scene& s, const std::vector<ConstImageU8>& views, int32_t
   std::vector<uint8_t> scratch(DepthOrderScratchBytes(c.width, c.height));
   LB_RETURN_IF_ERROR(
       OrderDepth(views.data(), planes.data(), scratch.data(), &stage, &motion, &m, image, nullptr));
+  TrimAsThePipelineDoes(views[static_cast<size_t>(reference)], image, stage.config());
   const int32_t bias = DepthStage::MapBiasQ8(stage.config());
   out->resize(map.size());
   for (size_t i = 0; i < map.size(); ++i) (*out)[i] = static_cast<float>(map[i] - bias) / 256.0f;

@@ -5,6 +5,7 @@
 // depth_planes_accuracy_test prints), in CPU time.
 //   build/host/tests/bench/depth/depth_bench --benchmark_counters_tabular=true
 // BM_TeddyOverSgbm and BM_HandheldPlanesOverRectified give the ratios, alternated call by call.
+// BM_FatteningTrimTeddy: the trim of the near side's overreach on teddy's map.
 // BM_HandheldPlanesTwoWorkers: the plane sweep with two workers, the winner-take-all striped
 // against one stripe.
 #include <benchmark/benchmark.h>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include "algo/depth/depth_stage.h"
+#include "algo/depth/fattening_trim.h"
 #include "firmware/platform/worker_pool.h"
 #include "tests/algo/depth/handheld.h"
 #include "tests/algo/depth/middlebury.h"
@@ -89,6 +91,59 @@ void BM_DepthStageTeddy(benchmark::State& state) {
 }
 // Arg 0: the label disparities (what refocus depth writes); 1: with the sub-label refinement.
 BENCHMARK(BM_DepthStageTeddy)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->MinTime(3.0);
+
+// The trim of the near side's overreach (fattening_trim.h) on teddy's map, as the pipeline runs
+// it after the stage, on 1 and 2 workers; the stage's own time is BM_DepthStageTeddy/1.
+void BM_FatteningTrimTeddy(benchmark::State& state) {
+  const middlebury::Set* set = Teddy();
+  if (!set) {
+    state.SkipWithError("../shared/data/middlebury/teddy is absent");
+    return;
+  }
+  const DepthConfig c = TeddyConfig(*set);
+  const size_t bytes = DepthStage::RequiredBytes(c);
+  std::vector<uint8_t> memory(bytes + Arena::kAlign);
+  Arena arena(Arena::AlignUp(memory.data()), bytes);
+  DepthStage stage;
+  const std::vector<ConstImageU8> views = set->Views();
+  std::vector<uint16_t> map(static_cast<size_t>(c.width) * c.height);
+  if (!stage.Configure(c, arena).ok() ||
+      !stage.Compute(views.data(), MakeView(map.data(), c.width, c.height)).ok()) {
+    state.SkipWithError("the depth stage failed");
+    return;
+  }
+  const int32_t workers = static_cast<int32_t>(state.range(0));
+  const size_t trim_bytes = FatteningTrim::RequiredBytes(c.width, workers);
+  std::vector<uint8_t> rows(trim_bytes + Arena::kAlign);
+  Arena rows_arena(Arena::AlignUp(rows.data()), trim_bytes);
+  FatteningTrim trim;
+  trim.Carve(rows_arena, c.width, workers);
+  WorkerPool pool;
+  if (!pool.Start(workers).ok()) {
+    state.SkipWithError("no workers");
+    return;
+  }
+  trim.SetRunner(&pool);
+  std::vector<uint16_t> disp(map.size());
+  int64_t moved = 0;
+  for (auto _ : state) {
+    moved = trim.Run(views[static_cast<size_t>(c.reference)],
+                     MakeView(map.data(), c.width, c.height).AsConst(),
+                     MakeView(disp.data(), c.width, c.height), FatteningTrim::LabelStepQ8(c));
+    benchmark::DoNotOptimize(disp.data());
+  }
+  state.counters["moved_pct"] =
+      100.0 * static_cast<double>(moved) / static_cast<double>(map.size());
+  state.counters["s_per_px"] = benchmark::Counter(
+      static_cast<double>(map.size()),
+      benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_FatteningTrimTeddy)
+    ->Arg(1)
+    ->Arg(2)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2.0);
 
 // The 640x480, 7 views, 64 labels configuration the memory bound is stated for, on teddy's
 // views cropped/tiled to that size (time only; there is no ground truth at this size).
