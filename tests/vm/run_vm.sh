@@ -198,17 +198,28 @@ chmod +x "$root/init"
 (cd "$root" && find . | cpio -o -H newc --quiet) | gzip -1 >"$work/initramfs.gz"
 cp "$kroot/boot/vmlinuz-$version" "$work/vmlinuz"
 
-log "booting $version with: ${names[*]}"
-start=$(date +%s)
-set +e
-timeout "$timeout_s" qemu-system-x86_64 -accel tcg -m 512M -smp 1 -nographic -no-reboot \
-  -kernel "$work/vmlinuz" -initrd "$work/initramfs.gz" \
-  -append "console=ttyS0 rdinit=/init panic=-1 quiet loglevel=3" </dev/null >"$work/console.log" 2>&1
-qemu_status=$?
-set -e
-tr -d '\r' <"$work/console.log" >"$work/console.txt"
-cat "$work/console.txt"
-log "VM ran $(($(date +%s) - start)) s (qemu status $qemu_status)"
+for attempt in 1 2; do
+  log "booting $version with: ${names[*]}"
+  start=$(date +%s)
+  set +e
+  timeout "$timeout_s" qemu-system-x86_64 -accel tcg -m 512M -smp 1 -nographic -no-reboot \
+    -kernel "$work/vmlinuz" -initrd "$work/initramfs.gz" \
+    -append "console=ttyS0 rdinit=/init panic=-1 quiet loglevel=3" </dev/null >"$work/console.log" 2>&1
+  qemu_status=$?
+  set -e
+  tr -d '\r' <"$work/console.log" >"$work/console.txt"
+  cat "$work/console.txt"
+  log "VM ran $(($(date +%s) - start)) s (qemu status $qemu_status)"
+  # Out of time with no test failed: booted once more. Emulated on one loaded core, the VM has
+  # stalled inside libcamera's configure of vimc for the whole timeout, where it takes seconds.
+  # A second timeout, or any test's failure, still fails.
+  if ((attempt == 1 && qemu_status == 124)) &&
+    ! grep -Eq '^LBVM-RESULT [^ ]+ [1-9][0-9]*$' "$work/console.txt"; then
+    log "the VM ran out of time with no test failed: booting it once more"
+    continue
+  fi
+  break
+done
 
 passed=0 failed=0
 for t in "${names[@]}"; do
