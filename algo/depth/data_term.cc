@@ -78,7 +78,7 @@ void DataTerm::SetRunner(TaskRunner* runner) {
 void DataTerm::SetParams(const DataTermParams& params, int32_t reference) {
   params_ = params;
   reference_ = reference;
-  const int32_t c = params.color_trunc + kCensusBits * params.census_weight;
+  const int32_t c = params.color_trunc + kCensusBits * params.census_weight + 1;
   invalid_cost_ = c > 255 ? 255 : c;
 }
 
@@ -405,7 +405,8 @@ void DataTerm::ComputeRunBand(const Scratch& s, int32_t disp_q8, const RowRuns* 
     // The ring's three rows of each view are y - 1 .. y + 1.
     for (int32_t k = 0; k < runs[y].count; ++k) {
       const int32_t x0 = runs[y].x[2 * k], x1 = runs[y].x[2 * k + 1];
-      if (x0 < x1) kernels_->select(s.hsum, w, others, x0, x1, out + (y - y0) * stride);
+      if (x0 < x1)
+        kernels_->select(s.hsum, w, others, 9 * invalid_cost_, x0, x1, out + (y - y0) * stride);
     }
   }
 }
@@ -433,7 +434,7 @@ void DataTerm::ComputeBand(const Scratch& s, const PlaneHomography* planes, uint
     // prefetcher follows), and the winner-take-all's bands keep them in cache from one label to
     // the next; asking again cost more than it saved (teddy's shifts, as the plane sweep).
     // The ring's three rows of each view are y - 1 .. y + 1, in any order.
-    kernels_->select(hsum, w, others, x0, x1, out + (y - y0) * stride);
+    kernels_->select(hsum, w, others, 9 * invalid_cost_, x0, x1, out + (y - y0) * stride);
   }
 }
 

@@ -5,8 +5,12 @@
 // interpolation (the shift is the same for the whole image, so one Q8 fraction per view and
 // label); the pixel cost is a truncated absolute colour difference plus a census (5x5, 24 bits)
 // Hamming distance interpolated the same way, capped at 255. Costs are summed over 3x3 per view.
-// Across views: the mean of the best half, so views in which p is occluded (about half of them
-// at most, on one side) do not dominate. Out-of-image samples cost the largest valid pixel cost.
+// Across views: the mean of the best half of the views that see p, so views in which p is
+// occluded (about half of them at most, on one side) do not dominate. A sample outside its view
+// costs one more than the worst match (DataTerm::invalid_cost), so a window of nine of them is
+// told apart: that view does not see p at this label and is left out. Counting it at a high
+// price instead made every label that shifts more views past the frame dearer, and pushed the
+// frame's edges far.
 //
 // Range: pixel cost 0..255, window sum 0..2295, D (a mean of window sums) 0..2295, uint16.
 // No costs are stored: each call computes the rows it is asked for, through a 3-row ring.
@@ -111,7 +115,9 @@ class DataTerm {
   // calls (borrowed; disp_q8 is then ignored), or nullptr for the rectified shifts.
   void SetPlanes(const PlaneHomography* per_view) { planes_ = per_view; }
 
-  // The pixel cost cap (what an out-of-image sample costs).
+  // What an out-of-image sample costs: one more than the worst match (color_trunc + 24 *
+  // census_weight), at most 255. DepthConfig keeps that sum below 255; above, the worst matches
+  // cost as much as the outside and a window of them counts as not seeing.
   int32_t invalid_cost() const { return invalid_cost_; }
   // Census of a view: per row, three planes of `width` bytes (neighbours 0-7, 8-15, 16-23 in
   // raster order, the first one in the top bit).

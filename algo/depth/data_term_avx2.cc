@@ -368,55 +368,78 @@ LB_AVX2 inline void SortNetwork(__m256i* v) {
   }
 }
 
-// 16 columns: view j's rows at view[j], view[j] + stride, view[j] + 2 * stride.
+// 16 columns: view j's rows at view[j], view[j] + stride, view[j] + 2 * stride. False, with
+// nothing stored, when a lane has a view that does not see it (a window of `unseen`, the sorted
+// maximum): those columns keep fewer windows, which the reference counts lane by lane. Rare: a
+// border strip as wide as the label's shift.
 template <int32_t kKeep, int32_t kB>
-LB_AVX2 inline __attribute__((always_inline)) void SelectStep(const uint16_t* const* view,
+LB_AVX2 inline __attribute__((always_inline)) bool SelectStep(const uint16_t* const* view,
                                                               ptrdiff_t at, ptrdiff_t stride,
-                                                              __m256i recip, uint16_t* out) {
+                                                              __m256i recip, __m256i below_unseen,
+                                                              uint16_t* out) {
   __m256i a[kKeep], b[kB + (kB == 0 ? 1 : 0)];  // no empty array when kKeep is 1
   for (int32_t j = 0; j < kKeep; ++j) a[j] = Window(view[j] + at, stride);
   for (int32_t j = 0; j < kB; ++j) b[j] = Window(view[kKeep + j] + at, stride);
   SortNetwork<kKeep>(a);
   SortNetwork<kB>(b);
+  if constexpr (kKeep > 1) {  // one or two views keep one window whatever they see
+    const __m256i most = kB > 0 ? _mm256_max_epi16(a[kKeep - 1], b[kB - 1]) : a[kKeep - 1];
+    if (!_mm256_testz_si256(_mm256_cmpgt_epi16(most, below_unseen), most)) return false;
+  }
   __m256i sum = a[0];
   if constexpr (kB == kKeep) sum = _mm256_min_epi16(a[0], b[kKeep - 1]);
   for (int32_t i = 1; i < kKeep; ++i) {
     sum = _mm256_add_epi16(sum, _mm256_min_epi16(a[i], b[kKeep - 1 - i]));
   }
   Store(out, kKeep == 1 ? sum : _mm256_mulhrs_epi16(sum, recip));
+  return true;
+}
+
+// Columns x..x + 15: SelectStep, or the reference where it declines.
+template <int32_t kKeep, int32_t kB>
+LB_AVX2 inline __attribute__((always_inline)) void Step(const uint16_t* ring, ptrdiff_t stride,
+                                                        int32_t unseen, const uint16_t* const* view,
+                                                        ptrdiff_t at, __m256i recip, __m256i below,
+                                                        int32_t x, uint16_t* out) {
+  if (!SelectStep<kKeep, kB>(view, at, stride, recip, below, out + x)) {
+    SelectRowC(ring, stride, kKeep + kB, unseen, x, x + 16, out);
+  }
 }
 
 // Whole steps with each view's pointer moved along (no address arithmetic per view and step),
 // then one step overlapping the one before.
 template <int32_t kKeep, int32_t kB>
-LB_AVX2 void SelectRowAvx2T(const uint16_t* ring, ptrdiff_t stride, int32_t x0, int32_t x1,
-                            uint16_t* out) {
+LB_AVX2 void SelectRowAvx2T(const uint16_t* ring, ptrdiff_t stride, int32_t unseen, int32_t x0,
+                            int32_t x1, uint16_t* out) {
   constexpr int32_t kViews = kKeep + kB;
   const __m256i recip = _mm256_set1_epi16(static_cast<int16_t>(RecipQ15(kKeep)));
+  const __m256i below = _mm256_set1_epi16(static_cast<int16_t>(unseen - 1));
   const uint16_t* view[kViews];
   for (int32_t j = 0; j < kViews; ++j) view[j] = ring + 3 * j * stride + x0;
   int32_t x = x0;
   for (; x + 32 <= x1; x += 32) {  // two steps a turn: the pointers move half as often
-    SelectStep<kKeep, kB>(view, 0, stride, recip, out + x);
-    SelectStep<kKeep, kB>(view, 16, stride, recip, out + x + 16);
+    Step<kKeep, kB>(ring, stride, unseen, view, 0, recip, below, x, out);
+    Step<kKeep, kB>(ring, stride, unseen, view, 16, recip, below, x + 16, out);
     for (int32_t j = 0; j < kViews; ++j) view[j] += 32;
   }
   if (x + 16 <= x1) {
-    SelectStep<kKeep, kB>(view, 0, stride, recip, out + x);
+    Step<kKeep, kB>(ring, stride, unseen, view, 0, recip, below, x, out);
     x += 16;
   }
   if (x < x1) {
     for (int32_t j = 0; j < kViews; ++j) view[j] = ring + 3 * j * stride + x1 - 16;
-    SelectStep<kKeep, kB>(view, 0, stride, recip, out + x1 - 16);
+    Step<kKeep, kB>(ring, stride, unseen, view, 0, recip, below, x1 - 16, out);
   }
 }
 
 template <int32_t kKeep>
-LB_AVX2 void SelectRowAvx2T(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t x0,
-                            int32_t x1, uint16_t* out) {
-  if (x1 - x0 < 16) return SelectRowC(ring, stride, others, x0, x1, out);
-  if (others == 2 * kKeep) return SelectRowAvx2T<kKeep, kKeep>(ring, stride, x0, x1, out);
-  SelectRowAvx2T<kKeep, kKeep - 1>(ring, stride, x0, x1, out);
+LB_AVX2 void SelectRowAvx2T(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t unseen,
+                            int32_t x0, int32_t x1, uint16_t* out) {
+  if (x1 - x0 < 16) return SelectRowC(ring, stride, others, unseen, x0, x1, out);
+  if (others == 2 * kKeep) {
+    return SelectRowAvx2T<kKeep, kKeep>(ring, stride, unseen, x0, x1, out);
+  }
+  SelectRowAvx2T<kKeep, kKeep - 1>(ring, stride, unseen, x0, x1, out);
 }
 
 // The instance for each kept count (others + 1) / 2 = 1 .. kMaxBest.

@@ -87,9 +87,10 @@ struct DataTerm::Kernels {
                ptrdiff_t plane, int32_t n, int32_t f, int32_t trunc, int32_t cw, uint8_t* out);
   void (*hsum)(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum);
   // D of columns x0..x1-1 from the ring of 3-sums: other view j's three rows (in any order: only
-  // their sum counts) at ring + (3 * j + k) * stride, k = 0..2.
-  void (*select)(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t x0, int32_t x1,
-                 uint16_t* out);
+  // their sum counts) at ring + (3 * j + k) * stride, k = 0..2. A window summing to `unseen` (9
+  // out-of-image samples) is a view that does not see the pixel (SelectRowC).
+  void (*select)(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t unseen, int32_t x0,
+                 int32_t x1, uint16_t* out);
   // The rectified data term's row for every other view (dtk::RectRow): cost and hsum fused.
   void (*rect_row)(const dtk::RectRow& row);
   PlaneSpanFn plane;  // the plane sweep's pixel costs, a run of spans (warp_cost.h)
@@ -106,13 +107,13 @@ namespace dtk {
 inline constexpr int32_t kMaxBest = 8;  // best half of up to 15 other views
 // A select kernel (the signature of Kernels::select); the SIMD twins keep one instance per
 // kept count, 1 .. kMaxBest, in a table.
-using SelectRowFn = void (*)(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t x0,
-                             int32_t x1, uint16_t* out);
+using SelectRowFn = void (*)(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t unseen,
+                             int32_t x0, int32_t x1, uint16_t* out);
 // The select kernel that runs the instance of `by_keep` (kMaxBest entries) for the kept count.
 template <const SelectRowFn* by_keep>
-void SelectByKeep(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t x0, int32_t x1,
-                  uint16_t* out) {
-  by_keep[(others + 1) / 2 - 1](ring, stride, others, x0, x1, out);
+void SelectByKeep(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t unseen,
+                  int32_t x0, int32_t x1, uint16_t* out) {
+  by_keep[(others + 1) / 2 - 1](ring, stride, others, unseen, x0, x1, out);
 }
 
 // Q15 reciprocal of `keep`: the mean of the kept sums, rounded (error < 1 for D <= 2295).
@@ -149,8 +150,8 @@ void PlaneLanesAvx2(const uint8_t* ref, const uint8_t* cref, int32_t width, int3
 void PlaneSpansNeon(const WarpRow& row, const WarpRun& run, uint8_t* out);
 #endif
 void HSumRowC(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum);
-void SelectRowC(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t x0, int32_t x1,
-                uint16_t* out);
+void SelectRowC(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t unseen, int32_t x0,
+                int32_t x1, uint16_t* out);
 
 extern const DataTerm::Kernels kReference;
 // Each table when this build has it, else nullptr: AVX2 intrinsics (x86-64, also checked with

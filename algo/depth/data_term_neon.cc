@@ -170,10 +170,13 @@ inline void SortNetwork(int16x8_t* v) {
 
 // As the AVX2 kernel: the first kKeep windows and the other kB sorted apart, the kept sum that
 // of min(A_i, B_(kKeep-1-i)); vqrdmulh is (2 * sum * recip + 2^15) >> 16 =
-// (sum * recip + 2^14) >> 15.
+// (sum * recip + 2^14) >> 15. A step with a lane whose sorted maximum is `unseen` (a view that
+// does not see it) goes to the reference, which keeps fewer windows there.
 template <int32_t kKeep, int32_t kB>
-void SelectRowNeonT(const uint16_t* ring, ptrdiff_t stride, int32_t x0, int32_t x1, uint16_t* out) {
+void SelectRowNeonT(const uint16_t* ring, ptrdiff_t stride, int32_t unseen, int32_t x0, int32_t x1,
+                    uint16_t* out) {
   const int16x8_t recip = vdupq_n_s16(static_cast<int16_t>(kKeep == 1 ? 0 : RecipQ15(kKeep)));
+  const int16x8_t below = vdupq_n_s16(static_cast<int16_t>(unseen - 1));
   for (int32_t step = x0; step < x1; step += 8) {
     const int32_t x = step + 8 <= x1 ? step : x1 - 8;
     int16x8_t a[kKeep], b[kB + (kB == 0 ? 1 : 0)];  // no empty array when kKeep is 1
@@ -181,6 +184,15 @@ void SelectRowNeonT(const uint16_t* ring, ptrdiff_t stride, int32_t x0, int32_t 
     for (int32_t j = 0; j < kB; ++j) b[j] = Window(ring, stride, kKeep + j, x);
     SortNetwork<kKeep>(a);
     SortNetwork<kB>(b);
+    if constexpr (kKeep > 1) {  // one or two views keep one window whatever they see
+      const int16x8_t most = kB > 0 ? vmaxq_s16(a[kKeep - 1], b[kB - 1]) : a[kKeep - 1];
+      const uint16x8_t over = vcgtq_s16(most, below);
+      const uint16x4_t any = vorr_u16(vget_low_u16(over), vget_high_u16(over));
+      if (vget_lane_u64(vreinterpret_u64_u16(any), 0) != 0) {
+        SelectRowC(ring, stride, kKeep + kB, unseen, x, x + 8, out);
+        continue;
+      }
+    }
     int16x8_t sum = a[0];
     if constexpr (kB == kKeep) sum = vminq_s16(a[0], b[kKeep - 1]);
     for (int32_t i = 1; i < kKeep; ++i) sum = vaddq_s16(sum, vminq_s16(a[i], b[kKeep - 1 - i]));
@@ -189,11 +201,11 @@ void SelectRowNeonT(const uint16_t* ring, ptrdiff_t stride, int32_t x0, int32_t 
 }
 
 template <int32_t kKeep>
-void SelectRowNeonT(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t x0, int32_t x1,
-                    uint16_t* out) {
-  if (x1 - x0 < 8) return SelectRowC(ring, stride, others, x0, x1, out);
-  if (others == 2 * kKeep) return SelectRowNeonT<kKeep, kKeep>(ring, stride, x0, x1, out);
-  SelectRowNeonT<kKeep, kKeep - 1>(ring, stride, x0, x1, out);
+void SelectRowNeonT(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t unseen,
+                    int32_t x0, int32_t x1, uint16_t* out) {
+  if (x1 - x0 < 8) return SelectRowC(ring, stride, others, unseen, x0, x1, out);
+  if (others == 2 * kKeep) return SelectRowNeonT<kKeep, kKeep>(ring, stride, unseen, x0, x1, out);
+  SelectRowNeonT<kKeep, kKeep - 1>(ring, stride, unseen, x0, x1, out);
 }
 
 // The instance for each kept count (others + 1) / 2 = 1 .. kMaxBest.

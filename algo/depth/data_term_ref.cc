@@ -124,24 +124,26 @@ void HSumRowC(const uint8_t* cost, int32_t x0, int32_t x1, uint16_t* hsum) {
 }
 
 // Per pixel: window sums (3 ring rows per other view, <= 2295), the mean of the smallest
-// (others + 1) / 2 of them. The kept sum is <= 8 * 2295, so 32-bit products are exact.
-// Chunks of 16 pixels so that the sorted-list insertion (a min/max chain) vectorises.
-void SelectRowC(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t x0, int32_t x1,
-                uint16_t* out) {
+// (n + 1) / 2 of them, n the views that see the pixel (whose window is below `unseen`; all
+// `others` when none does). The kept sum is <= 8 * 2295, so 32-bit products are exact. Chunks of
+// 16 pixels so that the sorted-list insertion (a min/max chain) vectorises.
+void SelectRowC(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t unseen, int32_t x0,
+                int32_t x1, uint16_t* out) {
   constexpr int32_t kChunk = 16;
-  const int32_t keep = (others + 1) / 2;
-  const uint32_t recip_q15 = RecipQ15(keep);
+  const int32_t most = (others + 1) / 2;
   for (int32_t xs = x0; xs < x1; xs += kChunk) {
     const int32_t n = x1 - xs < kChunk ? x1 - xs : kChunk;
     uint16_t best[kMaxBest][kChunk] = {};  // sorted, ascending
-    for (int32_t i = 0; i < keep; ++i)
+    int32_t seen[kChunk] = {};
+    for (int32_t i = 0; i < most; ++i)
       for (int32_t l = 0; l < kChunk; ++l) best[i][l] = UINT16_MAX;
     for (int32_t j = 0; j < others; ++j) {
       uint16_t a[kChunk] = {};
       const uint16_t* r0 = ring + 3 * j * stride + xs;
       const uint16_t *r1 = r0 + stride, *r2 = r0 + 2 * stride;
       for (int32_t l = 0; l < n; ++l) a[l] = static_cast<uint16_t>(r0[l] + r1[l] + r2[l]);
-      for (int32_t i = 0; i < keep; ++i) {
+      for (int32_t l = 0; l < kChunk; ++l) seen[l] += a[l] < unseen ? 1 : 0;
+      for (int32_t i = 0; i < most; ++i) {
         for (int32_t l = 0; l < kChunk; ++l) {
           const uint16_t lo = best[i][l] < a[l] ? best[i][l] : a[l];
           a[l] = best[i][l] < a[l] ? a[l] : best[i][l];
@@ -150,9 +152,10 @@ void SelectRowC(const uint16_t* ring, ptrdiff_t stride, int32_t others, int32_t 
       }
     }
     for (int32_t l = 0; l < n; ++l) {
+      const int32_t keep = seen[l] > 0 ? (seen[l] + 1) / 2 : most;
       uint32_t sum = 0;
       for (int32_t i = 0; i < keep; ++i) sum += best[i][l];
-      out[xs + l] = static_cast<uint16_t>((sum * recip_q15 + (1u << 14)) >> 15);
+      out[xs + l] = static_cast<uint16_t>((sum * RecipQ15(keep) + (1u << 14)) >> 15);
     }
   }
 }

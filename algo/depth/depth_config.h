@@ -24,7 +24,9 @@ struct DepthConfig {
   ViewGeometry geometry = ViewGeometry::kRectified;  // or kKnownPoses
 
   // Data term (see data_term.h).
-  int32_t color_trunc = 45;   // truncation of |dR|+|dG|+|dB|, 1..765
+  // color_trunc + 24 * census_weight is at most 254: the data term prices a sample outside its
+  // view one above the worst match, to know the views that do not see a pixel.
+  int32_t color_trunc = 45;   // truncation of |dR|+|dG|+|dB|, 1..254
   int32_t census_weight = 4;  // cost per differing census bit, 0..10
   // Smoothness V(a, b) = w_pq * min(|a - b|, smooth_trunc) over label indices: truncated linear,
   // Potts when smooth_trunc is 1. w_pq is smooth_weight where the reference is flat and

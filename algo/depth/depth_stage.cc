@@ -48,11 +48,12 @@ Status DepthStage::Validate(const DepthConfig& c) {
   }
   // These bounds keep every node's terminal balance far below GridMaxflow::kMaxCapacity:
   // |balance| <= 2295 + 8 * 4096 * 64.
-  if (c.color_trunc < 1 || c.color_trunc > 765 || c.census_weight < 0 || c.census_weight > 10 ||
-      c.smooth_weight < 0 || c.smooth_weight > 4096 || c.smooth_trunc < 1 || c.smooth_trunc > 64 ||
-      c.edge_threshold < 0 || c.edge_threshold > 255 || c.edge_weight_q8 < 0 ||
-      c.edge_weight_q8 > 256 || c.max_cycles < 0 || c.max_cycles > 32 || c.coarse_step < 1 ||
-      c.coarse_step > 16 || c.fine_window < 1 || c.fine_window > 255) {
+  if (c.color_trunc < 1 || c.census_weight < 0 || c.census_weight > 10 ||
+      c.color_trunc + DataTerm::kCensusBits * c.census_weight > 254 || c.smooth_weight < 0 ||
+      c.smooth_weight > 4096 || c.smooth_trunc < 1 || c.smooth_trunc > 64 || c.edge_threshold < 0 ||
+      c.edge_threshold > 255 || c.edge_weight_q8 < 0 || c.edge_weight_q8 > 256 ||
+      c.max_cycles < 0 || c.max_cycles > 32 || c.coarse_step < 1 || c.coarse_step > 16 ||
+      c.fine_window < 1 || c.fine_window > 255) {
     return Status(Code::kInvalidArgument,
                   "depth: cost parameters out of range (colour %d, census %d, smoothness %d "
                   "trunc %d edge %d/%d, cycles %d, coarse step %d window %d)",

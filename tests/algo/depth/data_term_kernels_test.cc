@@ -174,23 +174,64 @@ TEST(DataTermKernels, SelectVariantsEqualTheReference) {
   std::mt19937 rng(14);
   for (int32_t w : kWidths) {
     for (int32_t others = 1; others <= 15; ++others) {
-      const int32_t kind = static_cast<int32_t>(rng() % 3);
-      // Horizontal 3-sums 0..765: random, or all at the cap (window sums of 2295), or 0 / 765.
+      const int32_t kind = static_cast<int32_t>(rng() % 4);
+      // Horizontal 3-sums 0..765: random, or all at the cap (window sums of 2295), or 0 / 765;
+      // or 0..423 (a pixel cost cap of 141) with views that do not see a run of columns (3-sums
+      // of 423 on all three rows: a window of `unseen`).
       // The ring: 3 rows per view, `stride` apart (a little more than the row).
       const ptrdiff_t stride = w + 3;
+      const int32_t unseen = kind == 3 ? 9 * 141 : 2295;
       std::vector<uint16_t> ring(static_cast<size_t>(3 * others * stride));
       for (uint16_t& s : ring) {
         const uint32_t v = rng();
-        s = static_cast<uint16_t>(kind == 0 ? v % 766 : kind == 1 ? 765 : (v & 1) * 765);
+        s = static_cast<uint16_t>(kind == 0   ? v % 766
+                                  : kind == 1 ? 765
+                                  : kind == 2 ? (v & 1) * 765
+                                              : v % 424);
+      }
+      for (int32_t j = 0; kind == 3 && j < others; ++j) {
+        if (rng() % 2 == 0) continue;
+        const int32_t a = static_cast<int32_t>(rng() % w), b = static_cast<int32_t>(rng() % w);
+        for (int32_t k = 0; k < 3; ++k)
+          for (int32_t x = std::min(a, b); x <= std::max(a, b); ++x)
+            ring[(3 * j + k) * stride + x] = 423;
       }
       const int32_t x0 = static_cast<int32_t>(rng() % w);
       std::vector<uint16_t> want(w, 0xbeef);
-      dtk::kReference.select(ring.data(), stride, others, x0, w, want.data());
+      dtk::kReference.select(ring.data(), stride, others, unseen, x0, w, want.data());
       for (const dtk::Variant& v : Others()) {
         std::vector<uint16_t> got(w, 0xbeef);
-        v.kernels->select(ring.data(), stride, others, x0, w, got.data());
+        v.kernels->select(ring.data(), stride, others, unseen, x0, w, got.data());
         ASSERT_EQ(got, want) << v.name << " w " << w << " others " << others << " kind " << kind;
       }
+    }
+  }
+}
+
+// Four other views, two of which see a column: the better of those two (the best half of the
+// views that see it); where all four see it, the mean of the best two; where none, `unseen`.
+TEST(DataTermKernels, ViewsThatDoNotSeeAPixelAreLeftOut) {
+  constexpr int32_t kW = 40, kUnseen = 9 * 141;
+  const ptrdiff_t stride = kW;
+  std::vector<uint16_t> ring(static_cast<size_t>(3 * 4 * stride));
+  auto window = [&](int32_t view, int32_t x, int32_t sum) {  // three rows, sum / 3 each
+    for (int32_t k = 0; k < 3; ++k)
+      ring[(3 * view + k) * stride + x] = static_cast<uint16_t>(sum / 3);
+  };
+  for (int32_t x = 0; x < kW; ++x) {
+    window(0, x, x < 30 ? 300 : kUnseen);
+    window(1, x, x < 30 ? 600 : kUnseen);
+    window(2, x, x < 10 ? 900 : kUnseen);
+    window(3, x, x < 10 ? 1200 : kUnseen);
+  }
+  dtk::Variant variants[dtk::kMaxVariants];
+  const int32_t n = dtk::Variants(variants);
+  for (int32_t i = 0; i < n; ++i) {
+    std::vector<uint16_t> d(kW, 0);
+    variants[i].kernels->select(ring.data(), stride, 4, kUnseen, 0, kW, d.data());
+    for (int32_t x = 0; x < kW; ++x) {
+      const int32_t want = x < 10 ? 450 : x < 30 ? 300 : kUnseen;
+      ASSERT_EQ(d[x], want) << variants[i].name << " column " << x;
     }
   }
 }

@@ -48,11 +48,13 @@ std::vector<float> ReferenceDataTerm(const std::vector<ConstImageU8>& views, int
   std::vector<std::vector<uint32_t>> census;
   for (const auto& v : views) census.push_back(ReferenceCensus(v));
   const float invalid =
-      std::min(255.0f, static_cast<float>(params.color_trunc + 24 * params.census_weight));
-  std::vector<std::vector<float>> pixel;  // per other view
+      std::min(255.0f, static_cast<float>(params.color_trunc + 24 * params.census_weight + 1));
+  std::vector<std::vector<float>> pixel;   // per other view
+  std::vector<std::vector<bool>> outside;  // per other view: the sample lies outside it
   for (int32_t v = 0; v < n; ++v) {
     if (v == ref) continue;
     std::vector<float> cost(static_cast<size_t>(w) * h);
+    std::vector<bool> out(cost.size(), false);
     for (int32_t y = 0; y < h; ++y)
       for (int32_t x = 0; x < w; ++x) {
         const float pos = static_cast<float>(x) - static_cast<float>(v - ref) * disp;
@@ -61,6 +63,7 @@ std::vector<float> ReferenceDataTerm(const std::vector<ConstImageU8>& views, int
         const int32_t x0 = static_cast<int32_t>(x0f);
         if (x0 < 0 || x0 > w - 1 || (f > 0 && x0 + 1 > w - 1)) {
           cost[y * w + x] = invalid;
+          out[y * w + x] = true;
           continue;
         }
         const int32_t x1 = f > 0 ? x0 + 1 : x0;
@@ -76,19 +79,28 @@ std::vector<float> ReferenceDataTerm(const std::vector<ConstImageU8>& views, int
                                                params.census_weight * ham);
       }
     pixel.push_back(std::move(cost));
+    outside.push_back(std::move(out));
   }
-  const size_t keep = (pixel.size() + 1) / 2;
   std::vector<float> out(static_cast<size_t>(w) * h);
   for (int32_t y = 0; y < h; ++y)
     for (int32_t x = 0; x < w; ++x) {
-      std::vector<float> sums;
-      for (const auto& cost : pixel) {
+      // The windows of the views that see the pixel (not all 9 samples outside), or of all
+      // views when none does.
+      std::vector<float> sums, seen;
+      for (size_t v = 0; v < pixel.size(); ++v) {
         float s = 0;
+        bool sees = false;
         for (int32_t dy = -1; dy <= 1; ++dy)
-          for (int32_t dx = -1; dx <= 1; ++dx)
-            s += cost[std::clamp(y + dy, 0, h - 1) * w + std::clamp(x + dx, 0, w - 1)];
+          for (int32_t dx = -1; dx <= 1; ++dx) {
+            const int32_t i = std::clamp(y + dy, 0, h - 1) * w + std::clamp(x + dx, 0, w - 1);
+            s += pixel[v][i];
+            sees = sees || !outside[v][i];
+          }
         sums.push_back(s);
+        if (sees) seen.push_back(s);
       }
+      if (!seen.empty()) sums = seen;
+      const size_t keep = (sums.size() + 1) / 2;
       std::sort(sums.begin(), sums.end());
       float total = 0;
       for (size_t i = 0; i < keep; ++i) total += sums[i];
@@ -129,7 +141,7 @@ TEST(DataTermTest, FixedPointAgreesWithFloatReference) {
     const int32_t ref = views / 2;
     const synth::Burst b = synth::MakeBurst(48, 20, views, ref, 2, 5, 14, 34, 4, 16, 11u + views);
     for (const DataTermParams params :
-         {DataTermParams{}, DataTermParams{20, 3}, DataTermParams{200, 10}}) {
+         {DataTermParams{}, DataTermParams{20, 3}, DataTermParams{200, 2}}) {
       Fixed f;
       PrepareTerm(f, b, params);
       for (int32_t disp_q8 : {0, 64, 320, 512 + 77, 1280, 1530}) {

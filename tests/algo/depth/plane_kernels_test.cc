@@ -176,7 +176,7 @@ TEST(PlaneKernels, SpanVariantsEqualTheReference) {
         const int32_t y = static_cast<int32_t>(rng() % h);
         const int32_t trunc = truncs[rng() % 7];
         const int32_t cw = kind == 2 ? 10 : static_cast<int32_t>(rng() % 11);
-        const int32_t invalid = std::min(255, trunc + 24 * cw);
+        const int32_t invalid = std::min(255, trunc + 24 * cw + 1);
         const WarpRow row = v.Row(y, trunc, cw, invalid);
         const RandomRun r(rng, w, h);
         ++runs;
@@ -329,7 +329,7 @@ TEST(PlaneKernels, RowsThroughRandomHomographiesEqualTheReference) {
       }
       const DataTermParams params{45 + static_cast<int32_t>(rng() % 200),
                                   static_cast<int32_t>(rng() % 11)};
-      const int32_t invalid = std::min(255, params.color_trunc + 24 * params.census_weight);
+      const int32_t invalid = std::min(255, params.color_trunc + 24 * params.census_weight + 1);
       for (int32_t y = 0; y < h; y += 5) {
         const int32_t x0 = static_cast<int32_t>(rng() % w);
         for (const int32_t x1 : {w, std::min(w, x0 + 1 + static_cast<int32_t>(rng() % 20))}) {
@@ -373,7 +373,7 @@ TEST(PlaneKernels, RowsEqualTheirSpansOneByOne) {
         hom.m[8] = (int64_t{1} << 20) - hom.m[6] * xc - hom.m[7] * y;
       }
       const DataTermParams params{45, 4};
-      const int32_t invalid = std::min(255, params.color_trunc + 24 * params.census_weight);
+      const int32_t invalid = std::min(255, params.color_trunc + 24 * params.census_weight + 1);
       const int32_t begin = trial % 2 == 0 ? 0 : static_cast<int32_t>(rng() % w);
       const int32_t end = begin + 1 + static_cast<int32_t>(rng() % (w - begin));
       std::vector<uint8_t> got(w, 0x5a), want(w, 0x5a);

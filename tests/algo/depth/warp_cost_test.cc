@@ -219,13 +219,16 @@ std::vector<uint32_t> Census(const ConstImageU8& img) {
 // neighbours in the 4x4 taps around it, the 0.5 the rounding), the nearest census tap may be
 // either neighbour when the position is within delta of a half pixel, and a sample within delta
 // of a view's edge may be valid or not (cost 0..invalid). Window sums and order statistics are
-// monotone, so the bounds go through the window and the best-half mean as they are.
+// monotone, so the bounds go through the window and the best-half mean as they are, for a given
+// set of views that see the pixel (a window not all outside). A window whose samples are all
+// outside or unsure may or may not see it: the bounds take the extremes over both.
 struct Reference {
   std::vector<float> d, lo, hi;
 };
 
 struct SampleCost {
   float nominal, lo, hi;
+  bool outside = false, unsure = false;  // outside the view at the exact position; near its edge
 };
 
 // Per view, computed once: the census and each pixel's largest channel step to its right and
@@ -255,13 +258,13 @@ SampleCost Sample(const ConstImageU8& view, const ViewData& data, const uint8_t*
   const uint32_t* census = data.census.data();
   const int32_t w = view.width, h = view.height;
   const float invalid =
-      std::min(255.0f, static_cast<float>(prm.color_trunc + 24 * prm.census_weight));
+      std::min(255.0f, static_cast<float>(prm.color_trunc + 24 * prm.census_weight + 1));
   auto edge = [&](double p, int32_t size) {
     return std::fabs(p) <= delta || std::fabs(p - (size - 1)) <= delta;
   };
   const bool valid = vx >= 0 && vy >= 0 && vx <= w - 1 && vy <= h - 1;
   const bool unsure = edge(vx, w) || edge(vy, h);
-  if (!valid) return {invalid, unsure ? 0 : invalid, invalid};
+  if (!valid) return {invalid, unsure ? 0 : invalid, invalid, true, unsure};
   const int32_t ix = static_cast<int32_t>(vx), iy = static_cast<int32_t>(vy);
   const float fx = static_cast<float>(vx - ix), fy = static_cast<float>(vy - iy);
   const int32_t ix1 = std::min(ix + 1, w - 1), iy1 = std::min(iy + 1, h - 1);
@@ -308,6 +311,7 @@ SampleCost Sample(const ConstImageU8& view, const ViewData& data, const uint8_t*
   SampleCost out{std::min(255.0f, a + cw * ham), std::min(255.0f, a_lo + cw * h_min),
                  std::min(255.0f, a_hi + cw * h_max)};
   if (unsure) out.lo = 0, out.hi = invalid;
+  out.unsure = unsure;
   return out;
 }
 
@@ -329,7 +333,19 @@ Reference ReferenceTerm(const motiontest::Burst& b, const std::vector<ViewData>&
     }
     cost.push_back(std::move(c));
   }
-  const size_t keep = (cost.size() + 1) / 2;
+  const size_t views = cost.size();
+  // The mean of the best half of `sums` over the views in `seen` (bit v), or of all when none.
+  auto best_half = [&](const float* sums, uint32_t seen) {
+    float kept[16];
+    size_t n = 0;
+    for (size_t v = 0; v < views; ++v)
+      if (seen == 0 || (seen >> v & 1)) kept[n++] = sums[v];
+    std::sort(kept, kept + n);
+    const size_t keep = (n + 1) / 2;
+    float mean = 0;
+    for (size_t k = 0; k < keep; ++k) mean += kept[k] / static_cast<float>(keep);
+    return mean;
+  };
   Reference out;
   out.d.resize(static_cast<size_t>(w) * h);
   out.lo.resize(out.d.size());
@@ -337,9 +353,11 @@ Reference ReferenceTerm(const motiontest::Burst& b, const std::vector<ViewData>&
   for (int32_t y = 0; y < h; ++y) {
     for (int32_t x = 0; x < w; ++x) {
       float sums[3][16];
-      for (size_t v = 0; v < cost.size(); ++v) {
+      uint32_t sees = 0, either = 0;  // bit v: sees at the exact positions; may or may not
+      for (size_t v = 0; v < views; ++v) {
         const std::vector<SampleCost>& c = cost[v];
         float s[3] = {0, 0, 0};
+        bool in = false, surely_in = false, any_unsure = false;
         for (int32_t dy = -1; dy <= 1; ++dy) {
           for (int32_t dx = -1; dx <= 1; ++dx) {
             const SampleCost& q =
@@ -347,18 +365,25 @@ Reference ReferenceTerm(const motiontest::Burst& b, const std::vector<ViewData>&
             s[0] += q.nominal;
             s[1] += q.lo;
             s[2] += q.hi;
+            in = in || !q.outside;
+            surely_in = surely_in || (!q.outside && !q.unsure);
+            any_unsure = any_unsure || q.unsure;
           }
         }
         for (int i = 0; i < 3; ++i) sums[i][v] = s[i];
+        if (in) sees |= 1u << v;
+        if (!surely_in && any_unsure) either |= 1u << v;
       }
-      float mean[3] = {0, 0, 0};
-      for (int i = 0; i < 3; ++i) {
-        std::sort(sums[i], sums[i] + cost.size());
-        for (size_t k = 0; k < keep; ++k) mean[i] += sums[i][k] / static_cast<float>(keep);
+      out.d[y * w + x] = best_half(sums[0], sees);
+      // Every choice for the views that may or may not see the pixel (the others as they are).
+      float lo = 1e9f, hi = -1e9f;
+      for (uint32_t set = 0; set < (1u << views); ++set) {
+        if ((set ^ sees) & ~either) continue;
+        lo = std::min(lo, best_half(sums[1], set));
+        hi = std::max(hi, best_half(sums[2], set));
       }
-      out.d[y * w + x] = mean[0];
-      out.lo[y * w + x] = mean[1];
-      out.hi[y * w + x] = mean[2];
+      out.lo[y * w + x] = lo;
+      out.hi[y * w + x] = hi;
     }
   }
   return out;
@@ -409,7 +434,7 @@ TEST(WarpCostTest, FixedPointAgreesWithFloatReference) {
   const double delta = 1.0 / 512 + 1.0 / 65536 + chord;
   std::vector<ViewData> data;
   for (const ConstImageU8& v : b.views) data.push_back(Prepare(v));
-  for (const DataTermParams params : {DataTermParams{}, DataTermParams{200, 10}}) {
+  for (const DataTermParams params : {DataTermParams{}, DataTermParams{200, 2}}) {
     Fixed f;
     PrepareTerm(f, b, params);
     for (const double t : {0.0, 0.3, 0.7, 1.0}) {
@@ -476,7 +501,7 @@ TEST(WarpCostTest, SimdDataTermEqualsTheCReference) {
     motiontest::Burst b;
     ASSERT_TRUE(motiontest::MakeBurst(motiontest::Handheld(7), w, 30, 4, &b));
     const int32_t h = b.scene.height();
-    for (const DataTermParams params : {DataTermParams{}, DataTermParams{200, 10}}) {
+    for (const DataTermParams params : {DataTermParams{}, DataTermParams{200, 2}}) {
       Fixed simd, plain;
       PrepareTerm(simd, b, params);
       PrepareTerm(plain, b, params);
