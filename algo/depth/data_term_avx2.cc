@@ -384,7 +384,8 @@ LB_AVX2 inline __attribute__((always_inline)) bool SelectStep(const uint16_t* co
   SortNetwork<kB>(b);
   if constexpr (kKeep > 1) {  // one or two views keep one window whatever they see
     const __m256i most = kB > 0 ? _mm256_max_epi16(a[kKeep - 1], b[kB - 1]) : a[kKeep - 1];
-    if (!_mm256_testz_si256(_mm256_cmpgt_epi16(most, below_unseen), most)) return false;
+    const __m256i over = _mm256_cmpgt_epi16(most, below_unseen);
+    if (!_mm256_testz_si256(over, over)) return false;
   }
   __m256i sum = a[0];
   if constexpr (kB == kKeep) sum = _mm256_min_epi16(a[0], b[kKeep - 1]);
@@ -395,14 +396,45 @@ LB_AVX2 inline __attribute__((always_inline)) bool SelectStep(const uint16_t* co
   return true;
 }
 
-// Columns x..x + 15: SelectStep, or the reference where it declines.
+// The step SelectStep declines: every window sorted, so those of the views that do not see a lane
+// (the largest) come last; the seen ones counted lane by lane, the first `keep` of the sorted
+// windows summed under a mask, and each lane divided by its own keep.
+template <int32_t kViews>
+LB_AVX2 __attribute__((noinline)) void SelectSeenStep(const uint16_t* const* view, ptrdiff_t at,
+                                                      ptrdiff_t stride, __m256i below_unseen,
+                                                      uint16_t* out) {
+  constexpr int32_t kMost = (kViews + 1) / 2;
+  __m256i v[kViews];
+  for (int32_t j = 0; j < kViews; ++j) v[j] = Window(view[j] + at, stride);
+  SortNetwork<kViews>(v);
+  __m256i unseen = _mm256_setzero_si256();  // lanes count -1 per view that does not see them
+  for (int32_t j = 0; j < kViews; ++j) {
+    unseen = _mm256_add_epi16(unseen, _mm256_cmpgt_epi16(v[j], below_unseen));
+  }
+  const __m256i seen = _mm256_add_epi16(_mm256_set1_epi16(kViews), unseen);
+  const __m256i none = _mm256_cmpeq_epi16(seen, _mm256_setzero_si256());
+  const __m256i keep =
+      _mm256_blendv_epi8(_mm256_srli_epi16(_mm256_add_epi16(seen, _mm256_set1_epi16(1)), 1),
+                         _mm256_set1_epi16(kMost), none);
+  __m256i sum = v[0], recip = _mm256_setzero_si256();
+  for (int32_t i = 1; i < kMost; ++i) {
+    sum = _mm256_add_epi16(sum,
+                           _mm256_and_si256(v[i], _mm256_cmpgt_epi16(keep, _mm256_set1_epi16(i))));
+    const __m256i at_keep = _mm256_cmpeq_epi16(keep, _mm256_set1_epi16(i + 1));
+    recip = _mm256_or_si256(
+        recip, _mm256_and_si256(at_keep, _mm256_set1_epi16(static_cast<int16_t>(RecipQ15(i + 1)))));
+  }
+  const __m256i one = _mm256_cmpeq_epi16(keep, _mm256_set1_epi16(1));
+  Store(out, _mm256_blendv_epi8(_mm256_mulhrs_epi16(sum, recip), sum, one));
+}
+
+// Columns x..x + 15: SelectStep, or SelectSeenStep where it declines.
 template <int32_t kKeep, int32_t kB>
-LB_AVX2 inline __attribute__((always_inline)) void Step(const uint16_t* ring, ptrdiff_t stride,
-                                                        int32_t unseen, const uint16_t* const* view,
-                                                        ptrdiff_t at, __m256i recip, __m256i below,
-                                                        int32_t x, uint16_t* out) {
-  if (!SelectStep<kKeep, kB>(view, at, stride, recip, below, out + x)) {
-    SelectRowC(ring, stride, kKeep + kB, unseen, x, x + 16, out);
+LB_AVX2 inline __attribute__((always_inline)) void Step(const uint16_t* const* view, ptrdiff_t at,
+                                                        ptrdiff_t stride, __m256i recip,
+                                                        __m256i below, uint16_t* out) {
+  if (!SelectStep<kKeep, kB>(view, at, stride, recip, below, out)) {
+    SelectSeenStep<kKeep + kB>(view, at, stride, below, out);
   }
 }
 
@@ -418,17 +450,17 @@ LB_AVX2 void SelectRowAvx2T(const uint16_t* ring, ptrdiff_t stride, int32_t unse
   for (int32_t j = 0; j < kViews; ++j) view[j] = ring + 3 * j * stride + x0;
   int32_t x = x0;
   for (; x + 32 <= x1; x += 32) {  // two steps a turn: the pointers move half as often
-    Step<kKeep, kB>(ring, stride, unseen, view, 0, recip, below, x, out);
-    Step<kKeep, kB>(ring, stride, unseen, view, 16, recip, below, x + 16, out);
+    Step<kKeep, kB>(view, 0, stride, recip, below, out + x);
+    Step<kKeep, kB>(view, 16, stride, recip, below, out + x + 16);
     for (int32_t j = 0; j < kViews; ++j) view[j] += 32;
   }
   if (x + 16 <= x1) {
-    Step<kKeep, kB>(ring, stride, unseen, view, 0, recip, below, x, out);
+    Step<kKeep, kB>(view, 0, stride, recip, below, out + x);
     x += 16;
   }
   if (x < x1) {
     for (int32_t j = 0; j < kViews; ++j) view[j] = ring + 3 * j * stride + x1 - 16;
-    Step<kKeep, kB>(ring, stride, unseen, view, 0, recip, below, x1 - 16, out);
+    Step<kKeep, kB>(view, 0, stride, recip, below, out + x1 - 16);
   }
 }
 

@@ -168,10 +168,37 @@ inline void SortNetwork(int16x8_t* v) {
   }
 }
 
+// As the AVX2 kernel's SelectSeenStep: every window sorted, the views that see each lane counted,
+// the first `keep` summed under a mask and each lane divided by its own keep.
+template <int32_t kViews>
+__attribute__((noinline)) void SelectSeenStep(const uint16_t* ring, ptrdiff_t stride, int32_t x,
+                                              int16x8_t below_unseen, uint16_t* out) {
+  constexpr int32_t kMost = (kViews + 1) / 2;
+  int16x8_t v[kViews];
+  for (int32_t j = 0; j < kViews; ++j) v[j] = Window(ring, stride, j, x);
+  SortNetwork<kViews>(v);
+  int16x8_t seen = vdupq_n_s16(kViews);  // vcgt gives all ones, -1, per view unseen
+  for (int32_t j = 0; j < kViews; ++j) {
+    seen = vaddq_s16(seen, vreinterpretq_s16_u16(vcgtq_s16(v[j], below_unseen)));
+  }
+  const uint16x8_t none = vceqq_s16(seen, vdupq_n_s16(0));
+  const int16x8_t keep =
+      vbslq_s16(none, vdupq_n_s16(kMost), vshrq_n_s16(vaddq_s16(seen, vdupq_n_s16(1)), 1));
+  int16x8_t sum = v[0], recip = vdupq_n_s16(0);
+  for (int32_t i = 1; i < kMost; ++i) {
+    const uint16x8_t kept = vcgtq_s16(keep, vdupq_n_s16(static_cast<int16_t>(i)));
+    sum = vaddq_s16(sum, vandq_s16(v[i], vreinterpretq_s16_u16(kept)));
+    const uint16x8_t at_keep = vceqq_s16(keep, vdupq_n_s16(static_cast<int16_t>(i + 1)));
+    recip = vbslq_s16(at_keep, vdupq_n_s16(static_cast<int16_t>(RecipQ15(i + 1))), recip);
+  }
+  const uint16x8_t one = vceqq_s16(keep, vdupq_n_s16(1));
+  vst1q_u16(out + x, vreinterpretq_u16_s16(vbslq_s16(one, sum, vqrdmulhq_s16(sum, recip))));
+}
+
 // As the AVX2 kernel: the first kKeep windows and the other kB sorted apart, the kept sum that
 // of min(A_i, B_(kKeep-1-i)); vqrdmulh is (2 * sum * recip + 2^15) >> 16 =
 // (sum * recip + 2^14) >> 15. A step with a lane whose sorted maximum is `unseen` (a view that
-// does not see it) goes to the reference, which keeps fewer windows there.
+// does not see it) goes to SelectSeenStep, which keeps fewer windows there.
 template <int32_t kKeep, int32_t kB>
 void SelectRowNeonT(const uint16_t* ring, ptrdiff_t stride, int32_t unseen, int32_t x0, int32_t x1,
                     uint16_t* out) {
@@ -189,7 +216,7 @@ void SelectRowNeonT(const uint16_t* ring, ptrdiff_t stride, int32_t unseen, int3
       const uint16x8_t over = vcgtq_s16(most, below);
       const uint16x4_t any = vorr_u16(vget_low_u16(over), vget_high_u16(over));
       if (vget_lane_u64(vreinterpret_u64_u16(any), 0) != 0) {
-        SelectRowC(ring, stride, kKeep + kB, unseen, x, x + 8, out);
+        SelectSeenStep<kKeep + kB>(ring, stride, x, below, out);
         continue;
       }
     }

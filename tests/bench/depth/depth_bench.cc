@@ -58,24 +58,43 @@ DepthConfig TeddyConfig(const middlebury::Set& set) {
   return c;
 }
 
-void BM_DepthStageTeddy(benchmark::State& state) {
-  const middlebury::Set* set = Teddy();
-  if (!set) {
-    state.SkipWithError("../shared/data/middlebury/teddy is absent");
-    return;
-  }
-  DepthConfig c = TeddyConfig(*set);
-  c.subpixel = state.range(0) != 0;  // the refinement costs one more pass of the data term
-  const size_t bytes = DepthStage::RequiredBytes(c);
-  std::vector<uint8_t> memory(bytes + Arena::kAlign);
-  void* const base = Arena::AlignUp(memory.data());
-  Arena arena(base, bytes);
+// Teddy's depth stage, configured in memory of its own, and the set's views. Open is false, the
+// benchmark skipped with the reason, when the data is absent or the stage refuses.
+struct TeddyStage {
+  const middlebury::Set* set = nullptr;
+  DepthConfig config;
+  std::vector<uint8_t> memory;
   DepthStage stage;
-  if (!stage.Configure(c, arena).ok()) {
-    state.SkipWithError("configure failed");
-    return;
+  std::vector<ConstImageU8> views;
+
+  bool Open(benchmark::State& state, bool subpixel = false) {
+    set = Teddy();
+    if (!set) {
+      state.SkipWithError("../shared/data/middlebury/teddy is absent");
+      return false;
+    }
+    config = TeddyConfig(*set);
+    config.subpixel = subpixel;
+    const size_t bytes = DepthStage::RequiredBytes(config);
+    memory.assign(bytes + Arena::kAlign, 0);
+    Arena arena(Arena::AlignUp(memory.data()), bytes);
+    if (!stage.Configure(config, arena).ok()) {
+      state.SkipWithError("configure failed");
+      return false;
+    }
+    views = set->Views();
+    return true;
   }
-  const std::vector<ConstImageU8> views = set->Views();
+};
+
+void BM_DepthStageTeddy(benchmark::State& state) {
+  TeddyStage t;
+  // The refinement costs one more pass of the data term.
+  if (!t.Open(state, state.range(0) != 0)) return;
+  const middlebury::Set* set = t.set;
+  const DepthConfig& c = t.config;
+  DepthStage& stage = t.stage;
+  const std::vector<ConstImageU8>& views = t.views;
   std::vector<uint16_t> disp(static_cast<size_t>(c.width) * c.height);
   const ImageU16 out = MakeView(disp.data(), c.width, c.height);
   for (auto _ : state) {
@@ -95,20 +114,12 @@ BENCHMARK(BM_DepthStageTeddy)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Mi
 // The trim of the near side's overreach (fattening_trim.h) on teddy's map, as the pipeline runs
 // it after the stage, on 1 and 2 workers; the stage's own time is BM_DepthStageTeddy/1.
 void BM_FatteningTrimTeddy(benchmark::State& state) {
-  const middlebury::Set* set = Teddy();
-  if (!set) {
-    state.SkipWithError("../shared/data/middlebury/teddy is absent");
-    return;
-  }
-  const DepthConfig c = TeddyConfig(*set);
-  const size_t bytes = DepthStage::RequiredBytes(c);
-  std::vector<uint8_t> memory(bytes + Arena::kAlign);
-  Arena arena(Arena::AlignUp(memory.data()), bytes);
-  DepthStage stage;
-  const std::vector<ConstImageU8> views = set->Views();
+  TeddyStage t;
+  if (!t.Open(state)) return;
+  const DepthConfig& c = t.config;
+  const std::vector<ConstImageU8>& views = t.views;
   std::vector<uint16_t> map(static_cast<size_t>(c.width) * c.height);
-  if (!stage.Configure(c, arena).ok() ||
-      !stage.Compute(views.data(), MakeView(map.data(), c.width, c.height)).ok()) {
+  if (!t.stage.Compute(views.data(), MakeView(map.data(), c.width, c.height)).ok()) {
     state.SkipWithError("the depth stage failed");
     return;
   }
@@ -350,21 +361,12 @@ BENCHMARK(BM_OpenCvSgbmTeddy)->Unit(benchmark::kMillisecond)->MinTime(3.0);
 // turns, each timed on its own; the counters are each side's median and the median of the
 // per-turn ratios.
 void BM_TeddyOverSgbm(benchmark::State& state) {
-  const middlebury::Set* set = Teddy();
-  if (!set) {
-    state.SkipWithError("../shared/data/middlebury/teddy is absent");
-    return;
-  }
-  const DepthConfig c = TeddyConfig(*set);
-  const size_t bytes = DepthStage::RequiredBytes(c);
-  std::vector<uint8_t> memory(bytes + Arena::kAlign);
-  Arena arena(Arena::AlignUp(memory.data()), bytes);
-  DepthStage stage;
-  if (!stage.Configure(c, arena).ok()) {
-    state.SkipWithError("configure failed");
-    return;
-  }
-  const std::vector<ConstImageU8> views = set->Views();
+  TeddyStage t;
+  if (!t.Open(state)) return;
+  const middlebury::Set* set = t.set;
+  const DepthConfig& c = t.config;
+  DepthStage& stage = t.stage;
+  const std::vector<ConstImageU8>& views = t.views;
   std::vector<uint16_t> disp(static_cast<size_t>(c.width) * c.height);
   const ImageU16 out = MakeView(disp.data(), c.width, c.height);
   cv::setNumThreads(1);
