@@ -370,7 +370,7 @@ LB_AVX2 inline void SortNetwork(__m256i* v) {
 
 // 16 columns: view j's rows at view[j], view[j] + stride, view[j] + 2 * stride. False, with
 // nothing stored, when a lane has a view that does not see it (a window of `unseen`, the sorted
-// maximum): those columns keep fewer windows, which the reference counts lane by lane. Rare: a
+// maximum): those columns keep fewer windows, which SelectSeenStep counts lane by lane. Rare: a
 // border strip as wide as the label's shift.
 template <int32_t kKeep, int32_t kB>
 LB_AVX2 inline __attribute__((always_inline)) bool SelectStep(const uint16_t* const* view,
